@@ -1,0 +1,12 @@
+/* lib/include/edgespace/edgespace.h — the whole public API of libedgespace.
+ * Each module's header is the reference manual for that module; es_core.h
+ * states the conventions they all follow. */
+#ifndef EDGESPACE_EDGESPACE_H
+#define EDGESPACE_EDGESPACE_H
+
+#include "es_core.h"
+#include "es_mesh.h"
+#include "es_geom.h"
+#include "es_io.h"
+
+#endif

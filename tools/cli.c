@@ -1,0 +1,102 @@
+/* tools/cli.c — shared glue of the edgespace subcommands (see cli.h). */
+#include "cli.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+typedef struct cli_state {
+    const char *verb;
+    int tty;
+    double last_draw;
+} cli_state;
+
+static cli_state state;
+
+static void on_log(void *ud, es_log_level level, const char *msg)
+{
+    cli_state *st = ud;
+    fprintf(stderr, "edgespace %s: %s%s\n", st->verb,
+            level == ES_LOG_WARNING ? "warning: " : "", msg);
+}
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* A one-line bar redrawn at most ten times a second; quiet when stderr is
+ * not a terminal so logs and pipes stay clean. */
+static void on_progress(void *ud, const char *what, int64_t done, int64_t total)
+{
+    cli_state *st = ud;
+    double t = now_seconds();
+    if (!st->tty) return;
+    if (done < total && t - st->last_draw < 0.1) return;
+    st->last_draw = t;
+    int width = 30, filled = total > 0 ? (int)(width * done / total) : width;
+    fprintf(stderr, "\r%-24.24s [", what);
+    for (int i = 0; i < width; i++) fputc(i < filled ? '#' : '.', stderr);
+    fprintf(stderr, "] %lld/%lld", (long long)done, (long long)total);
+    if (done >= total) fputs("\r\033[K", stderr);
+    fflush(stderr);
+}
+
+es_ctx *cli_ctx_new(const char *verb)
+{
+    es_ctx *ctx = NULL;
+    if (es_ctx_new(&ctx) != ES_OK) {
+        fprintf(stderr, "edgespace %s: out of memory\n", verb);
+        return NULL;
+    }
+    state.verb = verb;
+    state.tty = isatty(STDERR_FILENO);
+    es_ctx_set_log(ctx, on_log, &state);
+    es_ctx_set_progress(ctx, on_progress, &state);
+    return ctx;
+}
+
+int cli_fail(const char *verb, es_ctx *ctx, es_status rc)
+{
+    const char *msg = ctx ? es_ctx_errmsg(ctx) : "";
+    fprintf(stderr, "edgespace %s: %s\n", verb, msg && *msg ? msg : es_strerror(rc));
+    return CLI_FAIL;
+}
+
+int cli_usage_error(const char *verb, const char *fmt, ...)
+{
+    va_list ap;
+    fprintf(stderr, "edgespace %s: ", verb);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fprintf(stderr, "\nTry 'edgespace %s --help'.\n", verb);
+    return CLI_USAGE;
+}
+
+int cli_parse_i64(const char *s, int64_t *out)
+{
+    char *end;
+    errno = 0;
+    long long v = strtoll(s, &end, 10);
+    if (errno || end == s || *end) return -1;
+    *out = v;
+    return 0;
+}
+
+int cli_parse_double(const char *s, double *out)
+{
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (errno || end == s || *end || !isfinite(v)) return -1;
+    *out = v;
+    return 0;
+}

@@ -1,0 +1,30 @@
+/* tools/cli.h — glue shared by the edgespace subcommands: context set-up with
+ * warnings and progress on stderr, error reporting, option helpers. */
+#ifndef EDGESPACE_TOOLS_CLI_H
+#define EDGESPACE_TOOLS_CLI_H
+
+#include <edgespace/edgespace.h>
+
+/* Exit statuses of every subcommand. */
+enum { CLI_OK = 0, CLI_FAIL = 1, CLI_USAGE = 2 };
+
+/* A context whose warnings print as "edgespace VERB: warning: ..." and whose
+ * progress shows as a bar on stderr when stderr is a terminal. NULL if out
+ * of memory (after printing why). */
+es_ctx *cli_ctx_new(const char *verb);
+
+/* Print "edgespace VERB: <errmsg>" (or the status text) and return CLI_FAIL. */
+int cli_fail(const char *verb, es_ctx *ctx, es_status rc);
+
+/* Print "edgespace VERB: <message>" plus a hint to run --help; CLI_USAGE. */
+int cli_usage_error(const char *verb, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+
+/* Parse a whole string as int64 / double; 0 on success, -1 otherwise. */
+int cli_parse_i64(const char *s, int64_t *out);
+int cli_parse_double(const char *s, double *out);
+
+/* Subcommand entry points: argv[0] is the verb. */
+typedef int (*cli_cmd_fn)(int argc, char **argv);
+
+#endif

@@ -1,0 +1,13 @@
+/* tools/commands.h — the subcommands, each in tools/cmd_<verb>.c. */
+#ifndef EDGESPACE_TOOLS_COMMANDS_H
+#define EDGESPACE_TOOLS_COMMANDS_H
+
+/* -- topology, geometry, synthetic data */
+/* -- mesh I/O */
+/* -- store, manifest, ingest */
+/* -- statistics, point syntax */
+/* -- procrustes, landmarks, comparison */
+/* -- embedding, interpolation */
+/* -- plotting, rendering */
+
+#endif

@@ -1,0 +1,67 @@
+/* tools/edgespace.c — the edgespace command: dispatches to subcommands, git
+ * style. Each subcommand lives in tools/cmd_<verb>.c and stays thin over the
+ * library. */
+#include "cli.h"
+#include "commands.h"
+
+#include <stdio.h>
+#include <string.h>
+
+typedef struct command {
+    const char *name;
+    cli_cmd_fn fn;
+    const char *summary;
+} command;
+
+static const command commands[] = {
+    /* -- topology, geometry, synthetic data */
+    /* -- mesh I/O */
+    /* -- store, manifest, ingest */
+    /* -- statistics, point syntax */
+    /* -- procrustes, landmarks, comparison */
+    /* -- embedding, interpolation */
+    /* -- plotting, rendering */
+    {NULL, NULL, NULL}
+};
+
+static void print_help(FILE *f)
+{
+    fputs("usage: edgespace <command> [options]\n"
+          "       edgespace help [command] | --version\n\n"
+          "Statistical shape analysis in edge-length shape space.\n\ncommands:\n", f);
+    for (const command *c = commands; c->name; c++)
+        fprintf(f, "  %-18s %s\n", c->name, c->summary);
+    fputs("\nRun 'edgespace <command> --help' for a command's options.\n", f);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        print_help(stderr);
+        return CLI_USAGE;
+    }
+    const char *verb = argv[1];
+    if (!strcmp(verb, "--version") || !strcmp(verb, "version")) {
+        printf("edgespace %s\n", es_version());
+        return CLI_OK;
+    }
+    if (!strcmp(verb, "help") || !strcmp(verb, "--help") || !strcmp(verb, "-h")) {
+        if (argc > 2) {
+            for (const command *c = commands; c->name; c++) {
+                if (!strcmp(c->name, argv[2])) {
+                    char help[] = "--help";
+                    char *sub[] = {argv[2], help, NULL};
+                    return c->fn(2, sub);
+                }
+            }
+            fprintf(stderr, "edgespace: unknown command '%s'\n", argv[2]);
+            return CLI_USAGE;
+        }
+        print_help(stdout);
+        return CLI_OK;
+    }
+    for (const command *c = commands; c->name; c++)
+        if (!strcmp(c->name, verb)) return c->fn(argc - 1, argv + 1);
+    fprintf(stderr, "edgespace: unknown command '%s'\nTry 'edgespace help'.\n", verb);
+    return CLI_USAGE;
+}

@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# tools/setup.sh — install what edgespace needs on Debian 12, configure, build,
+# and then run the main job or the test suite.
+#
+#   bash tools/setup.sh demo    # install, build, run the main job (README step 1)
+#   bash tools/setup.sh test    # install, build, run every test  (README step 2)
+#   bash tools/setup.sh build   # install and build only
+#
+# Installs exactly the missing Debian packages (apt-get, non-interactive,
+# idempotent: a second run installs nothing). Environment:
+#   BUILD_DIR   build directory (default: build)
+#   MESON_ARGS  extra arguments for 'meson setup' (e.g. -Dwerror=true)
+set -euo pipefail
+
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$here"
+mode=${1:-build}
+build_dir=${BUILD_DIR:-build}
+
+packages=(
+  build-essential meson ninja-build pkg-config python3
+  libopenblas-dev liblapacke-dev libsuitesparse-dev libhdf5-dev hdf5-tools libcsv-dev
+  liblbfgs-dev libcairo2-dev
+  clang libclang-rt-14-dev   # libFuzzer targets for the parsers
+)
+
+install_missing() {
+  local missing=()
+  for p in "${packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  echo "setup: installing ${missing[*]}" >&2
+  local sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends \
+    "${missing[@]}" >&2
+}
+
+configure_and_build() {
+  # shellcheck disable=SC2086
+  if [ -f "$build_dir/build.ninja" ]; then
+    meson configure "$build_dir" ${MESON_ARGS:-} >/dev/null
+  else
+    meson setup "$build_dir" ${MESON_ARGS:-} >/dev/null
+  fi
+  ninja -C "$build_dir" >&2
+}
+
+install_missing
+case "$mode" in
+  build) configure_and_build ;;
+  demo)  configure_and_build; bash tools/main-job.sh "$build_dir" ;;
+  test)  configure_and_build; meson test -C "$build_dir" --print-errorlogs --num-processes 2 ;;
+  *) echo "usage: $0 [build|demo|test]" >&2; exit 2 ;;
+esac
