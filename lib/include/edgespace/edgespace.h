@@ -9,5 +9,6 @@
 #include "es_geom.h"
 #include "es_io.h"
 #include "es_stats.h"
+#include "es_point.h"
 
 #endif
