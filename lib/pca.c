@@ -11,9 +11,9 @@
  * lengths differ from each other by a few percent only).
  *
  * The Gram matrix needs every pair of shapes, so it is built in tiles: an
- * outer block of rows is held (as large as a memory budget allows) while
- * the later rows stream past it; with the default budget 600 x 175,000 takes
- * about two passes over the data, a third forms the components. Each entry
+ * outer tile of rows is held (256 MiB by default) while the later rows
+ * stream past it in tiles of the same size; 600 x 175,000 takes about two
+ * passes over the data, a third forms the components. Each entry
  * is a dot product over all E edges whatever the blocking.
  *
  * References: Jolliffe, Principal Component Analysis (2002), 3.5 (the Gram
@@ -27,9 +27,9 @@
 #include <math.h>
 #include <string.h>
 
-/* Rows held in the outer block of the Gram tiles when the source does not
- * fix the block size. */
-#define OUTER_BYTES ((int64_t)256 << 20)
+/* Bytes of one tile of rows of the Gram route (two are held) when the
+ * source does not fix the block size. */
+#define TILE_BYTES ((int64_t)256 << 20)
 
 void es_pca_opts_init(es_pca_opts *o)
 {
@@ -157,10 +157,13 @@ static es_status read_minus(es_ctx *ctx, const es_source *src, int64_t r0, int64
 
 static es_status fit_gram(es_ctx *ctx, const es_source *src, int64_t K, es_pca **out)
 {
-    const int64_t E = src->nedges, N = src->nrows, B = es__source_block(src);
-    int64_t BO = src->block > 0 ? B : OUTER_BYTES / (8 * E);
-    if (BO < B) BO = B;
+    const int64_t E = src->nedges, N = src->nrows;
+    /* square tiles: thin ones (a few rows against thousands of edges) run
+     * BLAS at a tenth of its speed */
+    int64_t BO = src->block > 0 ? src->block : TILE_BYTES / (8 * E);
+    if (BO < 1) BO = 1;
     if (BO > N) BO = N;
+    const int64_t B = BO;
     es_status rc = ES_OK;
     int nn, ne;
     if ((rc = es__lapack_int(ctx, N, &nn)) != ES_OK || (rc = es__lapack_int(ctx, E, &ne)) != ES_OK)
