@@ -553,7 +553,7 @@ static void test_large(es_ctx *ctx)
 
 static void test_oracle_fans(es_ctx *ctx)
 {
-    char buf[4096];
+    char buf[8192];
     const char *names[] = {"bumpy_ico2", "hemi2", "tube_small"};
     const int64_t loops[] = {0, 1, 0};
     const char *dir = es_test_shared_path("oracle/embed", buf, sizeof buf);
@@ -562,7 +562,7 @@ static void test_oracle_fans(es_ctx *ctx)
         return;
     }
     for (int i = 0; i < 3; i++) {
-        char path[4200];
+        char path[8400];
         obj o;
         snprintf(path, sizeof path, "%s/%s/mesh.obj", dir, names[i]);
         if (obj_read(path, &o) != 0) {
@@ -624,7 +624,7 @@ static void test_real_meshes(es_ctx *ctx)
         return;
     }
     for (size_t s = 0; s < sizeof sets / sizeof sets[0]; s++) {
-        char path[4200], first_fp[17] = "";
+        char path[8400], first_fp[17] = "";
         snprintf(path, sizeof path, "%s/%s", data, sets[s].dir);
         DIR *d = opendir(path);
         if (!d) {
