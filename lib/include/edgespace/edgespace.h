@@ -9,5 +9,6 @@
 #include "es_geom.h"
 #include "es_io.h"
 #include "es_plot.h"
+#include "es_render.h"
 
 #endif
