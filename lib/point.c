@@ -490,13 +490,19 @@ static const char *leaf_prefix(es_point_leaf k)
 }
 
 es_status es_point_eval(es_ctx *ctx, const es_point_expr *x, int64_t E,
-                        es_point_resolve_fn resolve, void *ud, double *vec, es_point_info *info)
+                        es_point_resolve_fn resolve, void *ud, const es_mesh *mesh, double *vec,
+                        es_point_info *info)
 {
     if (!x || !resolve || !vec || E < 1)
         ES_FAIL(ctx, ES_EINVAL, "point: nothing to evaluate");
+    if (mesh && es_mesh_nedges(mesh) != E)
+        ES_FAIL(ctx, ES_EMISMATCH, "point: %lld edges, the mesh has %lld", (long long)E,
+                (long long)es_mesh_nedges(mesh));
     double *leaf = es__alloc_array(ctx, E, sizeof *leaf);
     if (!leaf) return ES_ENOMEM;
-    es_point_info in = {0, NAN, 0, 0, 0};
+    es_point_info in;
+    memset(&in, 0, sizeof in);
+    in.scale = NAN;
     double wscale = 0;
     memset(vec, 0, (size_t)E * sizeof *vec);
     for (int64_t i = 0; i < x->n; i++) {
@@ -543,6 +549,11 @@ es_status es_point_eval(es_ctx *ctx, const es_point_expr *x, int64_t E,
     if (fabs(in.weight - 1.0) > 1e-12)
         es__warn(ctx, "point: the shapes' weights sum to %g, not 1: the lengths sum to %g",
                  in.weight, in.length_sum);
+    if (mesh) {
+        es_status rc = es_lengths_check(ctx, mesh, vec, 0.0, &in.validity);
+        if (rc != ES_OK) return rc;
+        in.checked = 1;
+    }
     if (info) *info = in;
     return ES_OK;
 }

@@ -4,6 +4,7 @@
 #include "es_test.h"
 #include "es_internal.h"
 #include "edgespace/es_point.h"
+#include "edgespace/es_mesh.h"
 
 enum { E = 4 };
 
@@ -52,7 +53,7 @@ static void eval_ok(es_ctx *ctx, const char *text, const double want[E], double 
     es_point_info info;
     ES_CHECK_OK(ctx, es_point_parse(ctx, text, &x));
     if (!x) return;
-    ES_CHECK_OK(ctx, es_point_eval(ctx, x, E, resolve, &calls, v, &info));
+    ES_CHECK_OK(ctx, es_point_eval(ctx, x, E, resolve, &calls, NULL, v, &info));
     ES_CHECK(calls == es_point_expr_nterms(x));
     for (int e = 0; e < E; e++) ES_CHECK_CLOSE(v[e], want[e], 1e-14, 1e-15);
     if (isnan(scale)) ES_CHECK_MSG(isnan(info.scale), "%s: scale %g", text, info.scale);
@@ -112,13 +113,13 @@ static void test_eval(es_ctx *ctx)
     double v[E];
     ES_CHECK_OK(ctx, es_point_parse(ctx, "mean + row:zz", &x));
     if (x) {
-        ES_CHECK_FAILS(ctx, es_point_eval(ctx, x, E, resolve, &calls, v, NULL), ES_ENOTFOUND,
+        ES_CHECK_FAILS(ctx, es_point_eval(ctx, x, E, resolve, &calls, NULL, v, NULL), ES_ENOTFOUND,
                        "point: row:zz: no such row");
         es_point_expr_free(x);
     }
     ES_CHECK_OK(ctx, es_point_parse(ctx, "mean[q=1] + pc:9", &x));
     if (x) {
-        ES_CHECK_FAILS(ctx, es_point_eval(ctx, x, E, resolve, &calls, v, NULL), ES_ENOTFOUND,
+        ES_CHECK_FAILS(ctx, es_point_eval(ctx, x, E, resolve, &calls, NULL, v, NULL), ES_ENOTFOUND,
                        "point: mean[q=1]: no rows match 'q=1'");
         es_point_expr_free(x);
     }
@@ -184,6 +185,45 @@ static void test_errors(es_ctx *ctx)
     ES_CHECK_FAILS(ctx, es_point_parse(ctx, deep, &x), ES_EFORMAT, "nested too deeply");
 }
 
+/* Validity: on one triangle, interpolating two valid rows stays valid,
+ * extrapolating far enough breaks the triangle inequality. */
+static es_status resolve_tri(es_ctx *ctx, void *ud, es_point_leaf kind, const char *arg,
+                             int64_t index, double *v, double *scale)
+{
+    (void)ud, (void)index;
+    if (kind != ES_POINT_ROW) ES_FAIL(ctx, ES_EINVAL, "rows only");
+    const double eq[3] = {1.0 / 3, 1.0 / 3, 1.0 / 3}, flat[3] = {0.25, 0.25, 0.5};
+    memcpy(v, !strcmp(arg, "eq") ? eq : flat, sizeof eq);
+    *scale = 3;
+    return ES_OK;
+}
+
+static void test_validity(es_ctx *ctx)
+{
+    const int64_t faces[3] = {0, 1, 2};
+    es_mesh *m = NULL;
+    ES_CHECK_OK(ctx, es_mesh_new(ctx, 3, 1, faces, NULL, &m));
+    if (!m) return;
+    const struct { const char *text; int valid; } cases[] = {
+        {"lerp(row:eq, row:flat, 0.5)", 1}, {"lerp(row:eq, row:flat, 1.5)", 0},
+        {"row:eq", 1}, {"2*row:flat - 3*row:eq", 0}};
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        es_point_expr *x = NULL;
+        es_point_info info;
+        double v[3];
+        ES_CHECK_OK(ctx, es_point_parse(ctx, cases[i].text, &x));
+        if (!x) continue;
+        ES_CHECK_OK(ctx, es_point_eval(ctx, x, 3, resolve_tri, NULL, m, v, &info));
+        ES_CHECK(info.checked == 1);
+        ES_CHECK_MSG(info.validity.valid == cases[i].valid, "%s", cases[i].text);
+        if (!cases[i].valid) ES_CHECK(info.validity.n_bad_faces + info.validity.n_nonpositive > 0);
+        ES_CHECK_FAILS(ctx, es_point_eval(ctx, x, 4, resolve_tri, NULL, m, v, &info),
+                       ES_EMISMATCH, "mesh has 3");
+        es_point_expr_free(x);
+    }
+    es_mesh_free(m);
+}
+
 int main(void)
 {
     ES_TEST_BEGIN();
@@ -191,6 +231,7 @@ int main(void)
     if (es_ctx_new(&ctx) != ES_OK) return 1;
     test_eval(ctx);
     test_errors(ctx);
+    test_validity(ctx);
     es_ctx_free(ctx);
     ES_TEST_END();
 }

@@ -29,6 +29,8 @@
 #define EDGESPACE_ES_POINT_H
 
 #include "es_core.h"
+#include "es_geom.h"
+#include "es_mesh.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -72,14 +74,19 @@ typedef struct es_point_info {
     double length_sum;    /* sum of the point's lengths (== weight for normalized inputs) */
     int64_t nshapes;      /* shape leaves */
     int64_t ndirections;  /* direction leaves */
+    int checked;          /* 1 when a mesh was given and `validity` is filled */
+    es_validity validity; /* es_lengths_check of the point (positive lengths,
+                             triangle inequality per face, rtol 0) */
 } es_point_info;
 
-/* Evaluate expr: vec (nedges) = sum_i c_i leaf_i. info may be NULL.
- * A failing resolver's status is returned with its message prefixed by the
- * leaf ("point: row:s009: ..."). */
+/* Evaluate expr: vec (nedges) = sum_i c_i leaf_i. info may be NULL. With a
+ * mesh (its E must equal nedges) info->validity reports where the point
+ * leaves the realizable region; an invalid point is not an error. A failing
+ * resolver's status is returned with its message prefixed by the leaf
+ * ("point: row:s009: ..."). */
 ES_API es_status es_point_eval(es_ctx *ctx, const es_point_expr *expr, int64_t nedges,
-                               es_point_resolve_fn resolve, void *userdata, double *vec,
-                               es_point_info *info);
+                               es_point_resolve_fn resolve, void *userdata,
+                               const es_mesh *mesh, double *vec, es_point_info *info);
 
 #ifdef __cplusplus
 }
