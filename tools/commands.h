@@ -3,6 +3,7 @@
 #define EDGESPACE_TOOLS_COMMANDS_H
 
 /* -- topology, geometry, synthetic data */
+int cmd_synth(int argc, char **argv);
 /* -- mesh I/O */
 /* -- store, manifest, ingest */
 /* -- statistics, point syntax */

@@ -15,6 +15,7 @@ typedef struct command {
 
 static const command commands[] = {
     /* -- topology, geometry, synthetic data */
+    {"synth", cmd_synth, "write a synthetic family of meshes in correspondence"},
     /* -- mesh I/O */
     /* -- store, manifest, ingest */
     /* -- statistics, point syntax */
