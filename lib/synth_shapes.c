@@ -55,6 +55,36 @@ static void add_noise(es__rng *rng, double *xyz, int64_t nv, double sd)
 
 /* ---- barbells ---- */
 
+/* Angles phi_0 = 0 .. phi_{n-1} at equal arc length around the
+ * superellipse (sgnpow(cos phi, eps), sgnpow(sin phi, eps)). */
+static void superellipse_angles(double eps, int64_t n, double *phi)
+{
+    enum { NS = 8192 };
+    double prev[2] = {1, 0}, total = 0, acc = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        int64_t j = 1;
+        acc = 0;
+        prev[0] = 1;
+        prev[1] = 0;
+        phi[0] = 0;
+        for (int i = 1; i <= NS; i++) {
+            double t = 2 * M_PI * i / NS;
+            double p[2] = {sgnpow(cos(t), eps), sgnpow(sin(t), eps)};
+            double d = hypot(p[0] - prev[0], p[1] - prev[1]);
+            if (pass == 1)
+                while (j < n && acc + d >= total * (double)j / (double)n) {
+                    double w = d > 0 ? (total * (double)j / (double)n - acc) / d : 1;
+                    phi[j++] = 2 * M_PI * ((double)(i - 1) + w) / NS;
+                }
+            acc += d;
+            prev[0] = p[0];
+            prev[1] = p[1];
+        }
+        total = acc;
+        for (; pass == 1 && j < n; j++) phi[j] = 2 * M_PI * (double)j / (double)n;
+    }
+}
+
 /* One barbell: superellipsoid ends of radius R and exponent p, bar of
  * radius rb and length L along x, centred at the origin. Ring order: left
  * pole, left bulb (nb rings, the last is the neck), bar (nbar rings), right
@@ -66,15 +96,35 @@ static void barbell_xyz(double p, double L, int64_t nseg, int64_t nb, int64_t nb
     double thn = M_PI - asin(pow(rb / R, 1.0 / eps));       /* radial(thn) = rb */
     double c = L / 2 + R * pow(-cos(thn), eps);            /* bulb centre |x| */
     int64_t v = 0;
+    /* rings at equal arc length along the bulb's profile, so that the flat
+     * sides of the cube-like end are sampled as densely as its corners */
+    enum { NS = 4096 };
+    double arc[NS + 1], thk[128]; /* nb <= 96 (resolution <= 64) */
+    arc[0] = 0;
+    for (int i = 1; i <= NS; i++) {
+        double t0 = thn * (i - 1) / NS, t1 = thn * i / NS;
+        double dx = R * (sgnpow(cos(t1), eps) - sgnpow(cos(t0), eps));
+        double dr = R * (pow(fabs(sin(t1)), eps) - pow(fabs(sin(t0)), eps));
+        arc[i] = arc[i - 1] + sqrt(dx * dx + dr * dr);
+    }
+    for (int64_t k = 1, i = 1; k <= nb; k++) {
+        double target = arc[NS] * (double)k / (double)nb;
+        while (i < NS && arc[i] < target) i++;
+        double w = arc[i] > arc[i - 1] ? (target - arc[i - 1]) / (arc[i] - arc[i - 1]) : 1;
+        thk[k] = thn * ((double)(i - 1) + w) / NS;
+    }
+    thk[nb] = thn;
+    double phi[96 * 2]; /* nseg <= 192 (resolution <= 64) */
+    superellipse_angles(eps, nseg, phi);
     xyz[v++] = -(c + R); xyz[v++] = 0; xyz[v++] = 0;
     for (int side = 0; side < 2; side++) {
         for (int64_t kk = 1; kk <= nb; kk++) {
             int64_t k = side == 0 ? kk : nb + 1 - kk;
-            double th = thn * (double)k / (double)nb;
+            double th = thk[k];
             double xl = R * sgnpow(cos(th), eps), rad = R * pow(fabs(sin(th)), eps);
             double x = side == 0 ? -c - xl : c + xl;
             for (int64_t j = 0; j < nseg; j++) {
-                double ph = 2 * M_PI * (double)j / (double)nseg;
+                double ph = phi[j];
                 xyz[v++] = x;
                 xyz[v++] = rad * sgnpow(cos(ph), eps);
                 xyz[v++] = rad * sgnpow(sin(ph), eps);

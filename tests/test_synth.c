@@ -129,7 +129,7 @@ static void test_barbell(es_ctx *ctx)
     es_mesh *m = topology(ctx, &s);
     if (m) {
         check_topology(m, 0, 0);
-        check_members(ctx, &s, m, 0.5);
+        check_members(ctx, &s, m, 5);
         for (int64_t i = 0; i < 4; i++) ES_CHECK_MSG(volume(&s, i) > 0, "%s", s.names[i]);
         /* the cube-like end holds more volume than the sphere-like one */
         ES_CHECK(volume(&s, 2) > volume(&s, 0) && volume(&s, 3) > volume(&s, 1));
