@@ -3,12 +3,13 @@
  *
  * The shapes themselves are in synth_shapes.c. Subdivision numbers the new
  * vertices by edge id, so a subdivided family stays in correspondence and
- * the result is the same on every run. OBJ output is written here with a
- * minimal writer (v/f lines, %.17g) until the io module's es_mesh_write is
- * on main; it then can replace write_obj without changing the files.
+ * the result is the same on every run. Members are written with the io
+ * module's writer (es__meshdata_write: OBJ, %.17g, exact round trips),
+ * which needs no topology; es_mesh_write is not on main yet.
  */
 #include "synth_internal.h"
 #include "edgespace/es_mesh.h"
+#include "mesh_io_internal.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -207,22 +208,6 @@ es_status es_synth_subdivide(es_ctx *ctx, es_synth_set *s, int levels)
 
 /* ---- output ---- */
 
-static es_status write_obj(es_ctx *ctx, const char *path, int64_t nv, const double *xyz,
-                           int64_t nf, const int64_t *faces)
-{
-    FILE *fp = fopen(path, "w");
-    if (!fp) ES_FAIL(ctx, ES_EIO, "synth: cannot create '%s': %s", path, strerror(errno));
-    for (int64_t v = 0; v < nv; v++)
-        fprintf(fp, "v %.17g %.17g %.17g\n", xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]);
-    for (int64_t f = 0; f < nf; f++)
-        fprintf(fp, "f %lld %lld %lld\n", (long long)faces[3 * f] + 1,
-                (long long)faces[3 * f + 1] + 1, (long long)faces[3 * f + 2] + 1);
-    int bad = ferror(fp);
-    if (fclose(fp) != 0 || bad)
-        ES_FAIL(ctx, ES_EIO, "synth: cannot write '%s': %s", path, strerror(errno));
-    return ES_OK;
-}
-
 /* A CSV field, quoted when it holds a comma, quote or newline (RFC 4180). */
 static void csv_field(FILE *fp, const char *s)
 {
@@ -269,7 +254,8 @@ es_status es_synth_write(es_ctx *ctx, const es_synth_set *s, const char *dir)
     for (int64_t i = 0; i < s->nmembers; i++) {
         if (snprintf(path, sizeof path, "%s/%s.obj", dir, s->names[i]) >= (int)sizeof path)
             ES_FAIL(ctx, ES_ERANGE, "synth: path too long in '%s'", dir);
-        rc = write_obj(ctx, path, s->nverts, s->xyz + 3 * s->nverts * i, s->nfaces, s->faces);
+        rc = es__meshdata_write(ctx, path, ES_FORMAT_OBJ, s->nverts, s->nfaces, s->faces,
+                                s->xyz + 3 * s->nverts * i, NULL);
         if (rc != ES_OK) return rc;
         es__progress(ctx, "synth write", i + 1, s->nmembers);
     }
