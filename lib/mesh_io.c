@@ -38,14 +38,10 @@ void es__mdbuild_init(es__mdbuild *b, es_ctx *ctx, es_meshdata *md)
 
 static es_status grow(es_ctx *ctx, void **arr, int64_t *cap, int64_t need, size_t elem)
 {
-    int64_t ncap = *cap ? *cap : INITIAL_CAP;
+    int64_t ncap = *cap == 0 ? INITIAL_CAP : *cap > INT64_MAX / 2 ? INT64_MAX : 2 * *cap;
     size_t bytes;
     void *p;
-    while (ncap < need) {
-        if (ncap > INT64_MAX / 2) ES_FAIL(ctx, ES_ERANGE, "mesh too large (%lld elements)",
-                                          (long long)need);
-        ncap *= 2;
-    }
+    if (ncap < need) ncap = need;   /* an exact reservation is not rounded up */
     if (!es__mul_size((size_t)ncap, elem, &bytes))
         ES_FAIL(ctx, ES_ERANGE, "mesh too large (%lld elements)", (long long)need);
     p = es__realloc(ctx, *arr, bytes);
@@ -213,6 +209,12 @@ es_status es__read_file(es_ctx *ctx, const char *path, char **buf, size_t *len)
     }
     if (cap == 0) cap = 65536;
     for (;;) {
+        /* a full buffer of the stat'ed size grows only if more data follows */
+        if (b && n + 1 == cap) {
+            int c = fgetc(f);
+            if (c == EOF) break;
+            b[n++] = (char)c;
+        }
         if (!b || n + 1 >= cap) {
             char *nb;
             if (b) {
