@@ -25,7 +25,7 @@
 #include <stdlib.h>
 #include <strings.h>
 
-#define INITIAL_CAP 1024
+#define INITIAL_CAP 64
 
 void es__mdbuild_init(es__mdbuild *b, es_ctx *ctx, es_meshdata *md)
 {

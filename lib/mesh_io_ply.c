@@ -131,6 +131,11 @@ static es_status header(plyp *P)
             size_t nn;
             int64_t count;
             if (P->nelems == MAX_ELEMS) HFAIL("more than %d elements", MAX_ELEMS);
+            {
+                elem *ne = es__realloc(P->ctx, P->elems, (size_t)(P->nelems + 1) * sizeof *ne);
+                if (!ne) return ES_ENOMEM;
+                P->elems = ne;
+            }
             if (!word(&q, eol, &nm, &nn)) HFAIL("element without a name");
             if (!word(&q, eol, &w, &n) || es__parse_int64(w, w + n, &count) != w + n ||
                 count < 0)
@@ -465,8 +470,6 @@ es_status es__ply_parse(es_ctx *ctx, const char *name, const char *buf, size_t l
     P.buf = P.p = buf;
     P.end = buf + len;
     es__mdbuild_init(&P.b, ctx, md);
-    P.elems = es__alloc_array(ctx, MAX_ELEMS, sizeof *P.elems);
-    if (!P.elems) return ES_ENOMEM;
     if ((rc = header(&P)) == ES_OK)
         rc = P.fmt == F_ASCII ? body_ascii(&P) : body_binary(&P);
     es__free(ctx, P.elems);
