@@ -377,3 +377,33 @@ es_status es__meshdata_write(es_ctx *ctx, const char *path, es_mesh_format forma
     if (rc != ES_OK) remove(path);
     return rc;
 }
+
+/* ---------------------------------------------------------------- meshes */
+
+es_status es_mesh_read(es_ctx *ctx, const char *path, es_mesh **out)
+{
+    es_meshdata md;
+    es_status rc;
+    if (!out) ES_FAIL(ctx, ES_EINVAL, "es_mesh_read: out is NULL");
+    *out = NULL;
+    if ((rc = es_meshdata_read(ctx, path, ES_FORMAT_AUTO, &md)) != ES_OK) return rc;
+    rc = es_mesh_new(ctx, md.nverts, md.nfaces, md.faces, md.xyz, out);
+    if (rc != ES_OK) {
+        /* name the file: topology messages only know faces and vertices */
+        char msg[1024];
+        snprintf(msg, sizeof msg, "%s", es_ctx_errmsg(ctx));
+        es__fail(ctx, rc, "%s: %s", path, msg);
+    }
+    es_meshdata_clear(ctx, &md);
+    return rc;
+}
+
+es_status es_mesh_write(es_ctx *ctx, const char *path, es_mesh_format format,
+                        const es_mesh *mesh, const double *xyz, const uint8_t *vertex_rgb)
+{
+    if (!mesh) ES_FAIL(ctx, ES_EINVAL, "es_mesh_write: mesh is NULL");
+    if (!xyz) xyz = es_mesh_xyz(mesh);
+    if (!xyz) ES_FAIL(ctx, ES_EINVAL, "'%s': no positions given and the mesh has none", path);
+    return es__meshdata_write(ctx, path, format, es_mesh_nverts(mesh), es_mesh_nfaces(mesh),
+                              es_mesh_faces(mesh), xyz, vertex_rgb);
+}
