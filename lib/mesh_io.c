@@ -24,6 +24,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <strings.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #define INITIAL_CAP 64
 
@@ -196,58 +199,67 @@ const char *es__parse_int64(const char *p, const char *end, int64_t *out)
 
 es_status es__read_file(es_ctx *ctx, const char *path, char **buf, size_t *len)
 {
-    FILE *f = fopen(path, "rb");
+    struct stat st;
     char *b = NULL;
-    size_t cap = 0, n = 0;
+    size_t cap, n = 0;
+    int fd;
     *buf = NULL;
     *len = 0;
-    if (!f) ES_FAIL(ctx, ES_EIO, "cannot open '%s': %s", path, strerror(errno));
-    if (fseek(f, 0, SEEK_END) == 0) {
-        long sz = ftell(f);
-        if (sz > 0) cap = (size_t)sz + 1;
-        rewind(f);
+    if ((fd = open(path, O_RDONLY)) < 0)
+        ES_FAIL(ctx, ES_EIO, "cannot open '%s': %s", path, strerror(errno));
+    if (fstat(fd, &st) != 0 || S_ISDIR(st.st_mode)) {
+        int e = S_ISDIR(st.st_mode) ? EISDIR : errno;
+        close(fd);
+        ES_FAIL(ctx, ES_EIO, "cannot read '%s': %s", path, strerror(e));
     }
-    if (cap == 0) cap = 65536;
+    /* regular files: one buffer of the right size; pipes and the like grow */
+    cap = S_ISREG(st.st_mode) && st.st_size > 0 && (uintmax_t)st.st_size < SIZE_MAX
+              ? (size_t)st.st_size + 1 : 65536;
     for (;;) {
-        /* a full buffer of the stat'ed size grows only if more data follows */
-        if (b && n + 1 == cap) {
-            int c = fgetc(f);
-            if (c == EOF) break;
-            b[n++] = (char)c;
-        }
-        if (!b || n + 1 >= cap) {
+        if (!b || n + 1 == cap) {
             char *nb;
             if (b) {
+                /* a full buffer of the stat'ed size grows only if more follows */
+                char c;
+                ssize_t got = read(fd, &c, 1);
+                if (got == 0) break;
+                if (got < 0 && errno == EINTR) continue;
+                if (got < 0) goto read_error;
                 if (cap > SIZE_MAX / 2) {
                     es__free(ctx, b);
-                    fclose(f);
+                    close(fd);
                     ES_FAIL(ctx, ES_ERANGE, "'%s' is too large", path);
                 }
                 cap *= 2;
+                nb = es__realloc(ctx, b, cap);
+                if (nb) nb[n++] = c;
+            } else {
+                nb = es__malloc(ctx, cap);
             }
-            nb = es__realloc(ctx, b, cap);
             if (!nb) {
                 es__free(ctx, b);
-                fclose(f);
+                close(fd);
                 return ES_ENOMEM;
             }
             b = nb;
         }
-        size_t got = fread(b + n, 1, cap - 1 - n, f);
-        n += got;
+        ssize_t got = read(fd, b + n, cap - 1 - n);
         if (got == 0) break;
+        if (got < 0 && errno == EINTR) continue;
+        if (got < 0) goto read_error;
+        n += (size_t)got;
     }
-    if (ferror(f)) {
-        int e = errno;
-        es__free(ctx, b);
-        fclose(f);
-        ES_FAIL(ctx, ES_EIO, "cannot read '%s': %s", path, strerror(e));
-    }
-    fclose(f);
+    close(fd);
     b[n] = '\0';
     *buf = b;
     *len = n;
     return ES_OK;
+read_error: {
+        int e = errno;
+        es__free(ctx, b);
+        close(fd);
+        ES_FAIL(ctx, ES_EIO, "cannot read '%s': %s", path, strerror(e));
+    }
 }
 
 /* ---------------------------------------------------------------- dispatch */

@@ -292,6 +292,7 @@ static es_status body_binary(plyp *P)
     for (int ei = 0; ei < P->nelems; ei++) {
         const elem *e = &P->elems[ei];
         int64_t minsize = 0;
+        if (e->nprops == 0) continue;   /* nothing to read, however many */
         for (int k = 0; k < e->nprops; k++)
             minsize += e->props[k].is_list ? type_size[e->props[k].count_type]
                                            : type_size[e->props[k].type];
@@ -400,6 +401,7 @@ static es_status body_ascii(plyp *P)
     es_status rc;
     for (int ei = 0; ei < P->nelems; ei++) {
         const elem *e = &P->elems[ei];
+        if (e->nprops == 0) continue;
         /* every value takes at least two bytes (digit and separator) */
         if (e->nprops > 0 && e->count > (P->end - P->p) / (2 * e->nprops))
             ES_FAIL(P->ctx, ES_EFORMAT, "%s:%" PRId64 ": file truncated: element '%s' "

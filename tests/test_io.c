@@ -265,6 +265,15 @@ static void test_syntax(es_ctx *ctx)
     }
     es_meshdata_clear(ctx, &md);
 
+    /* an element without properties costs nothing, whatever its count */
+    ES_CHECK_OK(ctx, parse_str(ctx, "empty-elem.ply", "ply\nformat ascii 1.0\n"
+                               "element nothing 1000000000000000\nelement vertex 3\n"
+                               "property double x\nproperty double y\nproperty double z\n"
+                               "element face 1\nproperty list uchar int vertex_indices\n"
+                               "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 2 1\n", &md));
+    ES_CHECK(md.nverts == 3 && md.nfaces == 1);
+    es_meshdata_clear(ctx, &md);
+
     /* format from the name, from the contents, or forced */
     ES_CHECK(es_mesh_format_from_path("a/b.OBJ") == ES_FORMAT_OBJ);
     ES_CHECK(es_mesh_format_from_path("x.ply") == ES_FORMAT_PLY);
@@ -285,6 +294,8 @@ static void test_syntax(es_ctx *ctx)
     ES_CHECK_FAILS(ctx, es_meshdata_read(ctx, SRC "/no/such/file.obj", ES_FORMAT_AUTO, &md),
                    ES_EIO, "no/such/file.obj");
     ES_CHECK(md.xyz == NULL && md.nverts == 0);
+    ES_CHECK_FAILS(ctx, es_meshdata_read(ctx, SRC "/valid", ES_FORMAT_OBJ, &md), ES_EIO,
+                   "tests/data/valid");
 }
 
 /* ---------------------------------------------------------------- round trips */
