@@ -548,7 +548,8 @@ es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
     if (!cams) return ES_ENOMEM;
     double upp = 0;
     for (int64_t i = 0; i < n; i++) {
-        if ((rc = make_basis(ctx, spec, &spec->meshes[i], &cams[i])) != ES_OK) goto done;
+        const es_render_mesh *vm = spec->same_view ? &spec->meshes[0] : &spec->meshes[i];
+        if ((rc = make_basis(ctx, spec, vm, &cams[i])) != ES_OK) goto done;
         double s = frame_mesh(spec, &spec->meshes[i], &cams[i], (double)W * ss, (double)H * ss);
         double u = cams[i].persp ? cams[i].dist / s : 1 / s;
         upp = fmax(upp, u);

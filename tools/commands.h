@@ -9,5 +9,6 @@
 /* -- procrustes, landmarks, comparison */
 /* -- embedding, interpolation */
 /* -- plotting, rendering */
+int cmd_render(int argc, char **argv);
 
 #endif

@@ -21,6 +21,7 @@ static const command commands[] = {
     /* -- procrustes, landmarks, comparison */
     /* -- embedding, interpolation */
     /* -- plotting, rendering */
+    {"render", cmd_render, "draw meshes side by side to PNG/SVG/PDF"},
     {NULL, NULL, NULL}
 };
 

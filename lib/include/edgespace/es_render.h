@@ -76,6 +76,8 @@ typedef struct es_render_spec {
     es_projection projection;  /* ES_PROJ_PERSPECTIVE */
     double fov_deg;            /* perspective field of view (25) */
     int has_view, has_up;      /* use view / up below instead of the automatic ones */
+    int same_view;             /* 1: every panel uses the automatic view of mesh 0
+                                * (sequences, shapes in one frame); 0: each its own */
     double view[3];            /* direction the camera looks along (not normalized) */
     double up[3];              /* screen up; made orthogonal to view */
     double fill;               /* fraction of the panel the largest mesh spans (0.9) */
