@@ -13,6 +13,12 @@
 #include <strings.h>
 
 #define VERB "render"
+
+/* Fontconfig (under cairo's text) keeps process-lifetime caches that
+ * LeakSanitizer would report at exit in sanitizer builds; they are not
+ * ours. Without a sanitizer this hook is never called. */
+const char *__lsan_default_suppressions(void);
+const char *__lsan_default_suppressions(void) { return "leak:libfontconfig.so\n"; }
 #define MAX_MESHES 64
 
 static void usage(FILE *f)
