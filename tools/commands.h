@@ -10,5 +10,6 @@
 /* -- embedding, interpolation */
 /* -- plotting, rendering */
 int cmd_render(int argc, char **argv);
+int cmd_plot(int argc, char **argv);
 
 #endif
