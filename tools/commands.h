@@ -10,5 +10,7 @@ int cmd_synth(int argc, char **argv);
 /* -- procrustes, landmarks, comparison */
 /* -- embedding, interpolation */
 /* -- plotting, rendering */
+int cmd_render(int argc, char **argv);
+int cmd_plot(int argc, char **argv);
 
 #endif

@@ -22,6 +22,8 @@ static const command commands[] = {
     /* -- procrustes, landmarks, comparison */
     /* -- embedding, interpolation */
     /* -- plotting, rendering */
+    {"render", cmd_render, "draw meshes side by side to PNG/SVG/PDF"},
+    {"plot", cmd_plot, "scatter, lines, scree, histogram or heat map of a CSV table"},
     {NULL, NULL, NULL}
 };
 
