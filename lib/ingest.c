@@ -197,7 +197,6 @@ static es_status ingest(es_ctx *ctx, const char *store_path, int64_t n, const in
     /* ---- phase 1: read and validate everything ---- */
     for (int64_t i = 0; i < n; i++) {
         const char *path = in[i].path;
-        es_mesh_format fmt = o->format;
         char hash[25], real[PATH_MAX];
         int64_t row = st ? es_store_find_row(st, in[i].id) : -1;
         es__progress(ctx, "reading meshes", i, n);
@@ -207,8 +206,6 @@ static es_status ingest(es_ctx *ctx, const char *store_path, int64_t n, const in
         if (row >= 0) {
             if (!strcmp(es_store_content_hash(st, row), hash)) {
                 rep->rows_skipped++;
-                es__info(ctx, "'%s' is in the store already as row '%s' (same content); "
-                         "skipped", path, in[i].id);
                 es__free(ctx, buf);
                 buf = NULL;
                 continue;
@@ -218,12 +215,7 @@ static es_status ingest(es_ctx *ctx, const char *store_path, int64_t n, const in
                           path, in[i].id, es_store_source_path(st, row));
             goto done;
         }
-        if (fmt == ES_FORMAT_AUTO && (fmt = es_mesh_format_from_path(path)) == ES_FORMAT_AUTO) {
-            rc = es__fail(ctx, ES_EFORMAT, "'%s': unknown mesh format (extension not .obj, "
-                          ".ply or .off)", path);
-            goto done;
-        }
-        if ((rc = es_meshdata_parse(ctx, path, buf, len, fmt, &md))) goto done;
+        if ((rc = es_meshdata_parse(ctx, path, buf, len, o->format, &md))) goto done;
         es__free(ctx, buf);
         buf = NULL;
         if (!r.faces) {

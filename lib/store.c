@@ -1763,8 +1763,9 @@ static es_status list_impl(es_ctx *ctx, es_store *s, const char *kind, char ***n
     char full[600];
     name_list l = {ctx, NULL, 0, 0, ES_OK};
     hid_t g;
-    if (bad_name(kind)) ES_FAIL(ctx, ES_EINVAL, "store: bad result kind '%s'", kind ? kind : "");
-    snprintf(full, sizeof full, "/analysis/%s", kind);
+    if (kind && *kind && bad_name(kind))
+        ES_FAIL(ctx, ES_EINVAL, "store: bad result kind '%s'", kind);
+    snprintf(full, sizeof full, "/analysis%s%s", kind && *kind ? "/" : "", kind ? kind : "");
     if (!link_exists(s->file, full)) return ES_OK;
     if ((g = H5Gopen2(s->file, full, H5P_DEFAULT)) < 0)
         return h5fail(ctx, ES_EFORMAT, "store: %s is not a group", full);

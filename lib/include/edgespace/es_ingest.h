@@ -1,5 +1,5 @@
-/* lib/include/edgespace/es_ingest.h — manifests and ingest: meshes in
- * correspondence (plus their labels) into an HDF5 store.
+/* lib/include/edgespace/es_ingest.h — manifests, ingest and export: meshes
+ * in correspondence (plus their labels) into an HDF5 store, and back out.
  *
  * A manifest (datasets-spec/manifest-format.md) is a CSV file read with
  * libcsv: a header row with a `file` column (mesh paths relative to the
@@ -26,6 +26,7 @@
 
 #include "es_core.h"
 #include "es_io.h"
+#include "es_store.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -88,6 +89,21 @@ ES_API es_status es_ingest_manifest(es_ctx *ctx, const char *store_path,
 ES_API es_status es_ingest_files(es_ctx *ctx, const char *store_path, int64_t nfiles,
                                  const char *const *files, const es_ingest_opts *opts,
                                  es_ingest_report *report);
+
+/* ---- export ------------------------------------------------------------ */
+
+
+/* Write rows of a store as CSV: header "id,scale,<a>-<b>,..." (one column
+ * per edge, named by its 0-based vertex pair), then one line per row with
+ * the normalized lengths (%.17g, so values read back exactly). rows NULL
+ * with nrows = -1: every row. raw != 0 writes scale x length instead. */
+ES_API es_status es_export_lengths_csv(es_ctx *ctx, es_store *store, const int64_t *rows,
+                                       int64_t nrows, int raw, const char *path);
+/* Write each row's stored positions as a mesh file DIR/<id>.<ext> (ext from
+ * format: obj, ply or off; ES_FORMAT_AUTO means OBJ). The directory is
+ * created if absent. */
+ES_API es_status es_export_meshes(es_ctx *ctx, es_store *store, const int64_t *rows,
+                                  int64_t nrows, const char *dir, es_mesh_format format);
 
 #ifdef __cplusplus
 }

@@ -168,7 +168,9 @@ ES_API es_status es_store_get_attr(es_ctx *ctx, es_store *store, const char *pat
                                    const char *key, char *buf, size_t n);
 /* 1 if the result or dataset exists, else 0. */
 ES_API int es_store_has(es_store *store, const char *path);
-/* Names of the results of one kind (es_free each and the array). */
+/* Names of the results of one kind, in name order; kind NULL or "": the
+ * kinds present. *names is NULL when there are none. es_free each name and
+ * the array. */
 ES_API es_status es_store_list_results(es_ctx *ctx, es_store *store, const char *kind,
                                        char ***names, int64_t *n);
 
