@@ -5,6 +5,7 @@
 #include "edgespace/es_ingest.h"
 #include "edgespace/es_io.h"
 #include "edgespace/es_store.h"
+#include "mesh_io_internal.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -95,10 +96,9 @@ done:
 es_status es_export_meshes(es_ctx *ctx, es_store *s, const int64_t *rows, int64_t nrows,
                            const char *dir, es_mesh_format format)
 {
-    int64_t n, *own = NULL;
+    int64_t n, *own = NULL, *faces = NULL;
     const int64_t *list;
     double *xyz = NULL;
-    es_mesh *mesh = NULL;
     es_status rc;
     const char *ext;
     struct stat st;
@@ -116,11 +116,12 @@ es_status es_export_meshes(es_ctx *ctx, es_store *s, const int64_t *rows, int64_
         ES_FAIL(ctx, ES_EIO, "export: '%s' is not a directory", dir);
     }
     if ((rc = row_list(ctx, s, rows, nrows, &list, &n, &own))) return rc;
-    if ((rc = es_store_mesh(ctx, s, &mesh))) goto done;
-    if (!(xyz = es__alloc_array(ctx, 3 * es_store_nverts(s), sizeof *xyz))) {
+    if (!(xyz = es__alloc_array(ctx, 3 * es_store_nverts(s), sizeof *xyz)) ||
+        !(faces = es__alloc_array(ctx, 3 * es_store_nfaces(s), sizeof *faces))) {
         rc = ES_ENOMEM;
         goto done;
     }
+    if ((rc = es_store_read_faces(ctx, s, faces))) goto done;
     for (int64_t j = 0; j < n; j++) {
         const char *id = es_store_row_id(s, list[j]);
         size_t len = strlen(dir) + strlen(id) + 8;
@@ -133,13 +134,14 @@ es_status es_export_meshes(es_ctx *ctx, es_store *s, const int64_t *rows, int64_
         if (!(path = es__malloc(ctx, len))) { rc = ES_ENOMEM; goto done; }
         snprintf(path, len, "%s/%s.%s", dir, id, ext);
         if (!(rc = es_store_read_positions(ctx, s, list[j], xyz)))
-            rc = es_mesh_write(ctx, path, format, mesh, xyz, NULL);
+            rc = es__meshdata_write(ctx, path, format, es_store_nverts(s), es_store_nfaces(s),
+                                    faces, xyz, NULL);
         es__free(ctx, path);
         if (rc) goto done;
     }
     es__progress(ctx, "exporting meshes", n, n);
 done:
-    es_mesh_free(mesh);
+    es__free(ctx, faces);
     es__free(ctx, xyz);
     es__free(ctx, own);
     return rc;
