@@ -145,7 +145,7 @@ static es_status create_rows(es_ctx *ctx, hid_t loc, const char *name, hid_t fty
     size_t row = elem_bytes * (rank > 1 ? d1 : 1) * (rank > 2 ? d2 : 1);
     hid_t sp = -1, dcpl = -1, ds = -1;
     es_status rc = ES_OK;
-    chunk[0] = rank == 1 ? 1024 : chunk_rows(row);
+    chunk[0] = rank == 1 ? 256 : chunk_rows(row);
     chunk[1] = d1;
     chunk[2] = d2;
     if ((sp = H5Screate_simple(rank, dims, maxd)) < 0 ||
