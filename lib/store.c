@@ -130,6 +130,17 @@ static hid_t open_ds(hid_t loc, const char *name)
     return ds;
 }
 
+/* For appends: no chunk cache, so whole chunks go straight from the
+ * caller's buffer to the file instead of through a copy per chunk. */
+static hid_t open_ds_nocache(hid_t loc, const char *name)
+{
+    hid_t dapl = H5Pcreate(H5P_DATASET_ACCESS), ds;
+    if (dapl >= 0) H5Pset_chunk_cache(dapl, 0, 0, 1.0);
+    ds = H5Dopen2(loc, name, dapl);
+    close_id(dapl);
+    return ds;
+}
+
 /* Rows per chunk so that a chunk is about 1 MiB (at least 1, at most 64). */
 static hsize_t chunk_rows(size_t row_bytes)
 {
@@ -167,7 +178,7 @@ static es_status append_rows(es_ctx *ctx, hid_t loc, const char *name, hid_t mty
     es_status rc = ES_OK;
     int rank;
     if (n == 0) return ES_OK;
-    if ((ds = open_ds(loc, name)) < 0 || (fsp = H5Dget_space(ds)) < 0 ||
+    if ((ds = open_ds_nocache(loc, name)) < 0 || (fsp = H5Dget_space(ds)) < 0 ||
         (rank = H5Sget_simple_extent_dims(fsp, dims, NULL)) < 1 || rank > 3) {
         rc = h5fail(ctx, ES_EFORMAT, "store: cannot open dataset '%s'", name);
         goto done;
@@ -1010,7 +1021,7 @@ static es_status read_block(es_ctx *ctx, es_store *s, const char *name, int64_t 
     hid_t ds = -1, fsp = -1, msp = -1;
     es_status rc = ES_OK;
     if (n == 0) return ES_OK;
-    if ((ds = open_ds(s->file, name)) < 0 || (fsp = H5Dget_space(ds)) < 0 ||
+    if ((ds = open_ds_nocache(s->file, name)) < 0 || (fsp = H5Dget_space(ds)) < 0 ||
         H5Sselect_hyperslab(fsp, H5S_SELECT_SET, fstart, NULL, cnt, NULL) < 0 ||
         (msp = H5Screate_simple(2, mdims, NULL)) < 0 ||
         H5Sselect_hyperslab(msp, H5S_SELECT_SET, mstart, NULL, cnt, NULL) < 0 ||
