@@ -6,6 +6,9 @@
 int cmd_synth(int argc, char **argv);
 /* -- mesh I/O */
 /* -- store, manifest, ingest */
+int cmd_ingest(int argc, char **argv);
+int cmd_info(int argc, char **argv);
+int cmd_export(int argc, char **argv);
 /* -- statistics, point syntax */
 /* -- procrustes, landmarks, comparison */
 /* -- embedding, interpolation */
