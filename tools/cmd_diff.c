@@ -114,6 +114,10 @@ int cmd_diff(int argc, char **argv)
     }
     printf("|mean difference| = %.6g; largest |t| = %.3g at edge %lld (%lld degrees of freedom)\n",
            sqrt(norm), tmax, (long long)emax, (long long)(d->npairs - 1));
+    if ((rc = es_store_commit(ctx, st)) != ES_OK) {
+        cli_fail("diff", ctx, rc);
+        goto done;
+    }
     printf("stored as /analysis/diff/%s\n", name);
     ret = CLI_OK;
     if (csv) {
@@ -134,7 +138,8 @@ int cmd_diff(int argc, char **argv)
     }
 done:
     es_diff_free(d);
-    es_store_close(st);
+    if (ret == CLI_OK) es_store_close(st);
+    else es_store_abort(st);   /* leave the store as it was */
     free(cmdline);
     es_ctx_free(ctx);
     return ret;

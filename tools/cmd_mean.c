@@ -66,6 +66,10 @@ int cmd_mean(int argc, char **argv)
     printf("%-20s %8s %14s\n", by ? by : "group", "rows", "mean scale");
     for (int64_t g = 0; g < r->ngroups; g++)
         printf("%-20s %8lld %14.6g\n", r->names[g], (long long)r->counts[g], r->scales[g]);
+    if ((rc = es_store_commit(ctx, st)) != ES_OK) {
+        cli_fail("mean", ctx, rc);
+        goto done;
+    }
     if (name) printf("stored as /analysis/mean/%s\n", name);
     ret = CLI_OK;
     if (csv)
@@ -73,7 +77,8 @@ int cmd_mean(int argc, char **argv)
                                    (const char *const *)r->names, r->means);
 done:
     es_group_result_free(r);
-    es_store_close(st);
+    if (ret == CLI_OK) es_store_close(st);
+    else es_store_abort(st);   /* leave the store as it was */
     free(cmdline);
     es_ctx_free(ctx);
     return ret;

@@ -174,12 +174,17 @@ int cmd_pca(int argc, char **argv)
                (long long)(k + 1), p->eigenvalues[k], 100 * p->explained[k], 100 * cum);
     }
     if (p->ncomp > 10) printf("  ... (%lld more)\n", (long long)(p->ncomp - 10));
+    if ((rc = es_store_commit(ctx, st)) != ES_OK) {
+        cli_fail("pca", ctx, rc);
+        goto done;
+    }
     printf("stored as /analysis/pca/%s\n", name);
     ret = csv ? write_csvs(ctx, st, p, rows, csv) : CLI_OK;
 done:
     es_pca_free(p);
     es_free(ctx, rows);
-    es_store_close(st);
+    if (ret == CLI_OK) es_store_close(st);
+    else es_store_abort(st);   /* leave the store as it was */
     free(cmdline);
     es_ctx_free(ctx);
     return ret;

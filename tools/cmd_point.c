@@ -86,6 +86,10 @@ int cmd_point(int argc, char **argv)
                    v->worst_violation);
         printf("\n");
     }
+    if ((rc = es_store_commit(ctx, st)) != ES_OK) {
+        cli_fail("point", ctx, rc);
+        goto done;
+    }
     if (name) printf("stored as /analysis/point/%s\n", name);
     ret = CLI_OK;
     if (csv) {
@@ -94,7 +98,8 @@ int cmd_point(int argc, char **argv)
     }
 done:
     es_free(ctx, vec);
-    es_store_close(st);
+    if (ret == CLI_OK) es_store_close(st);
+    else es_store_abort(st);   /* leave the store as it was */
     free(cmdline);
     es_ctx_free(ctx);
     return ret;

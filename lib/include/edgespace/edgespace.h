@@ -10,7 +10,11 @@
 #include "es_io.h"
 #include "es_plot.h"
 #include "es_render.h"
+#include "es_synth.h"
+#include "es_store.h"
+#include "es_ingest.h"
 #include "es_stats.h"
 #include "es_point.h"
+#include "es_analysis.h"
 
 #endif
