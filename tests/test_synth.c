@@ -458,6 +458,18 @@ static void test_files(es_ctx *ctx)
     }
     ES_CHECK_MSG(nv == s.nverts && nf == s.nfaces && bad == 0, "%lld v, %lld f, %lld bad",
                  (long long)nv, (long long)nf, (long long)bad);
+    /* every file written has the set's face list (same fingerprint) */
+    char want_fp[17], got_fp[17];
+    es_faces_fingerprint(s.nverts, s.nfaces, s.faces, want_fp);
+    for (int64_t i = 0; i < s.nmembers; i++) {
+        es_meshdata md;
+        snprintf(path, sizeof path, "%s/out/%s.obj", dir, s.names[i]);
+        ES_CHECK_OK(ctx, es_meshdata_read(ctx, path, ES_FORMAT_OBJ, &md));
+        es_faces_fingerprint(md.nverts, md.nfaces, md.faces, got_fp);
+        ES_CHECK_MSG(md.faces && !strcmp(got_fp, want_fp), "%s: fingerprint %s, want %s", path,
+                     got_fp, want_fp);
+        es_meshdata_clear(ctx, &md);
+    }
     snprintf(path, sizeof path, "%s/new/deeper", dir);    /* parents are created */
     ES_CHECK_OK(ctx, es_synth_write(ctx, &s, path));
     snprintf(path, sizeof path, "%s/out/manifest.csv/below", dir); /* under a file */
