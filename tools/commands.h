@@ -6,9 +6,14 @@
 int cmd_synth(int argc, char **argv);
 /* -- mesh I/O */
 /* -- store, manifest, ingest */
+int cmd_ingest(int argc, char **argv);
+int cmd_info(int argc, char **argv);
+int cmd_export(int argc, char **argv);
 /* -- statistics, point syntax */
 /* -- procrustes, landmarks, comparison */
 /* -- embedding, interpolation */
 /* -- plotting, rendering */
+int cmd_render(int argc, char **argv);
+int cmd_plot(int argc, char **argv);
 
 #endif

@@ -11,5 +11,7 @@
 #include "es_plot.h"
 #include "es_render.h"
 #include "es_synth.h"
+#include "es_store.h"
+#include "es_ingest.h"
 
 #endif
