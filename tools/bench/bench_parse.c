@@ -21,7 +21,16 @@
 
 typedef struct file { char *path, *buf; size_t len; } file;
 
+/* CPU time of this process: on a shared, loaded machine it measures the
+ * work done, where wall time would mostly measure the wait for a core. */
 static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static double wall(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -135,7 +144,7 @@ int main(int argc, char **argv)
     int n = 0, passes = 5;
     size_t total = 0;
     es_ctx *ctx;
-    double best_fast = 1e30, best_naive = 1e30, best_read = 1e30;
+    double best_fast = 1e30, best_naive = 1e30, best_read = 1e30, best_fast_wall = 1e30;
     int64_t verts = 0, mismatches = 0;
 
     for (int i = 1; i < argc; i++) add_path(&fs, &n, argv[i]);
@@ -148,7 +157,7 @@ int main(int argc, char **argv)
     if (es_ctx_new(&ctx) != ES_OK) return 1;
 
     for (int pass = 0; pass < passes; pass++) {
-        double t0 = now();
+        double w0 = wall(), t0 = now();
         for (int i = 0; i < n; i++) {
             es_meshdata md;
             if (es_meshdata_parse(ctx, fs[i].path, fs[i].buf, fs[i].len, ES_FORMAT_OBJ, &md)) {
@@ -159,6 +168,7 @@ int main(int argc, char **argv)
             es_meshdata_clear(ctx, &md);
         }
         double t1 = now();
+        if (wall() - w0 < best_fast_wall) best_fast_wall = wall() - w0;
         for (int i = 0; i < n; i++) {
             es_meshdata md;
             naive_parse(fs[i].buf, fs[i].len, &md);
@@ -195,13 +205,14 @@ int main(int argc, char **argv)
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
     double mb = (double)total / 1e6;
-    printf("input: %d OBJ file%s, %.1f MB, %lld vertices (best of %d passes, in memory)\n", n,
-           n == 1 ? "" : "s", mb, (long long)verts, passes);
+    printf("input: %d OBJ file%s, %.1f MB, %lld vertices (best of %d passes, in memory, "
+           "CPU time of one thread)\n", n, n == 1 ? "" : "s", mb, (long long)verts, passes);
     printf("es_meshdata_parse : %8.1f MB/s  %8.1f meshes/s  (%.3f s)\n", mb / best_fast,
            n / best_fast, best_fast);
     printf("naive strtod parse: %8.1f MB/s  %8.1f meshes/s  (%.3f s)\n", mb / best_naive,
            n / best_naive, best_naive);
     printf("speed-up          : %8.2fx\n", best_naive / best_fast);
+    printf("es_meshdata_parse : %8.1f MB/s  wall clock\n", mb / best_fast_wall);
     if (best_read > 1e-9 && strcmp(fs[0].path, "generated.obj"))
         printf("es_meshdata_read  : %8.1f MB/s  %8.1f meshes/s  (file reading included)\n",
                mb / best_read, n / best_read);
