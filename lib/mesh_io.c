@@ -319,6 +319,13 @@ es_status es_meshdata_parse(es_ctx *ctx, const char *name, const char *buf, size
     if (!buf && len) ES_FAIL(ctx, ES_EINVAL, "%s: buffer is NULL", name);
     if (!buf) buf = "";
     if (format == ES_FORMAT_AUTO) format = es_mesh_format_from_path(name);
+    /* a UTF-8 byte order mark before a text format (editors on Windows);
+     * PLY keeps it so that binary byte offsets stay those of the file */
+    if (len >= 3 && !memcmp(buf, "\xEF\xBB\xBF", 3) && format != ES_FORMAT_PLY &&
+        format != ES_FORMAT_PLY_ASCII) {
+        buf += 3;
+        len -= 3;
+    }
     if (format == ES_FORMAT_AUTO) format = sniff(buf, len);
     switch (format) {
     case ES_FORMAT_OBJ: rc = es__obj_parse(ctx, name, buf, len, out); break;

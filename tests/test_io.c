@@ -229,6 +229,12 @@ static void test_syntax(es_ctx *ctx)
              strstr(last_warning, "line 2"));
     es_meshdata_clear(ctx, &md);
 
+    /* a UTF-8 byte order mark is skipped */
+    ES_CHECK_OK(ctx, parse_str(ctx, "bom.obj", "\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                               "f 1 2 3\n", &md));
+    ES_CHECK(md.nverts == 3 && md.nfaces == 1);
+    es_meshdata_clear(ctx, &md);
+
     /* a pentagon: fan (0,1,2) (0,2,3) (0,3,4) */
     ES_CHECK_OK(ctx, parse_str(ctx, "pent.obj", "v 0 0 0\nv 1 0 0\nv 2 1 0\nv 1 2 0\n"
                                "v 0 1 0\nf 1 2 3 4 5\n", &md));
