@@ -260,6 +260,7 @@ static void test_syntax(es_ctx *ctx)
     }
 
     /* PLY ascii with a quad and vertex_index */
+    n_warnings = 0;
     ES_CHECK_OK(ctx, parse_str(ctx, "quad.ply", "ply\nformat ascii 1.0\nelement vertex 4\n"
                                "property int x\nproperty int y\nproperty int z\n"
                                "element face 1\nproperty list uchar uint vertex_index\n"
@@ -267,7 +268,8 @@ static void test_syntax(es_ctx *ctx)
     {
         static const int64_t f[6] = {0, 2, 1, 0, 1, 3};
         check_arrays(&md, 4, tet_xyz, 2, f, "quad.ply");
-        ES_CHECK(md.n_polygons_split == 1);
+        ES_CHECK(md.n_polygons_split == 1 && n_warnings == 1 &&
+                 strstr(last_warning, "quad.ply: 1 polygon with more than 3 corners"));
     }
     es_meshdata_clear(ctx, &md);
 
