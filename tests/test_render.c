@@ -511,6 +511,40 @@ static void test_shared_faces(es_ctx *ctx)
             es_mesh_free(m);
         }
     }
+    /* per-edge scalars through es_render_mesh_from: the log ratio of the
+     * happy and neutral edge lengths, drawn on the happy face */
+    es_mesh *topo = NULL;
+    ES_CHECK_OK(ctx, es_mesh_new(ctx, md[0].nverts, md[0].nfaces, md[0].faces, md[0].xyz, &topo));
+    if (topo) {
+        es_render_mesh e;
+        es_render_mesh_from(&e, topo, md[1].xyz);
+        ES_CHECK(e.xyz == md[1].xyz && e.nedges == es_mesh_nedges(topo) && e.faces);
+        double *lr = malloc((size_t)e.nedges * sizeof *lr);
+        for (int64_t k = 0; k < e.nedges; k++) {
+            double la = 0, lb = 0;
+            for (int c = 0; c < 3; c++) {
+                double d0 = md[0].xyz[3 * e.edges[2 * k] + c] - md[0].xyz[3 * e.edges[2 * k + 1] + c];
+                double d1 = md[1].xyz[3 * e.edges[2 * k] + c] - md[1].xyz[3 * e.edges[2 * k + 1] + c];
+                la += d0 * d0, lb += d1 * d1;
+            }
+            lr[k] = 0.5 * log(lb / la);
+        }
+        e.scalar_kind = ES_SCALARS_EDGE;
+        e.scalars = lr;
+        e.label = "log(happy / neutral) per edge";
+        es_render_spec sp;
+        es_render_spec_init(&sp);
+        sp.meshes = &e;
+        sp.nmeshes = 1;
+        sp.cmap = ES_CMAP_RDBU;
+        sp.vmin = -0.3, sp.vmax = 0.3;
+        es_render_report r2;
+        ES_CHECK_OK(ctx, es_render(ctx, &sp, tp_path("render", "face_study_edge_ratio.png"), &r2));
+        ES_CHECK(r2.vmin == -0.3 && r2.vmax == 0.3);
+        free(lr);
+        es_mesh_free(topo);
+    }
+
     es_render_spec spec;
     es_render_spec_init(&spec);
     spec.meshes = items;
