@@ -699,6 +699,15 @@ es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
         es__draw_colorbar(cr, x, y, w, h, spec->cmap, rep.vmin, rep.vmax, spec->colorbar_label,
                           fs);
         rep.colorbar[0] = x, rep.colorbar[1] = y, rep.colorbar[2] = w, rep.colorbar[3] = h;
+        if (rep.n_nan_scalars > 0) {
+            /* a key for the grey of missing values, under the bar */
+            double ky = y + h + 0.6 * fs;
+            cairo_set_source_rgb(cr, ES_NAN_GREY, ES_NAN_GREY, ES_NAN_GREY);
+            cairo_rectangle(cr, x, ky, w, w);
+            cairo_fill(cr);
+            cairo_set_source_rgb(cr, 0, 0, 0);
+            es__text(cr, x + w + 6, ky + 0.5 * w, "n/a", 0.85 * fs, 0, 0.5, 0);
+        }
     }
     rc = es__canvas_close(ctx, &cv);
 done:

@@ -619,6 +619,51 @@ static void test_cli(void)
     tm_free(&s);
 }
 
+typedef struct failing_alloc { int64_t count, fail_at; } failing_alloc;
+static void *fa_malloc(void *ud, size_t n)
+{
+    failing_alloc *fa = ud;
+    return ++fa->count == fa->fail_at ? NULL : malloc(n);
+}
+static void *fa_realloc(void *ud, void *p, size_t n)
+{
+    failing_alloc *fa = ud;
+    return ++fa->count == fa->fail_at ? NULL : realloc(p, n);
+}
+static void fa_free(void *ud, void *p) { (void)ud; free(p); }
+
+/* Fail the k-th allocation of a two-panel render with per-edge scalars for
+ * k = 1, 2, ... until it succeeds: ES_ENOMEM each time, no leak (ASan). */
+static void test_alloc_failures(es_ctx *ctx)
+{
+    tm_mesh sq = make_square();
+    const int64_t edges[10] = {0, 1, 1, 2, 2, 0, 2, 3, 3, 0};
+    const double ev[5] = {1, 2, 3, 4, NAN};
+    es_render_mesh it[2] = {as_item(&sq, "a"), as_item(&sq, "b")};
+    it[1].scalar_kind = ES_SCALARS_EDGE;
+    it[1].scalars = ev;
+    it[1].edges = edges;
+    it[1].nedges = 5;
+    es_render_spec spec;
+    es_render_spec_init(&spec);
+    spec.meshes = it;
+    spec.nmeshes = 2;
+    spec.width = spec.height = 64;
+    const char *png = tp_path("render", "alloc.png");
+    es_status rc = ES_ENOMEM;
+    int k;
+    for (k = 1; k < 40 && rc == ES_ENOMEM; k++) {
+        failing_alloc fa = {0, k};
+        es_allocator a = {fa_malloc, fa_realloc, fa_free, &fa};
+        es_ctx_set_allocator(ctx, &a);
+        rc = es_render(ctx, &spec, png, NULL);
+        es_ctx_set_allocator(ctx, NULL);
+        ES_CHECK(rc == ES_OK || rc == ES_ENOMEM);
+    }
+    ES_CHECK_MSG(rc == ES_OK && k > 5, "rc %d after %d tries", rc, k);
+    tm_free(&sq);
+}
+
 int main(void)
 {
     es_ctx *ctx = NULL;
@@ -630,6 +675,7 @@ int main(void)
     test_scalars(ctx);
     test_auto_view(ctx);
     test_errors(ctx);
+    test_alloc_failures(ctx);
     test_shared_faces(ctx);
     test_cli();
     es_ctx_free(ctx);

@@ -25,8 +25,8 @@
  *
  * Scalars: per vertex (interpolated across faces, then mapped), per edge
  * (each face shows the mean of its three edges) or per face. NaN or inf
- * scalars are drawn in the neutral grey ES_NAN_GREY and counted in the
- * report. Without scalars a mesh is drawn in `base_rgb`.
+ * scalars are drawn in the neutral grey ES_NAN_GREY (shaded like the rest),
+ * counted in the report and keyed "n/a" under the colour bar. Without scalars a mesh is drawn in `base_rgb`.
  */
 #ifndef EDGESPACE_ES_RENDER_H
 #define EDGESPACE_ES_RENDER_H
