@@ -3,6 +3,7 @@
 #define EDGESPACE_TOOLS_COMMANDS_H
 
 /* -- topology, geometry, synthetic data */
+int cmd_synth(int argc, char **argv);
 /* -- mesh I/O */
 /* -- store, manifest, ingest */
 int cmd_ingest(int argc, char **argv);
@@ -12,5 +13,7 @@ int cmd_export(int argc, char **argv);
 /* -- procrustes, landmarks, comparison */
 /* -- embedding, interpolation */
 /* -- plotting, rendering */
+int cmd_render(int argc, char **argv);
+int cmd_plot(int argc, char **argv);
 
 #endif

@@ -15,6 +15,7 @@ typedef struct command {
 
 static const command commands[] = {
     /* -- topology, geometry, synthetic data */
+    {"synth", cmd_synth, "write a synthetic family of meshes in correspondence"},
     /* -- mesh I/O */
     /* -- store, manifest, ingest */
     {"ingest", cmd_ingest, "read meshes (manifest or files) into an HDF5 store"},
@@ -24,6 +25,8 @@ static const command commands[] = {
     /* -- procrustes, landmarks, comparison */
     /* -- embedding, interpolation */
     /* -- plotting, rendering */
+    {"render", cmd_render, "draw meshes side by side to PNG/SVG/PDF"},
+    {"plot", cmd_plot, "scatter, lines, scree, histogram or heat map of a CSV table"},
     {NULL, NULL, NULL}
 };
 
