@@ -13,5 +13,8 @@
 #include "es_synth.h"
 #include "es_store.h"
 #include "es_ingest.h"
+#include "es_stats.h"
+#include "es_point.h"
+#include "es_analysis.h"
 
 #endif
