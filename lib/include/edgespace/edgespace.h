@@ -8,5 +8,6 @@
 #include "es_mesh.h"
 #include "es_geom.h"
 #include "es_io.h"
+#include "es_procrustes.h"
 
 #endif
