@@ -46,34 +46,59 @@ typedef struct gpa_state {
     int64_t k, n, kd;
     int d;
     es_mat x;
-    double *sum;     /* kd: sum of the configurations */
-    double *norm2;   /* n: ||X_i||^2 */
+    double *sum;     /* kd: sum of the (scaled) configurations */
+    double *norm2;   /* n: ||b_i X_i||^2, the norms including pending scales */
+    double *pend;    /* n: pending scale b_i not yet multiplied into column i */
     double *phi;     /* n: Ten Berge eigenvector */
     double *work;    /* max(n*n, kd) */
-    double *beta;    /* n */
+    double *z;       /* n */
+    int64_t power_steps;
 } gpa_state;
 
 #define COL(st, j) ((st)->x.data + (int64_t)(j) * (st)->x.ld)
 
-/* One Gauss-Seidel rotation sweep; returns the largest ||R - I||_F. */
+/* A = X^T (S - X) for one k x d configuration in a single pass (9 or 4
+ * accumulators): the cross product with the mean of the others up to the
+ * factor 1/(n-1), which the rotation ignores. */
+static void cross_with_others(int64_t k, int d, const double *x, const double *s, double b,
+                              double *a)
+{
+    if (d == 2) {
+        double a00 = 0, a01 = 0, a10 = 0, a11 = 0;
+        for (int64_t v = 0; v < k; v++) {
+            double x0 = b * x[v], x1 = b * x[v + k];
+            double o0 = s[v] - x0, o1 = s[v + k] - x1;
+            a00 += x0 * o0; a01 += x0 * o1; a10 += x1 * o0; a11 += x1 * o1;
+        }
+        a[0] = a00; a[1] = a10; a[2] = a01; a[3] = a11;
+        return;
+    }
+    double a00 = 0, a01 = 0, a02 = 0, a10 = 0, a11 = 0, a12 = 0, a20 = 0, a21 = 0, a22 = 0;
+    for (int64_t v = 0; v < k; v++) {
+        double x0 = b * x[v], x1 = b * x[v + k], x2 = b * x[v + 2 * k];
+        double o0 = s[v] - x0, o1 = s[v + k] - x1, o2 = s[v + 2 * k] - x2;
+        a00 += x0 * o0; a01 += x0 * o1; a02 += x0 * o2;
+        a10 += x1 * o0; a11 += x1 * o1; a12 += x1 * o2;
+        a20 += x2 * o0; a21 += x2 * o1; a22 += x2 * o2;
+    }
+    a[0] = a00; a[1] = a10; a[2] = a20;
+    a[3] = a01; a[4] = a11; a[5] = a21;
+    a[6] = a02; a[7] = a12; a[8] = a22;
+}
+
+/* One Gauss-Seidel rotation sweep; returns the largest ||R - I||_F. A
+ * pending scale b_i is applied in the same pass, so the Ten Berge step
+ * costs no pass of its own. */
 static es_status rotation_sweep(gpa_state *st, int allow_reflection, double *rot_acc,
                                 double *change)
 {
-    int64_t k = st->k, kd = st->kd;
+    int64_t k = st->k;
     int d = st->d;
     double *s = st->sum, maxc = 0;
     for (int64_t i = 0; i < st->n; i++) {
-        double *xi = COL(st, i), a[9], r[9];
+        double *xi = COL(st, i), a[9], r[9], b = st->pend[i];
         es_status rc;
-        /* A = X_i^T (S - X_i): the cross product with the mean of the others
-         * up to the factor 1/(n-1), which the rotation ignores */
-        for (int p = 0; p < d; p++)
-            for (int q = 0; q < d; q++) {
-                const double *xp = xi + p * k, *xq = xi + q * k, *sq = s + q * k;
-                double acc = 0;
-                for (int64_t v = 0; v < k; v++) acc += xp[v] * (sq[v] - xq[v]);
-                a[p + q * d] = acc;
-            }
+        cross_with_others(k, d, xi, s, b, a);
         if ((rc = es__procrustes_rotation(st->ctx, d, a, allow_reflection, r, NULL)) != ES_OK)
             return rc;
         double c = 0;
@@ -84,10 +109,10 @@ static es_status rotation_sweep(gpa_state *st, int allow_reflection, double *rot
             }
         c = sqrt(c);
         if (c > maxc) maxc = c;
-        /* X_i <- X_i R and S += X_i(new) - X_i(old), one pass */
+        /* X_i <- b X_i R and S += X_i(new) - b X_i(old), one pass */
         if (d == 2) {
             for (int64_t v = 0; v < k; v++) {
-                double x0 = xi[v], x1 = xi[v + k];
+                double x0 = b * xi[v], x1 = b * xi[v + k];
                 double y0 = x0 * r[0] + x1 * r[1], y1 = x0 * r[2] + x1 * r[3];
                 s[v] += y0 - x0;
                 s[v + k] += y1 - x1;
@@ -96,7 +121,7 @@ static es_status rotation_sweep(gpa_state *st, int allow_reflection, double *rot
             }
         } else {
             for (int64_t v = 0; v < k; v++) {
-                double x0 = xi[v], x1 = xi[v + k], x2 = xi[v + 2 * k];
+                double x0 = b * xi[v], x1 = b * xi[v + k], x2 = b * xi[v + 2 * k];
                 double y0 = x0 * r[0] + x1 * r[1] + x2 * r[2];
                 double y1 = x0 * r[3] + x1 * r[4] + x2 * r[5];
                 double y2 = x0 * r[6] + x1 * r[7] + x2 * r[8];
@@ -108,6 +133,7 @@ static es_status rotation_sweep(gpa_state *st, int allow_reflection, double *rot
                 xi[v + 2 * k] = y2;
             }
         }
+        st->pend[i] = 1.0;
         /* cumulative rotation: aligned = x_centred * R_1 R_2 ... */
         double *ra = rot_acc + i * d * d, t[9];
         for (int p = 0; p < d; p++)
@@ -118,9 +144,22 @@ static es_status rotation_sweep(gpa_state *st, int allow_reflection, double *rot
             }
         memcpy(ra, t, (size_t)(d * d) * sizeof *t);
     }
-    (void)kd;
     *change = maxc;
     return ES_OK;
+}
+
+/* Multiply pending scales into the data and recompute the sum exactly. */
+static void flush_scales(gpa_state *st)
+{
+    memset(st->sum, 0, (size_t)st->kd * sizeof *st->sum);
+    for (int64_t j = 0; j < st->n; j++) {
+        double *xj = COL(st, j), b = st->pend[j];
+        for (int64_t v = 0; v < st->kd; v++) {
+            xj[v] *= b;
+            st->sum[v] += xj[v];
+        }
+        st->pend[j] = 1.0;
+    }
 }
 
 /* Leading eigenvector of the cosine matrix from the explicit Gram matrix. */
@@ -147,18 +186,32 @@ static es_status tenberge_exact(gpa_state *st)
     if (info != 0 || m != 1)
         ES_FAIL(st->ctx, ES_ENUMERIC, "gpa: eigen-decomposition for Ten Berge scaling failed "
                 "(info %d)", (int)info);
+    for (int64_t j = 0; j < n; j++) st->phi[j] = fabs(st->phi[j]);
     return ES_OK;
 }
 
-/* The same eigenvector by power iteration, two passes over x per step. */
-static es_status tenberge_power(gpa_state *st)
+/* The same eigenvector by power iteration, warm-started at
+ * phi_j = ||X_j|| / sqrt(total): the previous scaling made that the
+ * eigenvector of the previous iterate, and for it y = sum_j phi_j X_j /
+ * ||X_j|| is just S / sqrt(total), which the sweep has kept up to date, so
+ * the first step costs one pass and later ones two. Stops when phi moves by
+ * less than 0.1 tol / sqrt(n) (enough for scale changes below tol/10) or
+ * 1e-15. On return work holds y for the returned phi, so the scaled sum is
+ * sqrt(total) * y. */
+static es_status tenberge_power(gpa_state *st, double total, double tol)
 {
     int64_t n = st->n, kd = st->kd;
-    double *y = st->work, *z = st->beta, *phi = st->phi;
+    double *y = st->work, *z = st->z, *phi = st->phi;
+    double stop = fmax(1e-15, 0.1 * tol / sqrt((double)n));
+    for (int64_t j = 0; j < n; j++) phi[j] = sqrt(st->norm2[j] / total);
+    for (int64_t v = 0; v < kd; v++) y[v] = st->sum[v] / sqrt(total);
     for (int it = 0; it < 500; it++) {
-        memset(y, 0, (size_t)kd * sizeof *y);
-        for (int64_t j = 0; j < n; j++)
-            cblas_daxpy((int)kd, phi[j] / sqrt(st->norm2[j]), COL(st, j), 1, y, 1);
+        if (it > 0) {
+            memset(y, 0, (size_t)kd * sizeof *y);
+            for (int64_t j = 0; j < n; j++)
+                cblas_daxpy((int)kd, phi[j] / sqrt(st->norm2[j]), COL(st, j), 1, y, 1);
+        }
+        st->power_steps++;
         double nz = 0, diff = 0;
         for (int64_t j = 0; j < n; j++) {
             z[j] = cblas_ddot((int)kd, COL(st, j), 1, y, 1) / sqrt(st->norm2[j]);
@@ -167,20 +220,20 @@ static es_status tenberge_power(gpa_state *st)
         nz = sqrt(nz);
         if (!(nz > 0) || !isfinite(nz))
             ES_FAIL(st->ctx, ES_ENUMERIC, "gpa: Ten Berge power iteration broke down");
-        for (int64_t j = 0; j < n; j++) {
-            double v = fabs(z[j] / nz);
-            diff = fmax(diff, fabs(v - phi[j]));
-            phi[j] = v;
-        }
-        if (diff <= 1e-15) return ES_OK;
+        for (int64_t j = 0; j < n; j++) diff = fmax(diff, fabs(fabs(z[j] / nz) - phi[j]));
+        /* phi (the vector y was built from) is kept, not the update: y and
+         * phi stay consistent; the update differs by less than diff */
+        if (diff <= stop) return ES_OK;
+        for (int64_t j = 0; j < n; j++) phi[j] = fabs(z[j] / nz);
     }
     ES_FAIL(st->ctx, ES_ENOCONV, "gpa: Ten Berge power iteration did not converge in 500 steps "
             "(the configurations are too dissimilar for the large-data path)");
 }
 
-/* Ten Berge scaling step: x_i *= beta_i, keeping the total sum of squares. */
-static es_status scaling_step(gpa_state *st, double total, double *scale_acc, double *change,
-                              int exact)
+/* Ten Berge scaling step: pending scales beta_i, keeping the total sum of
+ * squares; the sum of the scaled set is set up for the next sweep. */
+static es_status scaling_step(gpa_state *st, double total, double tol, double *scale_acc,
+                              double *change, int exact)
 {
     int64_t n = st->n, kd = st->kd;
     es_status rc;
@@ -189,23 +242,23 @@ static es_status scaling_step(gpa_state *st, double total, double *scale_acc, do
     } else {
         if (kd > INT32_MAX) ES_FAIL(st->ctx, ES_ERANGE, "gpa: %lld coordinates per configuration "
                                     "exceed BLAS's int", (long long)kd);
-        if ((rc = tenberge_power(st)) != ES_OK) return rc;
+        if ((rc = tenberge_power(st, total, tol)) != ES_OK) return rc;
     }
     double maxc = 0;
-    memset(st->sum, 0, (size_t)kd * sizeof *st->sum);
     for (int64_t j = 0; j < n; j++) {
-        double b = sqrt(total / st->norm2[j]) * fabs(st->phi[j]);
+        double b = sqrt(total / st->norm2[j]) * st->phi[j];
         if (!(b > 0) || !isfinite(b))
             ES_FAIL(st->ctx, ES_ENUMERIC, "gpa: Ten Berge scale of configuration %lld is %g "
                     "(it is orthogonal to all others)", (long long)j, b);
-        double *xj = COL(st, j);
-        for (int64_t v = 0; v < kd; v++) {
-            xj[v] *= b;
-            st->sum[v] += xj[v];
-        }
+        st->pend[j] = b;
         st->norm2[j] *= b * b;
         scale_acc[j] *= b;
         maxc = fmax(maxc, fabs(b - 1.0));
+    }
+    if (exact) {
+        flush_scales(st);
+    } else {
+        for (int64_t v = 0; v < kd; v++) st->sum[v] = sqrt(total) * st->work[v];
     }
     *change = maxc;
     return ES_OK;
@@ -238,16 +291,17 @@ es_status es_gpa_align(es_ctx *ctx, int64_t k, int d, es_mat x, const es_gpa_opt
 
     memset(&st, 0, sizeof st);
     st.ctx = ctx; st.k = k; st.d = d; st.n = n; st.kd = kd; st.x = x;
-    /* one block: sum kd, work max(kd, n*n), norm2 n, phi n, beta n, scale n, rot d*d*n */
-    int64_t nwork = kd > nn ? kd : nn, total_len = kd + nwork + 4 * n + (int64_t)d * d * n;
+    /* one block: sum kd, work max(kd, n*n), norm2, pend, phi, z, scale n each, rot d*d*n */
+    int64_t nwork = kd > nn ? kd : nn, total_len = kd + nwork + 5 * n + (int64_t)d * d * n;
     buf = es__alloc_array(ctx, total_len, sizeof *buf);
     if (!buf) return ES_ENOMEM;
     st.sum = buf;
     st.work = st.sum + kd;
     st.norm2 = st.work + nwork;
-    st.phi = st.norm2 + n;
-    st.beta = st.phi + n;
-    scale_acc = st.beta + n;
+    st.pend = st.norm2 + n;
+    st.phi = st.pend + n;
+    st.z = st.phi + n;
+    scale_acc = st.z + n;
     rot_acc = scale_acc + n;
 
     /* centre, record centroids and sizes, check for degenerate input */
@@ -280,10 +334,9 @@ es_status es_gpa_align(es_ctx *ctx, int64_t k, int d, es_mat x, const es_gpa_opt
         st.norm2[j] = ss;
         total += ss;
         scale_acc[j] = 1.0;
-        st.phi[j] = sqrt(ss);
+        st.pend[j] = 1.0;
         for (int q = 0; q < d * d; q++) rot_acc[j * d * d + q] = q % (d + 1) == 0;
     }
-    for (int64_t j = 0; j < n; j++) st.phi[j] /= sqrt(total);
     rep.total_ss = total;
 
     int exact = (double)n * (double)n * (double)kd <= GRAM_LIMIT;
@@ -291,7 +344,7 @@ es_status es_gpa_align(es_ctx *ctx, int64_t k, int d, es_mat x, const es_gpa_opt
         if ((rc = rotation_sweep(&st, o.allow_reflection, rot_acc, &rep.rot_change)) != ES_OK)
             goto done;
         if (o.scale &&
-            (rc = scaling_step(&st, total, scale_acc, &rep.scale_change, exact)) != ES_OK)
+            (rc = scaling_step(&st, total, o.tol, scale_acc, &rep.scale_change, exact)) != ES_OK)
             goto done;
         es__progress(ctx, "gpa", rep.iterations, o.max_iter);
         if (rep.rot_change <= o.tol && rep.scale_change <= o.tol) {
@@ -301,6 +354,9 @@ es_status es_gpa_align(es_ctx *ctx, int64_t k, int d, es_mat x, const es_gpa_opt
     }
     if (rep.iterations > o.max_iter) rep.iterations = o.max_iter;
     es__progress(ctx, "gpa", o.max_iter, o.max_iter);
+    es__info(ctx, "gpa: %lld iterations, %lld power steps", (long long)rep.iterations,
+             (long long)st.power_steps);
+    flush_scales(&st);   /* also recomputes the sum without accumulated rounding */
 
     /* mean, GSS and rho */
     double *mean = st.work, msz = 0, gss = 0, sr = 0;
@@ -311,12 +367,15 @@ es_status es_gpa_align(es_ctx *ctx, int64_t k, int d, es_mat x, const es_gpa_opt
     msz = sqrt(msz);
     for (int64_t j = 0; j < n; j++) {
         const double *xj = COL(&st, j);
-        double a[9], r = 0;
-        for (int64_t v = 0; v < kd; v++) gss += (xj[v] - mean[v]) * (xj[v] - mean[v]);
+        double a[9], r = 0, nx = 0;
+        for (int64_t v = 0; v < kd; v++) {
+            gss += (xj[v] - mean[v]) * (xj[v] - mean[v]);
+            nx += xj[v] * xj[v];
+        }
         if (msz > 0) {
             es__procrustes_cross(k, d, xj, mean, a);
-            if ((rc = es__procrustes_rho(ctx, d, a, sqrt(st.norm2[j]), msz, o.allow_reflection,
-                                         &r)) != ES_OK)
+            if ((rc = es__procrustes_rho(ctx, d, a, sqrt(nx), msz, o.allow_reflection, &r)) !=
+                ES_OK)
                 goto done;
         } else {
             r = M_PI / 2;
