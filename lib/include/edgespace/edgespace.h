@@ -9,5 +9,6 @@
 #include "es_geom.h"
 #include "es_io.h"
 #include "es_procrustes.h"
+#include "es_landmarks.h"
 
 #endif
