@@ -10,5 +10,6 @@
 #include "es_io.h"
 #include "es_procrustes.h"
 #include "es_landmarks.h"
+#include "es_compare.h"
 
 #endif
