@@ -8,6 +8,8 @@
 #include "es_mesh.h"
 #include "es_geom.h"
 #include "es_io.h"
+#include "es_plot.h"
+#include "es_render.h"
 #include "es_procrustes.h"
 #include "es_landmarks.h"
 #include "es_compare.h"
