@@ -695,3 +695,107 @@ fail:
     table_free(&t);
     return rc;
 }
+
+/* ---- truss lengths and index lists ----------------------------------------- */
+
+es_status es_landmarks_truss_lengths(es_ctx *ctx, const es_landmarks *lm, int64_t nedges,
+                                     const int64_t *edges, es_mat len)
+{
+    if (len.rows != nedges || len.cols != lm->n || len.ld < nedges)
+        ES_FAIL(ctx, ES_EINVAL, "landmarks: lengths matrix must be %lld x %lld",
+                (long long)nedges, (long long)lm->n);
+    for (int64_t e = 0; e < nedges; e++) {
+        int64_t a = edges[2 * e], b = edges[2 * e + 1];
+        if (a < 0 || b < 0 || a >= lm->k || b >= lm->k || a == b)
+            ES_FAIL(ctx, ES_EINVAL, "landmarks: edge %lld joins landmarks %lld and %lld (of "
+                    "%lld)", (long long)e + 1, (long long)a + 1, (long long)b + 1,
+                    (long long)lm->k);
+    }
+    int64_t kd = lm->k * lm->d;
+    for (int64_t j = 0; j < lm->n; j++) {
+        const double *c = lm->xyz + j * kd;
+        for (int64_t e = 0; e < nedges; e++) {
+            int64_t a = edges[2 * e], b = edges[2 * e + 1];
+            double s = 0;
+            for (int q = 0; q < lm->d; q++) {
+                double dd = c[a + q * lm->k] - c[b + q * lm->k];
+                s += dd * dd;
+            }
+            ES_AT(len, e, j) = sqrt(s);
+        }
+    }
+    return ES_OK;
+}
+
+es_status es_landmarks_read_index_list(es_ctx *ctx, const char *path, int per, int64_t **idx,
+                                       int64_t *count)
+{
+    char *buf = NULL;
+    size_t len;
+    es_status rc;
+    const char *file = base_name(path);
+    *idx = NULL;
+    *count = 0;
+    if (per != 2 && per != 3) ES_FAIL(ctx, ES_EINVAL, "landmarks: %d indices per line", per);
+    if ((rc = slurp(ctx, path, &buf, &len)) != ES_OK) return rc;
+    int64_t cap = 64, n = 0, line = 0;
+    int64_t *out = es__alloc_array(ctx, cap * per, sizeof *out);
+    if (!out) { es__free(ctx, buf); return ES_ENOMEM; }
+    char *cur = buf;
+    while (cur && *cur) {
+        char *nl = strchr(cur, '\n');
+        if (nl) *nl = 0;
+        char *s = cur, *hash = strchr(s, '#');
+        cur = nl ? nl + 1 : NULL;
+        line++;
+        if (hash) *hash = 0;
+        int64_t v[4];
+        int got = 0;
+        char *p = s, *e;
+        for (;;) {
+            while (*p == ' ' || *p == '\t' || *p == ',' || *p == '\r') p++;
+            if (!*p) break;
+            errno = 0;
+            long long x = strtoll(p, &e, 10);
+            if (e == p || errno || (*e && *e != ' ' && *e != '\t' && *e != ',' && *e != '\r') ||
+                got == per) {
+                rc = es__fail(ctx, ES_EFORMAT, "landmarks: %s:%lld: expected %d landmark numbers",
+                              file, (long long)line, per);
+                goto fail;
+            }
+            if (x < 1) {
+                rc = es__fail(ctx, ES_EFORMAT, "landmarks: %s:%lld: landmark number %lld < 1",
+                              file, (long long)line, x);
+                goto fail;
+            }
+            v[got++] = x - 1;
+            p = e;
+        }
+        if (got == 0) continue;
+        if (got != per) {
+            rc = es__fail(ctx, ES_EFORMAT, "landmarks: %s:%lld: expected %d landmark numbers, "
+                          "found %d", file, (long long)line, per, got);
+            goto fail;
+        }
+        if (n == cap) {
+            int64_t *no = es__realloc(ctx, out, (size_t)(2 * cap * per) * sizeof *no);
+            if (!no) { rc = ES_ENOMEM; goto fail; }
+            out = no;
+            cap *= 2;
+        }
+        for (int q = 0; q < per; q++) out[n * per + q] = v[q];
+        n++;
+    }
+    if (n == 0) {
+        rc = es__fail(ctx, ES_EFORMAT, "landmarks: %s: no entries", file);
+        goto fail;
+    }
+    es__free(ctx, buf);
+    *idx = out;
+    *count = n;
+    return ES_OK;
+fail:
+    es__free(ctx, buf);
+    es__free(ctx, out);
+    return rc;
+}

@@ -213,3 +213,15 @@ es_status es_procrustes_distance(es_ctx *ctx, int64_t k, int d, const double *x,
     if (partial) *partial = 2.0 * sin(r / 2.0);
     return ES_OK;
 }
+
+void es_procrustes_from_xyz(int64_t k, const double *xyz, double *config)
+{
+    for (int64_t v = 0; v < k; v++)
+        for (int q = 0; q < 3; q++) config[v + q * k] = xyz[3 * v + q];
+}
+
+void es_procrustes_to_xyz(int64_t k, const double *config, double *xyz)
+{
+    for (int64_t v = 0; v < k; v++)
+        for (int q = 0; q < 3; q++) xyz[3 * v + q] = config[v + q * k];
+}

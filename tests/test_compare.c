@@ -220,6 +220,81 @@ static void test_groups(es_ctx *ctx)
                    "group 2 is empty");
 }
 
+static int64_t count_lines(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    int64_t n = 0;
+    int c;
+    if (!f) return -1;
+    while ((c = fgetc(f)) != EOF) n += c == '\n';
+    fclose(f);
+    return n;
+}
+
+/* The whole study on landmark triangles: truss lengths of a complete graph
+ * and GPA-aligned configurations of two groups, outputs written. */
+static void test_study(es_ctx *ctx)
+{
+    es__rng rng;
+    es__rng_init(&rng, 31);
+    int64_t n = 12, k = 5, d = 2, kd = k * d, ne = k * (k - 1) / 2;
+    es_landmarks lm = {0};
+    double xyz[120], len[120], aligned[120];
+    int64_t edges[20], group[12];
+    for (int64_t j = 0, e = 0; j < k; j++)
+        for (int64_t i = 0; i < j; i++, e++) { edges[2 * e] = i; edges[2 * e + 1] = j; }
+    for (int64_t j = 0; j < n; j++) {
+        group[j] = j < 6 ? 0 : 1;
+        for (int64_t v = 0; v < kd; v++)
+            xyz[v + j * kd] = (double)((v * 7) % 5) + 0.05 * es__rng_normal(&rng) +
+                              (group[j] && v == 0 ? 0.8 : 0.0);
+    }
+    lm.n = n; lm.k = k; lm.d = (int)d; lm.xyz = xyz;
+    ES_CHECK_OK(ctx, es_landmarks_truss_lengths(ctx, &lm, ne, edges, (es_mat){len, ne, n, ne}));
+    ES_CHECK_CLOSE(len[0], hypot(xyz[0] - xyz[1], xyz[5] - xyz[6]), 1e-15, 0);
+    int64_t bad[2] = {0, 5};
+    ES_CHECK_FAILS(ctx, es_landmarks_truss_lengths(ctx, &lm, 1, bad, (es_mat){len, 1, n, 1}),
+                   ES_EINVAL, "edge 1 joins landmarks 1 and 6");
+    memcpy(aligned, xyz, sizeof aligned);
+    ES_CHECK_OK(ctx, es_gpa_align(ctx, k, (int)d, (es_mat){aligned, kd, n, kd}, NULL, NULL, NULL));
+    es_compare_opts o;
+    es_compare_opts_init(&o);
+    o.permutations = 499;
+    o.top_pairs = 5;
+    es_compare_result *r = NULL;
+    ES_CHECK_OK(ctx, es_compare_study(ctx, (es_mat){len, ne, n, ne}, (es_mat){aligned, kd, n, kd},
+                                      group, 2, &o, &r));
+    if (!r) return;
+    /* both spaces see the group difference */
+    ES_CHECK(r->groups_len.p <= 0.02 && r->groups_proc.p <= 0.02);
+    ES_CHECK(r->mantel_rho > 0.3 && r->mantel_p <= 0.01);
+    ES_CHECK(r->ntop == 5 && r->nn_agreement >= 0 && r->nn_agreement <= 1);
+    double rho2;
+    ES_CHECK_OK(ctx, es_compare_mantel(ctx, n, r->d_len, r->d_proc, 0, &rho2, NULL));
+    ES_CHECK(rho2 == r->mantel_rho);
+    char dir[256];
+    snprintf(dir, sizeof dir, "%s/test-compare-out/study", ES_BUILD_ROOT);
+    const char *ids[12] = {"a", "b", "c", "d", "e", "f", "g,1", "h", "i", "j", "k", "l"};
+    const char *gn[2] = {"one", "two"};
+    ES_CHECK_OK(ctx, es_compare_write(ctx, r, ids, group, gn, dir, 1));
+    char path[512];
+    static const struct { const char *f; int64_t lines; } files[] = {
+        {"distances_lengths.csv", 13}, {"distances_procrustes.csv", 13}, {"pairs.csv", 67},
+        {"nearest.csv", 13}, {"disagreement.csv", 6}, {"group_means.csv", 3},
+        {"summary.csv", 11}, {"heatmap_lengths.svg", -1}, {"heatmap_procrustes.svg", -1},
+        {"pairs_scatter.svg", -1}};
+    for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
+        snprintf(path, sizeof path, "%s/%s", dir, files[i].f);
+        int64_t l = count_lines(path);
+        ES_CHECK_MSG(files[i].lines < 0 ? l > 0 : l == files[i].lines, "%s: %lld lines",
+                     files[i].f, (long long)l);
+    }
+    es_compare_result_free(r);
+    ES_CHECK_FAILS(ctx, es_compare_study(ctx, (es_mat){len, ne, n, ne},
+                                         (es_mat){aligned, kd, n - 1, kd}, NULL, 0, &o, &r),
+                   ES_EMISMATCH, "12 edge-length vectors but 11 configurations");
+}
+
 int main(void)
 {
     es_ctx *ctx = NULL;
@@ -229,6 +304,7 @@ int main(void)
     test_mantel(ctx);
     test_nn_disagreement(ctx);
     test_groups(ctx);
+    test_study(ctx);
     es_ctx_free(ctx);
     ES_TEST_END();
 }

@@ -73,6 +73,57 @@ ES_API es_status es_compare_groups(es_ctx *ctx, int64_t n, const double *dist,
                                    const int64_t *group, int64_t ngroups, int64_t permutations,
                                    double *mean_dist, double *p_pair, es_group_stats *stats);
 
+/* ---- the whole study ---------------------------------------------------- */
+
+typedef struct es_compare_opts {
+    int64_t permutations;  /* Mantel and group tests (default 999; 0: no tests) */
+    int64_t top_pairs;     /* disagreeing pairs to report (default 20, capped at n(n-1)/2) */
+    int normalize_lengths; /* divide each length column by its sum (default 1) */
+} es_compare_opts;
+
+ES_API void es_compare_opts_init(es_compare_opts *opts);
+
+/* Everything es_compare_study computes; arrays owned by the result. Space 1
+ * is edge-length space ("len"), space 2 Procrustes space ("proc"). */
+typedef struct es_compare_result {
+    int64_t n;
+    double *d_len, *d_proc;        /* n x n distance matrices */
+    double mantel_rho, mantel_p;   /* Spearman of the two, Mantel p */
+    double nn_agreement;
+    int64_t *nn_len, *nn_proc;     /* n nearest neighbours */
+    int64_t ntop;
+    int64_t *top_pairs;            /* 2 x ntop */
+    double *top_diff;              /* ntop: scaled rank in len - rank in proc */
+    int64_t ngroups;               /* 0 when no groups were given */
+    double *mean_len, *mean_proc;  /* ngroups x ngroups distances of group means */
+    double *p_len, *p_proc;        /* their permutation p-values */
+    es_group_stats groups_len, groups_proc;
+    es_ctx *ctx;
+} es_compare_result;
+
+/* The comparison study on n shapes: lengths (E x n edge lengths, raw or
+ * normalized) and aligned (k*d x n, e.g. es_gpa_align output: Procrustes
+ * distances are Euclidean distances of aligned configurations). group (n
+ * labels in [0, ngroups)) may be NULL with ngroups = 0. Caller owns *out
+ * (es_compare_result_free). */
+ES_API es_status es_compare_study(es_ctx *ctx, es_mat lengths, es_mat aligned,
+                                  const int64_t *group, int64_t ngroups,
+                                  const es_compare_opts *opts, es_compare_result **out);
+ES_API void es_compare_result_free(es_compare_result *res);
+
+/* Write the study to dir (created if missing): distances_lengths.csv and
+ * distances_procrustes.csv (n x n with ids), pairs.csv (i, j, ids, both
+ * distances, group pair), summary.csv (statistic, value), nearest.csv,
+ * disagreement.csv, and with groups group_means.csv (space, group_a,
+ * group_b, distance, p). figures = 1 adds heatmap_lengths.svg,
+ * heatmap_procrustes.svg and pairs_scatter.svg (distance pairs coloured by
+ * group pair) through es_plot. ids: n names (NULL: 1-based numbers);
+ * group_names: ngroups names (NULL: numbers). ES_EIO names the file. */
+ES_API es_status es_compare_write(es_ctx *ctx, const es_compare_result *res,
+                                  const char *const *ids, const int64_t *group,
+                                  const char *const *group_names, const char *dir,
+                                  int figures);
+
 #ifdef __cplusplus
 }
 #endif

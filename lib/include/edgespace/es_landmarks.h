@@ -67,6 +67,20 @@ ES_API int64_t es_landmarks_find_column(const es_landmarks *lm, const char *name
 
 ES_API void es_landmarks_free(es_landmarks *lm);
 
+/* "Truss" lengths: for each specimen, the lengths of nedges landmark pairs
+ * (edges: 2 x nedges, 0-based landmark indices) into len (nedges x n,
+ * column = specimen). ES_EINVAL on an index out of range or a pair with
+ * equal ends. */
+ES_API es_status es_landmarks_truss_lengths(es_ctx *ctx, const es_landmarks *lm,
+                                            int64_t nedges, const int64_t *edges, es_mat len);
+
+/* Read an edge list (2 numbers a line) or a triangulation (3 a line) of
+ * 1-based landmark numbers; blank lines and '#' comments allowed, commas or
+ * spaces separate. *idx (per x count, allocated with ctx: es_free) and
+ * *count. per = 2 or 3. ES_EFORMAT with file:line. */
+ES_API es_status es_landmarks_read_index_list(es_ctx *ctx, const char *path, int per,
+                                              int64_t **idx, int64_t *count);
+
 #ifdef __cplusplus
 }
 #endif

@@ -73,6 +73,11 @@ ES_API es_status es_procrustes_distance(es_ctx *ctx, int64_t k, int d, const dou
                                         const double *y, int allow_reflection, double *rho,
                                         double *full, double *partial);
 
+/* Layout conversion between meshes/stores (3 x k, xyz interleaved) and
+ * configurations (k x 3 column-major). Cannot fail. */
+ES_API void es_procrustes_from_xyz(int64_t k, const double *xyz, double *config);
+ES_API void es_procrustes_to_xyz(int64_t k, const double *config, double *xyz);
+
 /* ---- generalized Procrustes analysis ------------------------------------ */
 
 typedef struct es_gpa_opts {
