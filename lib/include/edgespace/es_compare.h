@@ -24,6 +24,7 @@
 #define EDGESPACE_ES_COMPARE_H
 
 #include "es_core.h"
+#include "es_store.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -123,6 +124,22 @@ ES_API es_status es_compare_write(es_ctx *ctx, const es_compare_result *res,
                                   const char *const *ids, const int64_t *group,
                                   const char *const *group_names, const char *dir,
                                   int figures);
+
+/* The study on a store: the rows of GPA result /analysis/gpa/<gpa_name>
+ * (their aligned configurations) against their stored normalized edge
+ * lengths, grouped by label column `by` (NULL: no groups). Writes
+ * /analysis/compare/<name> (name NULL: gpa_name) with provenance: datasets
+ * d_lengths, d_procrustes (n x n), group_means_lengths/_procrustes and
+ * p_lengths/_procrustes (g x g), group_names, attributes spearman_rho,
+ * mantel_p, nn_agreement, permutations, by, gpa. out_dir (or NULL) gets
+ * es_compare_write's files (figures if `figures`). ES_ENOTFOUND if the GPA
+ * result or the column is missing; ES_EINVAL for a store without edges. The
+ * store must be open for writing if name is not "" (name "": nothing is
+ * written to the store). res (may be NULL) receives the result. */
+ES_API es_status es_compare_store_run(es_ctx *ctx, es_store *store, const char *gpa_name,
+                                      const char *by, const es_compare_opts *opts,
+                                      const char *name, const char *out_dir, int figures,
+                                      const char *command, es_compare_result **res);
 
 #ifdef __cplusplus
 }
