@@ -8,5 +8,7 @@
 #include "es_mesh.h"
 #include "es_geom.h"
 #include "es_io.h"
+#include "es_plot.h"
+#include "es_render.h"
 
 #endif

@@ -1,0 +1,142 @@
+/* lib/include/edgespace/es_render.h — pictures of triangle meshes.
+ *
+ * es_render draws one or several meshes side by side in a row, each with
+ * an optional label under it, an optional title above and, when scalars are
+ * given, one colour bar for all of them on the right. The output format
+ * follows the file extension as in es_plot.h (.png, .svg, .pdf).
+ *
+ * How: a z-buffer rasterizer (in render.c) draws each panel into an image
+ * at `supersample` times the resolution, with per-pixel Lambert shading
+ * under a headlight (light from the camera) from interpolated vertex
+ * normals, and box-filters it down; cairo then places the panels, labels
+ * and colour bar. A z-buffer rather than the painter's algorithm because it
+ * is exact for interpenetrating and cyclically overlapping triangles,
+ * shades per pixel and is O(pixels + triangles) without a sort; the price
+ * is that in SVG/PDF output the mesh panels are embedded images (text and
+ * colour bar stay vector).
+ *
+ * Camera: by default each mesh is seen along its smallest principal axis
+ * (PCA of its vertices), centred on its centroid, from the side its faces
+ * point to (es_render_auto_view gives the rule). Every panel uses the same
+ * scale (data units per pixel) so that sizes compare across panels, unless
+ * fit_each asks for each mesh to fill its own panel.
+ * Explicit `view` (the direction the camera looks along) and `up` vectors
+ * override the choice for all panels.
+ *
+ * Scalars: per vertex (interpolated across faces, then mapped), per edge
+ * (each face shows the mean of its three edges) or per face. NaN or inf
+ * scalars are drawn in the neutral grey ES_NAN_GREY and counted in the
+ * report. Without scalars a mesh is drawn in `base_rgb`.
+ */
+#ifndef EDGESPACE_ES_RENDER_H
+#define EDGESPACE_ES_RENDER_H
+
+#include "es_core.h"
+#include "es_plot.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum es_projection {
+    ES_PROJ_PERSPECTIVE = 0,   /* vertical field of view fov_deg */
+    ES_PROJ_ORTHOGRAPHIC
+} es_projection;
+
+typedef enum es_backface {
+    ES_BACKFACE_DARKER = 0,    /* drawn, lit from their own side, in a darker tone */
+    ES_BACKFACE_CULL           /* not drawn (what is behind them shows) */
+} es_backface;
+
+typedef enum es_scalar_kind {
+    ES_SCALARS_NONE = 0,
+    ES_SCALARS_VERTEX,         /* nverts values */
+    ES_SCALARS_EDGE,           /* nedges values, edge i = column i of `edges` */
+    ES_SCALARS_FACE            /* nfaces values */
+} es_scalar_kind;
+
+/* One mesh to draw. All arrays borrowed for the duration of the call. */
+typedef struct es_render_mesh {
+    int64_t nverts, nfaces;
+    const double *xyz;         /* 3 x nverts positions */
+    const int64_t *faces;      /* 3 x nfaces, 0-based, counter-clockwise = front */
+    const char *label;         /* drawn under the panel, or NULL */
+    es_scalar_kind scalar_kind;
+    const double *scalars;
+    /* For ES_SCALARS_EDGE: the edge list (2 x nedges vertex pairs, in any
+     * order, e.g. es_mesh_edges()); every face edge must be in it. */
+    int64_t nedges;
+    const int64_t *edges;
+} es_render_mesh;
+
+typedef struct es_render_spec {
+    int64_t nmeshes;
+    const es_render_mesh *meshes;
+    int width, height;         /* of each panel, device units (480 x 480) */
+    es_projection projection;  /* ES_PROJ_PERSPECTIVE */
+    double fov_deg;            /* perspective field of view (25) */
+    int has_view, has_up;      /* use view / up below instead of the automatic ones */
+    double view[3];            /* direction the camera looks along (not normalized) */
+    double up[3];              /* screen up; made orthogonal to view */
+    double fill;               /* fraction of the panel the largest mesh spans (0.9) */
+    int fit_each;              /* 1: every mesh spans `fill` of its own panel;
+                                * 0 (default): one scale for all panels */
+    es_backface backface;      /* ES_BACKFACE_DARKER */
+    es_colormap cmap;          /* for scalars (ES_CMAP_VIRIDIS) */
+    /* Colour range; vmin == vmax (default): the finite range over all
+     * meshes, symmetric about 0 for ES_CMAP_RDBU. */
+    double vmin, vmax;
+    int colorbar;              /* draw a colour bar when there are scalars (1) */
+    const char *colorbar_label;
+    const char *title;         /* above the row, or NULL */
+    double base_rgb[3];        /* surface colour without scalars (light grey-beige) */
+    double background_rgb[3];  /* (1, 1, 1) */
+    double font_size;          /* (12) */
+    int supersample;           /* 1..4 samples per pixel per axis (3) */
+} es_render_spec;
+
+typedef struct es_render_report {
+    int width, height;         /* the whole picture, device units */
+    int64_t n_nan_scalars;     /* non-finite scalars drawn grey, all meshes */
+    int64_t n_faces_drawn;     /* faces that covered at least one sample */
+    int64_t n_backfaces;       /* faces seen from behind (drawn darker or culled) */
+    double vmin, vmax;         /* colour range used */
+    double units_per_pixel;    /* scale shared by the panels (orthographic: exact;
+                                * perspective: at the depth of the bounding box
+                                * centre); with fit_each, the coarsest panel's */
+    double view[3], up[3];     /* camera of the first panel, unit vectors */
+    double panel_x0;           /* left edge of panel 0; panel i starts at
+                                * panel_x0 + i * panel width */
+    double panel_y0;           /* top edge of the panels */
+    double colorbar[4];        /* x, y, w, h of the colour bar's colour area, or zeros */
+} es_render_report;
+
+ES_API void es_render_spec_init(es_render_spec *spec);
+
+/* Draw spec->meshes to `path`. report: NULL or filled.
+ * Errors: ES_EINVAL (no meshes, NULL arrays, a face index out of range, a
+ * scalar kind without scalars, zero view/up vectors or view parallel to
+ * up, an unknown extension), ES_ENOTFOUND (an edge of a face missing from
+ * `edges`), ES_EIO, ES_ENOMEM. */
+ES_API es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
+                           es_render_report *report);
+
+/* The automatic camera of a mesh (faces may be NULL, nfaces 0):
+ *  - view: the eigenvector of the smallest eigenvalue of the vertex
+ *    covariance, signed so that the area-weighted sum of face normals
+ *    points back to the camera (the faces look at the camera); if that sum
+ *    is nearly orthogonal to it (a closed surface), signed so that the
+ *    camera sits on the positive side of the axis's largest component.
+ *  - up: of the two other axes, the one closer to the coordinate +y axis
+ *    (meshes are mostly stored y-up); if both are far from it (|cos| < 0.3)
+ *    the largest-variance axis. Signed to point along +y, or else with its
+ *    largest-magnitude component positive.
+ * Fails with ES_EINVAL on fewer than 3 vertices or non-finite positions. */
+ES_API es_status es_render_auto_view(es_ctx *ctx, int64_t nverts, const double *xyz,
+                                     int64_t nfaces, const int64_t *faces, double view[3],
+                                     double up[3]);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
