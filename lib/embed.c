@@ -45,8 +45,9 @@ struct es_embedder {
     cholmod_dense *X, *Y, *Ew, *B3, *B1, *BA;
     /* work, sized once */
     double *ang, *theta, *C, *G, *len, *alpha, *alpha_try, *xyz, *xyz_try, *xyz_best;
-    double *ltarget, *lpath, *res, *grad, *diag, *jw, *fanwork, *fanr, *fanth, *fanal, *vclos, *verr;
+    double *ltarget, *lpath, *res, *grad, *diag, *pcg, *jw, *fanwork, *fanr, *fanth, *fanal, *vclos, *verr;
     int have_vertex_results;
+    int64_t nfactor;        /* numeric factorizations in the last solve */
 };
 
 void es_embed_opts_init(es_embed_opts *o)
@@ -237,6 +238,7 @@ static es_status alloc_work(es_embedder *emb)
     ALLOC(emb->res, 9 * nv + ne);
     ALLOC(emb->grad, 3 * nv + ne);
     ALLOC(emb->diag, 3 * nv + ne);
+    ALLOC(emb->pcg, 18 * nv);
     ALLOC(emb->jw, 9 * ns);
     ALLOC(emb->fanwork, 18 * (2 * emb->maxk + 2));
     ALLOC(emb->fanr, 9);
@@ -381,6 +383,10 @@ es_status es_embedder_new(es_ctx *ctx, const es_mesh *mesh, es_embedder **out)
             goto fail;
         }
     }
+    es__info(ctx, "embed: analysis: positions n %lld nnz(L) %.0f flops %.3g (ordering %d); "
+             "closure n %lld nnz(L) %.0f", (long long)(3 * emb->nv), (double)emb->L3->xsize,
+             emb->cm.fl, emb->L3->ordering, (long long)emb->nvar,
+             emb->LA ? (double)emb->LA->xsize : 0.0);
     *out = emb;
     return ES_OK;
 fail:
@@ -412,7 +418,7 @@ void es_embedder_free(es_embedder *emb)
     void *bufs[] = {emb->slot_corner, emb->edge_slot, emb->pinned, emb->vweight, emb->rank,
                     emb->nlow, emb->var, emb->amap_off, emb->amap, emb->adiag, emb->ang,
                     emb->theta, emb->C, emb->G, emb->len, emb->alpha, emb->alpha_try, emb->xyz,
-                    emb->xyz_try, emb->xyz_best, emb->ltarget, emb->lpath, emb->res, emb->grad, emb->diag,
+                    emb->xyz_try, emb->xyz_best, emb->ltarget, emb->lpath, emb->res, emb->grad, emb->diag, emb->pcg,
                     emb->jw, emb->fanwork, emb->fanr, emb->fanth, emb->fanal, emb->vclos,
                     emb->verr};
     for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++) es__free(ctx, bufs[i]);
@@ -532,6 +538,8 @@ static es_status stage_dihedrals(es_embedder *emb, const es_embed_opts *o, doubl
             }
         }
         it++;
+        es__info(emb->ctx, "embed: dihedrals %lld E %.6g -> %.6g lambda %.3g", (long long)it, e,
+                 e_new, lambda);
         if (!accepted) break;
         if (e - e_new < o->dihedral_rtol * e) {
             e = e_new;
@@ -674,16 +682,92 @@ static double length_cost(const es_embedder *emb, const double *xyz, const doubl
     return c;
 }
 
+/* y = A x for the symmetric matrix held in its upper triangle (CSC). */
+static void sym_matvec(const cholmod_sparse *A, const double *x, double *y)
+{
+    const int64_t *cp = A->p, *ri = A->i;
+    const double *ax = A->x;
+    int64_t n = (int64_t)A->ncol;
+    for (int64_t i = 0; i < n; i++) y[i] = 0;
+    for (int64_t j = 0; j < n; j++)
+        for (int64_t p = cp[j]; p < cp[j + 1]; p++) {
+            int64_t i = ri[p];
+            y[i] += ax[p] * x[j];
+            if (i != j) y[j] += ax[p] * x[i];
+        }
+}
+
+static double dotn(const double *a, const double *b, int64_t n)
+{
+    double s = 0;
+    for (int64_t i = 0; i < n; i++) s += a[i] * b[i];
+    return s;
+}
+
+/* Solve A d = b (A = emb->H3 with its damped diagonal in place) by
+ * conjugate gradients preconditioned with the factor of an earlier A
+ * (emb->L3): the Gauss-Newton matrix changes little between iterations,
+ * so a lagged factor is a very good preconditioner and one solve costs a
+ * small fraction of a factorization. Returns the iterations used, or -1
+ * if the relative residual did not reach eta within max_it. */
+static int lagged_pcg(es_embedder *emb, const double *b, double *d, double eta, int max_it)
+{
+    int64_t n = 3 * emb->nv;
+    double *r = emb->pcg, *z = r + n, *p = z + n, *q = p + n, rz, bn;
+    double *bx = emb->B3->x;
+    bn = sqrt(dotn(b, b, n));
+    for (int64_t i = 0; i < n; i++) {
+        d[i] = 0;
+        r[i] = b[i];
+    }
+    if (!(bn > 0)) return 0;
+    emb->B3->ncol = 1;
+    for (int it = 0; it < max_it; it++) {
+        memcpy(bx, r, (size_t)n * sizeof *bx);
+        if (!cholmod_l_solve2(CHOLMOD_A, emb->L3, emb->B3, NULL, &emb->X, NULL, &emb->Y, &emb->Ew,
+                              &emb->cm)) {
+            emb->B3->ncol = 3;
+            return -1;
+        }
+        memcpy(z, emb->X->x, (size_t)n * sizeof *z);
+        if (it == 0) {
+            memcpy(p, z, (size_t)n * sizeof *p);
+            rz = dotn(r, z, n);
+        } else {
+            double rz_new = dotn(r, z, n), beta = rz_new / rz;
+            rz = rz_new;
+            for (int64_t i = 0; i < n; i++) p[i] = z[i] + beta * p[i];
+        }
+        sym_matvec(emb->H3, p, q);
+        {
+            double pq = dotn(p, q, n), a;
+            if (!(pq > 0)) break;
+            a = rz / pq;
+            for (int64_t i = 0; i < n; i++) {
+                d[i] += a * p[i];
+                r[i] -= a * q[i];
+            }
+        }
+        if (sqrt(dotn(r, r, n)) <= eta * bn) {
+            emb->B3->ncol = 3;
+            return it + 1;
+        }
+    }
+    emb->B3->ncol = 3;
+    return -1;
+}
+
 static es_status stage_refine(es_embedder *emb, const double *L, double *xyz, int max_iter,
                               double rtol, double tol, int64_t *iters)
 {
     int64_t nv = emb->nv, n3 = 3 * nv, ne = emb->ne;
-    double *x = emb->H3->x, *g = emb->grad, *dg = emb->diag, lambda = 1e-4, c;
-    double ctol = tol * tol * (double)ne;
+    double *x = emb->H3->x, *g = emb->grad, *dg = emb->diag, *step = emb->pcg + 4 * n3;
+    double *hd = step + n3, lambda = 1e-4, c, ctol = tol * tol * (double)ne;
+    int have_factor = 0;
     c = length_cost(emb, xyz, L);
     for (int it = 0; it < max_iter && c > ctol; it++) {
-        int accepted = 0;
-        double c_new = c;
+        double c_new = c, mean = 0, pred, rho = 0;
+        int accepted = 0, st, used = -1;
         memset(x, 0, emb->H3->nzmax * sizeof(double));
         memset(g, 0, (size_t)n3 * sizeof(double));
         for (int64_t e = 0; e < ne; e++) {
@@ -708,48 +792,59 @@ static es_status stage_refine(es_embedder *emb, const double *L, double *xyz, in
                     }
                 }
         }
-        {
-            double mean = 0;
+        for (int64_t i = 0; i < n3; i++) {
+            dg[i] = x[pos_diag(emb->H3, 3, emb->nlow, i / 3, (int)(i % 3), (int)(i % 3))];
+            mean += dg[i];
+        }
+        mean /= (double)n3;
+        for (int tries = 0; tries < 20 && !accepted; tries++) {
+            double eta = fmin(1e-2, fmax(1e-12, sqrt(c / (double)ne)));
             for (int64_t i = 0; i < n3; i++) {
-                dg[i] = x[pos_diag(emb->H3, 3, emb->nlow, i / 3, (int)(i % 3), (int)(i % 3))];
-                mean += dg[i];
+                double v = emb->vweight[i / 3] == 0 ? mean : dg[i];
+                x[pos_diag(emb->H3, 3, emb->nlow, i / 3, (int)(i % 3), (int)(i % 3))] =
+                    (emb->vweight[i / 3] == 0 ? mean : dg[i]) + lambda * (v + 1e-8 * mean) +
+                    1e-300;
+                hd[i] = -g[i];
             }
-            mean /= (double)n3;
-            for (int64_t i = 0; i < n3; i++)
-                if (emb->vweight[i / 3] == 0) dg[i] = mean;   /* isolated vertex: hold it */
-            for (int tries = 0; tries < 12; tries++) {
-                double *bx = emb->B3->x;
-                int st;
-                for (int64_t i = 0; i < n3; i++) {
-                    int64_t p = pos_diag(emb->H3, 3, emb->nlow, i / 3, (int)(i % 3), (int)(i % 3));
-                    x[p] = (emb->vweight[i / 3] == 0 ? 0 : dg[i]) +
-                           lambda * (dg[i] + 1e-8 * mean) + 1e-300;
-                    bx[i] = -g[i];
-                }
-                /* B3 has 3 columns; solve only the first */
+            used = have_factor ? lagged_pcg(emb, hd, step, eta, 12) : -1;
+            if (used < 0) {
+                memcpy(emb->B3->x, hd, (size_t)n3 * sizeof(double));
                 emb->B3->ncol = 1;
                 st = factor_solve(emb, emb->H3, emb->L3, emb->B3);
                 emb->B3->ncol = 3;
-                for (int64_t i = 0; i < n3; i++)
-                    x[pos_diag(emb->H3, 3, emb->nlow, i / 3, (int)(i % 3), (int)(i % 3))] =
-                        emb->vweight[i / 3] == 0 ? 0 : dg[i];
                 if (st < 0) return ES_ENUMERIC;
-                if (st == 0) {
-                    const double *dx = emb->X->x;
-                    double *xt = emb->xyz_try;
-                    for (int64_t i = 0; i < n3; i++) xt[i] = xyz[i] + dx[i];
-                    c_new = length_cost(emb, xt, L);
-                    if (isfinite(c_new) && c_new < c) {
-                        memcpy(xyz, xt, (size_t)n3 * sizeof *xyz);
-                        accepted = 1;
-                        lambda = fmax(lambda / 5.0, 1e-12);
-                        break;
-                    }
-                }
-                lambda *= 10.0;
+                have_factor = st == 0;
+                emb->nfactor++;
+                if (st == 0) memcpy(step, emb->X->x, (size_t)n3 * sizeof(double));
+            } else {
+                st = 0;
             }
+            /* restore the undamped diagonal for the model and matvecs */
+            for (int64_t i = 0; i < n3; i++)
+                x[pos_diag(emb->H3, 3, emb->nlow, i / 3, (int)(i % 3), (int)(i % 3))] =
+                    emb->vweight[i / 3] == 0 ? 0 : dg[i];
+            if (st == 0) {
+                double *xt = emb->xyz_try;
+                for (int64_t i = 0; i < n3; i++) xt[i] = xyz[i] + step[i];
+                c_new = length_cost(emb, xt, L);
+                sym_matvec(emb->H3, step, hd);
+                pred = -2.0 * dotn(g, step, n3) - dotn(step, hd, n3);
+                rho = pred > 0 ? (c - c_new) / pred : -1;
+                if (isfinite(c_new) && c_new < c && rho > 0) {
+                    memcpy(xyz, xt, (size_t)n3 * sizeof *xyz);
+                    accepted = 1;
+                    /* Nielsen's gain-ratio rule (1999) let lambda creep up on
+                     * these problems (rho stays small where the residual is
+                     * not zero); Marquardt's fixed factors converge faster. */
+                    lambda = fmax(lambda / (rho > 0.25 ? 5.0 : 2.0), 1e-12);
+                    break;
+                }
+            }
+            lambda *= 10.0;
         }
         (*iters)++;
+        es__info(emb->ctx, "embed: refine %d cost %.6g -> %.6g lambda %.3g rho %.3g pcg %d", it,
+                 c, c_new, lambda, rho, used);
         if (!accepted) break;
         if (c - c_new < rtol * c) {
             c = c_new;

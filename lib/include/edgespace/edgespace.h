@@ -10,5 +10,6 @@
 #include "es_io.h"
 #include "es_plot.h"
 #include "es_render.h"
+#include "es_embed.h"
 
 #endif
