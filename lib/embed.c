@@ -44,7 +44,7 @@ struct es_embedder {
     cholmod_factor *L3, *L1, *LA;
     cholmod_dense *X, *Y, *Ew, *B3, *B1, *BA;
     /* work, sized once */
-    double *ang, *theta, *C, *G, *len, *alpha, *alpha_try, *xyz, *xyz_try, *xyz_best;
+    double *ang, *theta, *C, *G, *len, *alpha, *alpha_try, *alpha_keep, *xyz, *xyz_try, *xyz_best;
     double *ltarget, *lpath, *res, *grad, *diag, *pcg, *jw, *fanwork, *fanr, *fanth, *fanal, *vclos, *verr;
     int have_vertex_results;
     int64_t nfactor;        /* numeric factorizations in the last solve */
@@ -52,6 +52,7 @@ struct es_embedder {
 
 void es_embed_opts_init(es_embed_opts *o)
 {
+    o->dihedral_mode = ES_EMBED_DIHEDRAL_AUTO;
     o->dihedral_max_iter = 30;
     o->dihedral_rtol = 1e-4;
     o->dihedral_tol = 1e-24;
@@ -230,6 +231,7 @@ static es_status alloc_work(es_embedder *emb)
     ALLOC(emb->len, ne);
     ALLOC(emb->alpha, ne);
     ALLOC(emb->alpha_try, ne);
+    ALLOC(emb->alpha_keep, ne);
     ALLOC(emb->xyz, 3 * nv);
     ALLOC(emb->xyz_try, 3 * nv);
     ALLOC(emb->xyz_best, 3 * nv);
@@ -237,8 +239,8 @@ static es_status alloc_work(es_embedder *emb)
     ALLOC(emb->lpath, ne);
     ALLOC(emb->res, 9 * nv + ne);
     ALLOC(emb->grad, 3 * nv + ne);
-    ALLOC(emb->diag, 3 * nv + ne);
-    ALLOC(emb->pcg, 18 * nv);
+    ALLOC(emb->diag, 3 * (3 * nv + ne));
+    ALLOC(emb->pcg, 18 * nv + 4 * ne);
     ALLOC(emb->jw, 9 * ns);
     ALLOC(emb->fanwork, 18 * (2 * emb->maxk + 2));
     ALLOC(emb->fanr, 9);
@@ -417,7 +419,7 @@ void es_embedder_free(es_embedder *emb)
     }
     void *bufs[] = {emb->slot_corner, emb->edge_slot, emb->pinned, emb->vweight, emb->rank,
                     emb->nlow, emb->var, emb->amap_off, emb->amap, emb->adiag, emb->ang,
-                    emb->theta, emb->C, emb->G, emb->len, emb->alpha, emb->alpha_try, emb->xyz,
+                    emb->theta, emb->C, emb->G, emb->len, emb->alpha, emb->alpha_try, emb->alpha_keep, emb->xyz,
                     emb->xyz_try, emb->xyz_best, emb->ltarget, emb->lpath, emb->res, emb->grad, emb->diag, emb->pcg,
                     emb->jw, emb->fanwork, emb->fanr, emb->fanth, emb->fanal, emb->vclos,
                     emb->verr};
@@ -451,6 +453,81 @@ static int factor_solve(es_embedder *emb, cholmod_sparse *A, cholmod_factor *L,
     return 0;
 }
 
+/* y = A x for the symmetric matrix held in its upper triangle (CSC). */
+static void sym_matvec(const cholmod_sparse *A, const double *x, double *y)
+{
+    const int64_t *cp = A->p, *ri = A->i;
+    const double *ax = A->x;
+    int64_t n = (int64_t)A->ncol;
+    for (int64_t i = 0; i < n; i++) y[i] = 0;
+    for (int64_t j = 0; j < n; j++)
+        for (int64_t p = cp[j]; p < cp[j + 1]; p++) {
+            int64_t i = ri[p];
+            y[i] += ax[p] * x[j];
+            if (i != j) y[j] += ax[p] * x[i];
+        }
+}
+
+static double dotn(const double *a, const double *b, int64_t n)
+{
+    double s = 0;
+    for (int64_t i = 0; i < n; i++) s += a[i] * b[i];
+    return s;
+}
+
+/* Solve A d = b (A = emb->H3 with its damped diagonal in place) by
+ * conjugate gradients preconditioned with the factor of an earlier A
+ * (emb->L3): the Gauss-Newton matrix changes little between iterations,
+ * so a lagged factor is a very good preconditioner and one solve costs a
+ * small fraction of a factorization. Returns the iterations used, or -1
+ * if the relative residual did not reach eta within max_it. */
+static int lagged_pcg(es_embedder *emb, const cholmod_sparse *A, cholmod_factor *Lf,
+                      cholmod_dense *B, const double *b, double *d, double eta, int max_it)
+{
+    int64_t n = (int64_t)A->ncol;
+    double *r = emb->pcg, *z = r + n, *p = z + n, *q = p + n, rz = 0, bn;
+    double *bx = B->x;
+    size_t ncol = B->ncol;
+    int ret = -1;
+    bn = sqrt(dotn(b, b, n));
+    for (int64_t i = 0; i < n; i++) {
+        d[i] = 0;
+        r[i] = b[i];
+    }
+    if (!(bn > 0)) return 0;
+    B->ncol = 1;
+    for (int it = 0; it < max_it; it++) {
+        memcpy(bx, r, (size_t)n * sizeof *bx);
+        if (!cholmod_l_solve2(CHOLMOD_A, Lf, B, NULL, &emb->X, NULL, &emb->Y, &emb->Ew, &emb->cm))
+            break;
+        memcpy(z, emb->X->x, (size_t)n * sizeof *z);
+        if (it == 0) {
+            memcpy(p, z, (size_t)n * sizeof *p);
+            rz = dotn(r, z, n);
+        } else {
+            double rz_new = dotn(r, z, n), beta = rz_new / rz;
+            rz = rz_new;
+            for (int64_t i = 0; i < n; i++) p[i] = z[i] + beta * p[i];
+        }
+        sym_matvec(A, p, q);
+        {
+            double pq = dotn(p, q, n), a;
+            if (!(pq > 0)) break;
+            a = rz / pq;
+            for (int64_t i = 0; i < n; i++) {
+                d[i] += a * p[i];
+                r[i] -= a * q[i];
+            }
+        }
+        if (sqrt(dotn(r, r, n)) <= eta * bn) {
+            ret = it + 1;
+            break;
+        }
+    }
+    B->ncol = ncol;
+    return ret;
+}
+
 /* ---- stage 1: dihedrals ---------------------------------------------- */
 
 static double closure_eval(es_embedder *emb, const double *alpha, int with_jac, double *vclos)
@@ -474,6 +551,7 @@ static es_status stage_dihedrals(es_embedder *emb, const es_embed_opts *o, doubl
 {
     int64_t n = emb->nvar, it = 0;
     double *x = emb->HA ? emb->HA->x : NULL, *g = emb->grad, lambda = 1e-3, e;
+    int have_factor = 0;
     e = closure_eval(emb, alpha, 0, NULL);
     *iters = 0;
     if (n == 0 || o->dihedral_max_iter <= 0) {
@@ -515,14 +593,27 @@ static es_status stage_dihedrals(es_embedder *emb, const es_embed_opts *o, doubl
             for (int tries = 0; tries < 12 && !accepted; tries++) {
                 double *bx = emb->BA->x;
                 int st;
+                double *dx = emb->diag + n, *rhs = dx + n;
+                int used = -1;
                 for (int64_t a = 0; a < n; a++) {
                     x[emb->adiag[a]] = dg[a] + lambda * (dg[a] + 1e-9 * mean) + 1e-300;
-                    bx[a] = -g[a];
+                    rhs[a] = -g[a];
                 }
-                st = factor_solve(emb, emb->HA, emb->LA, emb->BA);
-                if (st < 0) return ES_ENUMERIC;
+                if (have_factor)
+                    used = lagged_pcg(emb, emb->HA, emb->LA, emb->BA, rhs, dx,
+                                      fmin(1e-2, fmax(1e-12, sqrt(e))), 12);
+                if (used < 0) {
+                    memcpy(bx, rhs, (size_t)n * sizeof *bx);
+                    st = factor_solve(emb, emb->HA, emb->LA, emb->BA);
+                    if (st < 0) return ES_ENUMERIC;
+                    have_factor = st == 0;
+                    emb->nfactor++;
+                    if (st == 0) memcpy(dx, emb->X->x, (size_t)n * sizeof *dx);
+                } else {
+                    st = 0;
+                }
+                for (int64_t a = 0; a < n; a++) x[emb->adiag[a]] = dg[a];
                 if (st == 0) {
-                    const double *dx = emb->X->x;
                     for (int64_t ed = 0; ed < emb->ne; ed++)
                         emb->alpha_try[ed] =
                             emb->var[ed] >= 0 ? alpha[ed] + dx[emb->var[ed]] : alpha[ed];
@@ -682,81 +773,6 @@ static double length_cost(const es_embedder *emb, const double *xyz, const doubl
     return c;
 }
 
-/* y = A x for the symmetric matrix held in its upper triangle (CSC). */
-static void sym_matvec(const cholmod_sparse *A, const double *x, double *y)
-{
-    const int64_t *cp = A->p, *ri = A->i;
-    const double *ax = A->x;
-    int64_t n = (int64_t)A->ncol;
-    for (int64_t i = 0; i < n; i++) y[i] = 0;
-    for (int64_t j = 0; j < n; j++)
-        for (int64_t p = cp[j]; p < cp[j + 1]; p++) {
-            int64_t i = ri[p];
-            y[i] += ax[p] * x[j];
-            if (i != j) y[j] += ax[p] * x[i];
-        }
-}
-
-static double dotn(const double *a, const double *b, int64_t n)
-{
-    double s = 0;
-    for (int64_t i = 0; i < n; i++) s += a[i] * b[i];
-    return s;
-}
-
-/* Solve A d = b (A = emb->H3 with its damped diagonal in place) by
- * conjugate gradients preconditioned with the factor of an earlier A
- * (emb->L3): the Gauss-Newton matrix changes little between iterations,
- * so a lagged factor is a very good preconditioner and one solve costs a
- * small fraction of a factorization. Returns the iterations used, or -1
- * if the relative residual did not reach eta within max_it. */
-static int lagged_pcg(es_embedder *emb, const double *b, double *d, double eta, int max_it)
-{
-    int64_t n = 3 * emb->nv;
-    double *r = emb->pcg, *z = r + n, *p = z + n, *q = p + n, rz, bn;
-    double *bx = emb->B3->x;
-    bn = sqrt(dotn(b, b, n));
-    for (int64_t i = 0; i < n; i++) {
-        d[i] = 0;
-        r[i] = b[i];
-    }
-    if (!(bn > 0)) return 0;
-    emb->B3->ncol = 1;
-    for (int it = 0; it < max_it; it++) {
-        memcpy(bx, r, (size_t)n * sizeof *bx);
-        if (!cholmod_l_solve2(CHOLMOD_A, emb->L3, emb->B3, NULL, &emb->X, NULL, &emb->Y, &emb->Ew,
-                              &emb->cm)) {
-            emb->B3->ncol = 3;
-            return -1;
-        }
-        memcpy(z, emb->X->x, (size_t)n * sizeof *z);
-        if (it == 0) {
-            memcpy(p, z, (size_t)n * sizeof *p);
-            rz = dotn(r, z, n);
-        } else {
-            double rz_new = dotn(r, z, n), beta = rz_new / rz;
-            rz = rz_new;
-            for (int64_t i = 0; i < n; i++) p[i] = z[i] + beta * p[i];
-        }
-        sym_matvec(emb->H3, p, q);
-        {
-            double pq = dotn(p, q, n), a;
-            if (!(pq > 0)) break;
-            a = rz / pq;
-            for (int64_t i = 0; i < n; i++) {
-                d[i] += a * p[i];
-                r[i] -= a * q[i];
-            }
-        }
-        if (sqrt(dotn(r, r, n)) <= eta * bn) {
-            emb->B3->ncol = 3;
-            return it + 1;
-        }
-    }
-    emb->B3->ncol = 3;
-    return -1;
-}
-
 static es_status stage_refine(es_embedder *emb, const double *L, double *xyz, int max_iter,
                               double rtol, double tol, int64_t *iters)
 {
@@ -806,7 +822,7 @@ static es_status stage_refine(es_embedder *emb, const double *L, double *xyz, in
                     1e-300;
                 hd[i] = -g[i];
             }
-            used = have_factor ? lagged_pcg(emb, hd, step, eta, 12) : -1;
+            used = have_factor ? lagged_pcg(emb, emb->H3, emb->L3, emb->B3, hd, step, eta, 12) : -1;
             if (used < 0) {
                 memcpy(emb->B3->x, hd, (size_t)n3 * sizeof(double));
                 emb->B3->ncol = 1;
@@ -955,6 +971,24 @@ static es_status run_continuation(es_embedder *emb, const es_embed_opts *o, cons
     return ES_OK;
 }
 
+/* Stages 2-3 from dihedrals alpha; falls back to the initial mesh (or the
+ * origin) if the result is not finite. Adds to the report's stage times. */
+static es_status linear_stages(es_embedder *emb, const double *alpha, const double *L,
+                               double *xyz, es_embed_report *rep)
+{
+    es_status rc;
+    double t1 = now_s();
+    compute_fan_frames(emb, alpha);
+    if ((rc = stage_frames(emb)) != ES_OK) return rc;
+    rep->t_frames += now_s() - t1;
+    t1 = now_s();
+    if ((rc = stage_positions(emb, L, xyz)) != ES_OK) return rc;
+    rep->t_positions += now_s() - t1;
+    if (!all_finite(xyz, 3 * emb->nv))
+        for (int64_t i = 0; i < 3 * emb->nv; i++) xyz[i] = 0;
+    return ES_OK;
+}
+
 es_status es_embed_solve(es_embedder *emb, const double *target, double scale,
                          const double *init_alpha, const double *init_xyz,
                          const es_embed_opts *opts, double *xyz, es_embed_report *report)
@@ -1019,30 +1053,42 @@ es_status es_embed_solve(es_embedder *emb, const double *target, double scale,
     rep.closure_before = closure_eval(emb, alpha, 0, NULL);
     emb->have_vertex_results = 0;
 
-    /* dihedral path: stages 1-4 */
+    /* dihedral path: stages 1-4. In auto mode the linear stages run from
+     * both the initial and the stage-1 dihedrals and the reconstruction with
+     * the smaller edge-length error goes on to the refinement: stage 1 repairs
+     * incoherent (noisy) dihedrals but can pull interpolated ones into a wrong
+     * closure minimum (oracle README, failure E). */
     if (!(o->continuation_steps > 0 && init_xyz) || o->try_both) {
-        t1 = now_s();
-        if ((rc = stage_dihedrals(emb, o, alpha, &rep.closure_stage1, &rep.dihedral_iters)) != ES_OK)
-            return rc;
-        rep.t_dihedral = now_s() - t1;
-        t1 = now_s();
-        compute_fan_frames(emb, alpha);
-        if ((rc = stage_frames(emb)) != ES_OK) return rc;
-        rep.t_frames = now_s() - t1;
-        t1 = now_s();
-        if ((rc = stage_positions(emb, L, xyz)) != ES_OK) return rc;
-        rep.t_positions = now_s() - t1;
-        if (!all_finite(xyz, n3)) {
-            /* inconsistent beyond repair: restart from the initial mesh if any */
-            if (init_xyz) {
-                for (int64_t i = 0; i < n3; i++) xyz[i] = init_xyz[i] * f;
-            } else {
-                for (int64_t i = 0; i < n3; i++) xyz[i] = 0;
-            }
+        double rms0 = INFINITY, mx;
+        int mode = o->dihedral_mode;
+        if (emb->nvar == 0 || o->dihedral_max_iter <= 0) mode = ES_EMBED_DIHEDRAL_OFF;
+        if (mode != ES_EMBED_DIHEDRAL_ON) {
+            t1 = now_s();
+            if ((rc = linear_stages(emb, alpha, L, xyz, &rep)) != ES_OK) return rc;
+            quick_metrics(emb, xyz, L, &rms0, &mx);
+            rep.rms_ratio_linear = rms0;
+            rep.closure_stage1 = rep.closure_before;
         }
-        {
-            double mx;
-            quick_metrics(emb, xyz, L, &rep.rms_ratio_linear, &mx);
+        if (mode != ES_EMBED_DIHEDRAL_OFF) {
+            double rms1;
+            double *keep = emb->xyz_best;
+            if (mode == ES_EMBED_DIHEDRAL_AUTO) memcpy(keep, xyz, (size_t)n3 * sizeof *xyz);
+            memcpy(emb->alpha_keep, alpha, (size_t)ne * sizeof *alpha);
+            t1 = now_s();
+            if ((rc = stage_dihedrals(emb, o, alpha, &rep.closure_stage1, &rep.dihedral_iters)) !=
+                ES_OK)
+                return rc;
+            rep.t_dihedral = now_s() - t1;
+            if ((rc = linear_stages(emb, alpha, L, xyz, &rep)) != ES_OK) return rc;
+            quick_metrics(emb, xyz, L, &rms1, &mx);
+            if (mode == ES_EMBED_DIHEDRAL_AUTO && !(rms1 < rms0)) {
+                memcpy(xyz, keep, (size_t)n3 * sizeof *xyz);
+                memcpy(alpha, emb->alpha_keep, (size_t)ne * sizeof *alpha);
+                rep.rms_ratio_linear = rms0;
+            } else {
+                rep.rms_ratio_linear = rms1;
+                rep.used_stage1 = 1;
+            }
         }
         t1 = now_s();
         if (o->refine_max_iter > 0 &&

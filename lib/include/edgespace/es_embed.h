@@ -42,7 +42,15 @@ extern "C" {
 
 typedef struct es_embedder es_embedder;
 
+typedef enum es_embed_dihedral_mode {
+    ES_EMBED_DIHEDRAL_AUTO = 0, /* stages 2-3 from the initial and from the stage-1
+                                   dihedrals; refine the one with smaller edge error */
+    ES_EMBED_DIHEDRAL_ON,       /* always stage 1 (the paper) */
+    ES_EMBED_DIHEDRAL_OFF       /* skip stage 1: stages 2-3 from the initial dihedrals */
+} es_embed_dihedral_mode;
+
 typedef struct es_embed_opts {
+    es_embed_dihedral_mode dihedral_mode;   /* default AUTO */
     int dihedral_max_iter;    /* stage 1 LM iterations; 0 skips stage 1 (default 30) */
     double dihedral_rtol;     /* stage 1 stops when E drops by less than this fraction
                                  per iteration, or E <= dihedral_tol * #interior verts
@@ -76,6 +84,7 @@ typedef struct es_embed_report {
     int64_t refine_iters;     /* stage 4 LM iterations (all continuation steps) */
     int64_t continuation_steps; /* steps used (0: dihedral path) */
     int used_continuation;    /* 1 if the returned result came from continuation */
+    int used_stage1;          /* 1 if stage 1's dihedrals were kept (AUTO may drop them) */
     double t_dihedral, t_frames, t_positions, t_refine, t_total;   /* seconds */
     double rms_ratio_linear;  /* RMS ratio after stage 3, before refinement */
     double rms_ratio;         /* RMS(l_out - l_target) / mean(l_target) */
