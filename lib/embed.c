@@ -429,6 +429,8 @@ void es_embedder_free(es_embedder *emb)
 
 const es_mesh *es_embedder_mesh(const es_embedder *emb) { return emb ? emb->mesh : NULL; }
 
+es_ctx *es__embedder_ctx(const es_embedder *emb) { return emb->ctx; }
+
 const double *es_embedder_vertex_closure(const es_embedder *emb)
 {
     return emb && emb->have_vertex_results ? emb->vclos : NULL;

@@ -47,4 +47,8 @@ void es__mat3_right_z(double *m, double t);
  * degenerate (then m is set to I). */
 int es__mat3_nearest_rotation(double *m);
 
+/* The context an embedder was made with (interp.c). */
+struct es_embedder;
+es_ctx *es__embedder_ctx(const struct es_embedder *emb);
+
 #endif

@@ -11,5 +11,6 @@
 #include "es_plot.h"
 #include "es_render.h"
 #include "es_embed.h"
+#include "es_interp.h"
 
 #endif
