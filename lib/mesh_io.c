@@ -24,8 +24,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <strings.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
-#define INITIAL_CAP 1024
+#define INITIAL_CAP 64
 
 void es__mdbuild_init(es__mdbuild *b, es_ctx *ctx, es_meshdata *md)
 {
@@ -38,14 +41,10 @@ void es__mdbuild_init(es__mdbuild *b, es_ctx *ctx, es_meshdata *md)
 
 static es_status grow(es_ctx *ctx, void **arr, int64_t *cap, int64_t need, size_t elem)
 {
-    int64_t ncap = *cap ? *cap : INITIAL_CAP;
+    int64_t ncap = *cap == 0 ? INITIAL_CAP : *cap > INT64_MAX / 2 ? INT64_MAX : 2 * *cap;
     size_t bytes;
     void *p;
-    while (ncap < need) {
-        if (ncap > INT64_MAX / 2) ES_FAIL(ctx, ES_ERANGE, "mesh too large (%lld elements)",
-                                          (long long)need);
-        ncap *= 2;
-    }
+    if (ncap < need) ncap = need;   /* an exact reservation is not rounded up */
     if (!es__mul_size((size_t)ncap, elem, &bytes))
         ES_FAIL(ctx, ES_ERANGE, "mesh too large (%lld elements)", (long long)need);
     p = es__realloc(ctx, *arr, bytes);
@@ -200,52 +199,67 @@ const char *es__parse_int64(const char *p, const char *end, int64_t *out)
 
 es_status es__read_file(es_ctx *ctx, const char *path, char **buf, size_t *len)
 {
-    FILE *f = fopen(path, "rb");
+    struct stat st;
     char *b = NULL;
-    size_t cap = 0, n = 0;
+    size_t cap, n = 0;
+    int fd;
     *buf = NULL;
     *len = 0;
-    if (!f) ES_FAIL(ctx, ES_EIO, "cannot open '%s': %s", path, strerror(errno));
-    if (fseek(f, 0, SEEK_END) == 0) {
-        long sz = ftell(f);
-        if (sz > 0) cap = (size_t)sz + 1;
-        rewind(f);
+    if ((fd = open(path, O_RDONLY)) < 0)
+        ES_FAIL(ctx, ES_EIO, "cannot open '%s': %s", path, strerror(errno));
+    if (fstat(fd, &st) != 0 || S_ISDIR(st.st_mode)) {
+        int e = S_ISDIR(st.st_mode) ? EISDIR : errno;
+        close(fd);
+        ES_FAIL(ctx, ES_EIO, "cannot read '%s': %s", path, strerror(e));
     }
-    if (cap == 0) cap = 65536;
+    /* regular files: one buffer of the right size; pipes and the like grow */
+    cap = S_ISREG(st.st_mode) && st.st_size > 0 && (uintmax_t)st.st_size < SIZE_MAX
+              ? (size_t)st.st_size + 1 : 65536;
     for (;;) {
-        if (!b || n + 1 >= cap) {
+        if (!b || n + 1 == cap) {
             char *nb;
             if (b) {
+                /* a full buffer of the stat'ed size grows only if more follows */
+                char c;
+                ssize_t got = read(fd, &c, 1);
+                if (got == 0) break;
+                if (got < 0 && errno == EINTR) continue;
+                if (got < 0) goto read_error;
                 if (cap > SIZE_MAX / 2) {
                     es__free(ctx, b);
-                    fclose(f);
+                    close(fd);
                     ES_FAIL(ctx, ES_ERANGE, "'%s' is too large", path);
                 }
                 cap *= 2;
+                nb = es__realloc(ctx, b, cap);
+                if (nb) nb[n++] = c;
+            } else {
+                nb = es__malloc(ctx, cap);
             }
-            nb = es__realloc(ctx, b, cap);
             if (!nb) {
                 es__free(ctx, b);
-                fclose(f);
+                close(fd);
                 return ES_ENOMEM;
             }
             b = nb;
         }
-        size_t got = fread(b + n, 1, cap - 1 - n, f);
-        n += got;
+        ssize_t got = read(fd, b + n, cap - 1 - n);
         if (got == 0) break;
+        if (got < 0 && errno == EINTR) continue;
+        if (got < 0) goto read_error;
+        n += (size_t)got;
     }
-    if (ferror(f)) {
-        int e = errno;
-        es__free(ctx, b);
-        fclose(f);
-        ES_FAIL(ctx, ES_EIO, "cannot read '%s': %s", path, strerror(e));
-    }
-    fclose(f);
+    close(fd);
     b[n] = '\0';
     *buf = b;
     *len = n;
     return ES_OK;
+read_error: {
+        int e = errno;
+        es__free(ctx, b);
+        close(fd);
+        ES_FAIL(ctx, ES_EIO, "cannot read '%s': %s", path, strerror(e));
+    }
 }
 
 /* ---------------------------------------------------------------- dispatch */
@@ -374,4 +388,34 @@ es_status es__meshdata_write(es_ctx *ctx, const char *path, es_mesh_format forma
         rc = es__fail(ctx, ES_EIO, "cannot write '%s': %s", path, strerror(errno));
     if (rc != ES_OK) remove(path);
     return rc;
+}
+
+/* ---------------------------------------------------------------- meshes */
+
+es_status es_mesh_read(es_ctx *ctx, const char *path, es_mesh **out)
+{
+    es_meshdata md;
+    es_status rc;
+    if (!out) ES_FAIL(ctx, ES_EINVAL, "es_mesh_read: out is NULL");
+    *out = NULL;
+    if ((rc = es_meshdata_read(ctx, path, ES_FORMAT_AUTO, &md)) != ES_OK) return rc;
+    rc = es_mesh_new(ctx, md.nverts, md.nfaces, md.faces, md.xyz, out);
+    if (rc != ES_OK) {
+        /* name the file: topology messages only know faces and vertices */
+        char msg[1024];
+        snprintf(msg, sizeof msg, "%s", es_ctx_errmsg(ctx));
+        es__fail(ctx, rc, "%s: %s", path, msg);
+    }
+    es_meshdata_clear(ctx, &md);
+    return rc;
+}
+
+es_status es_mesh_write(es_ctx *ctx, const char *path, es_mesh_format format,
+                        const es_mesh *mesh, const double *xyz, const uint8_t *vertex_rgb)
+{
+    if (!mesh) ES_FAIL(ctx, ES_EINVAL, "es_mesh_write: mesh is NULL");
+    if (!xyz) xyz = es_mesh_xyz(mesh);
+    if (!xyz) ES_FAIL(ctx, ES_EINVAL, "'%s': no positions given and the mesh has none", path);
+    return es__meshdata_write(ctx, path, format, es_mesh_nverts(mesh), es_mesh_nfaces(mesh),
+                              es_mesh_faces(mesh), xyz, vertex_rgb);
 }

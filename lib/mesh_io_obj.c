@@ -208,10 +208,26 @@ es_status es__obj_parse(es_ctx *ctx, const char *name, const char *buf, size_t l
     P.end = buf + len;
     P.line = 1;
     es__mdbuild_init(&P.b, ctx, md);
-    /* ~30 bytes per vertex line, twice as many faces as vertices */
-    if ((rc = es__mdbuild_reserve_verts(&P.b, (int64_t)(len / 96) + 16)) != ES_OK ||
-        (rc = es__mdbuild_reserve_faces(&P.b, (int64_t)(len / 48) + 16)) != ES_OK)
-        return rc;
+    /* Size the arrays from a count of the lines that start with "v " and
+     * "f " (a memchr pass costs a few percent of the parse): no growth and
+     * no shrink copies, and each page of the result is touched once, which
+     * matters where fresh pages are expensive (virtual machines). */
+    {
+        int64_t nv = 0, nf = 0;
+        const char *p = buf, *end = buf + len;
+        while (p < end) {
+            const char *nl;
+            if (end - p > 1 && (p[1] == ' ' || p[1] == '\t')) {
+                nv += p[0] == 'v';
+                nf += p[0] == 'f';
+            }
+            nl = memchr(p, '\n', (size_t)(end - p));
+            p = nl ? nl + 1 : end;
+        }
+        if ((rc = es__mdbuild_reserve_verts(&P.b, nv + 1)) != ES_OK ||
+            (rc = es__mdbuild_reserve_faces(&P.b, nf + 1)) != ES_OK)
+            return rc;
+    }
 
     while (P.p < P.end) {
         skip_ws(&P);

@@ -131,6 +131,11 @@ static es_status header(plyp *P)
             size_t nn;
             int64_t count;
             if (P->nelems == MAX_ELEMS) HFAIL("more than %d elements", MAX_ELEMS);
+            {
+                elem *ne = es__realloc(P->ctx, P->elems, (size_t)(P->nelems + 1) * sizeof *ne);
+                if (!ne) return ES_ENOMEM;
+                P->elems = ne;
+            }
             if (!word(&q, eol, &nm, &nn)) HFAIL("element without a name");
             if (!word(&q, eol, &w, &n) || es__parse_int64(w, w + n, &count) != w + n ||
                 count < 0)
@@ -287,6 +292,7 @@ static es_status body_binary(plyp *P)
     for (int ei = 0; ei < P->nelems; ei++) {
         const elem *e = &P->elems[ei];
         int64_t minsize = 0;
+        if (e->nprops == 0) continue;   /* nothing to read, however many */
         for (int k = 0; k < e->nprops; k++)
             minsize += e->props[k].is_list ? type_size[e->props[k].count_type]
                                            : type_size[e->props[k].type];
@@ -395,6 +401,7 @@ static es_status body_ascii(plyp *P)
     es_status rc;
     for (int ei = 0; ei < P->nelems; ei++) {
         const elem *e = &P->elems[ei];
+        if (e->nprops == 0) continue;
         /* every value takes at least two bytes (digit and separator) */
         if (e->nprops > 0 && e->count > (P->end - P->p) / (2 * e->nprops))
             ES_FAIL(P->ctx, ES_EFORMAT, "%s:%" PRId64 ": file truncated: element '%s' "
@@ -465,8 +472,6 @@ es_status es__ply_parse(es_ctx *ctx, const char *name, const char *buf, size_t l
     P.buf = P.p = buf;
     P.end = buf + len;
     es__mdbuild_init(&P.b, ctx, md);
-    P.elems = es__alloc_array(ctx, MAX_ELEMS, sizeof *P.elems);
-    if (!P.elems) return ES_ENOMEM;
     if ((rc = header(&P)) == ES_OK)
         rc = P.fmt == F_ASCII ? body_ascii(&P) : body_binary(&P);
     es__free(ctx, P.elems);

@@ -128,12 +128,26 @@ es_status es_render_auto_view(es_ctx *ctx, int64_t nverts, const double *xyz,
     else sgn = e0[argmax_abs3(e0)] > 0 ? -1 : 1; /* camera on the positive side */
     for (int k = 0; k < 3; k++) view[k] = sgn * e0[k];
 
+    /* up: the data's own +y when it is close to the picture plane (stored
+     * y-up), else the longest axis with its longer tail pointing down */
     const double *pick;
-    double c1 = fabs(e1[1]), c2 = fabs(e2[1]);
-    if (c1 < 0.3 && c2 < 0.3) pick = e2;
-    else pick = c2 >= c1 ? e2 : e1;
-    double s2 = fabs(pick[1]) >= 0.3 ? (pick[1] > 0 ? 1 : -1)
-                                     : (pick[argmax_abs3(pick)] > 0 ? 1 : -1);
+    double s2, c1 = fabs(e1[1]), c2 = fabs(e2[1]);
+    if (fmax(c1, c2) > 0.98) {
+        pick = c2 >= c1 ? e2 : e1;
+        s2 = pick[1] > 0 ? 1 : -1;
+    } else {
+        double m2 = 0, m3 = 0;
+        pick = e2;
+        for (int64_t v = 0; v < nverts; v++) {
+            double t = (xyz[3 * v] - c[0]) * pick[0] + (xyz[3 * v + 1] - c[1]) * pick[1] +
+                       (xyz[3 * v + 2] - c[2]) * pick[2];
+            m2 += t * t;
+            m3 += t * t * t;
+        }
+        double skew = m2 > 0 ? (m3 / (double)nverts) / pow(m2 / (double)nverts, 1.5) : 0;
+        if (fabs(skew) > 0.05) s2 = skew < 0 ? 1 : -1;
+        else s2 = pick[argmax_abs3(pick)] > 0 ? 1 : -1;
+    }
     for (int k = 0; k < 3; k++) up[k] = s2 * pick[k];
     return ES_OK;
 }
@@ -534,7 +548,8 @@ es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
     if (!cams) return ES_ENOMEM;
     double upp = 0;
     for (int64_t i = 0; i < n; i++) {
-        if ((rc = make_basis(ctx, spec, &spec->meshes[i], &cams[i])) != ES_OK) goto done;
+        const es_render_mesh *vm = spec->same_view ? &spec->meshes[0] : &spec->meshes[i];
+        if ((rc = make_basis(ctx, spec, vm, &cams[i])) != ES_OK) goto done;
         double s = frame_mesh(spec, &spec->meshes[i], &cams[i], (double)W * ss, (double)H * ss);
         double u = cams[i].persp ? cams[i].dist / s : 1 / s;
         upp = fmax(upp, u);

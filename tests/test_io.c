@@ -265,6 +265,15 @@ static void test_syntax(es_ctx *ctx)
     }
     es_meshdata_clear(ctx, &md);
 
+    /* an element without properties costs nothing, whatever its count */
+    ES_CHECK_OK(ctx, parse_str(ctx, "empty-elem.ply", "ply\nformat ascii 1.0\n"
+                               "element nothing 1000000000000000\nelement vertex 3\n"
+                               "property double x\nproperty double y\nproperty double z\n"
+                               "element face 1\nproperty list uchar int vertex_indices\n"
+                               "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 2 1\n", &md));
+    ES_CHECK(md.nverts == 3 && md.nfaces == 1);
+    es_meshdata_clear(ctx, &md);
+
     /* format from the name, from the contents, or forced */
     ES_CHECK(es_mesh_format_from_path("a/b.OBJ") == ES_FORMAT_OBJ);
     ES_CHECK(es_mesh_format_from_path("x.ply") == ES_FORMAT_PLY);
@@ -285,6 +294,8 @@ static void test_syntax(es_ctx *ctx)
     ES_CHECK_FAILS(ctx, es_meshdata_read(ctx, SRC "/no/such/file.obj", ES_FORMAT_AUTO, &md),
                    ES_EIO, "no/such/file.obj");
     ES_CHECK(md.xyz == NULL && md.nverts == 0);
+    ES_CHECK_FAILS(ctx, es_meshdata_read(ctx, SRC "/valid", ES_FORMAT_OBJ, &md), ES_EIO,
+                   "tests/data/valid");
 }
 
 /* ---------------------------------------------------------------- round trips */
@@ -519,6 +530,59 @@ static void test_alloc_failures(es_ctx *ctx)
     }
 }
 
+/* ---------------------------------------------------------------- meshes */
+
+static void test_mesh(es_ctx *ctx)
+{
+    es_mesh *mesh = NULL, *m2 = NULL;
+    es_meshdata md;
+    const char *tmp = ES_BUILD_ROOT "/test_io_mesh.ply";
+
+    ES_CHECK_OK(ctx, es_mesh_read(ctx, SRC "/valid/cube.obj", &mesh));
+    if (!mesh) return;
+    ES_CHECK(es_mesh_nverts(mesh) == 8 && es_mesh_nfaces(mesh) == 12 &&
+             es_mesh_nedges(mesh) == 18);
+    ES_CHECK(!memcmp(es_mesh_faces(mesh), cube_faces, sizeof cube_faces));
+    ES_CHECK(es_mesh_xyz(mesh) && !memcmp(es_mesh_xyz(mesh), cube_xyz, sizeof cube_xyz));
+
+    /* the mesh's own positions, then given ones with colours */
+    ES_CHECK_OK(ctx, es_mesh_write(ctx, tmp, ES_FORMAT_AUTO, mesh, NULL, NULL));
+    ES_CHECK_OK(ctx, es_meshdata_read(ctx, tmp, ES_FORMAT_AUTO, &md));
+    check_arrays(&md, 8, cube_xyz, 12, cube_faces, "es_mesh_write");
+    es_meshdata_clear(ctx, &md);
+    double moved[24];
+    uint8_t rgb[24];
+    for (int i = 0; i < 24; i++) {
+        moved[i] = cube_xyz[i] * 0.1 + 1.0 / 3.0;
+        rgb[i] = (uint8_t)(i * 10);
+    }
+    ES_CHECK_OK(ctx, es_mesh_write(ctx, tmp, ES_FORMAT_PLY_ASCII, mesh, moved, rgb));
+    ES_CHECK_OK(ctx, es_mesh_read(ctx, tmp, &m2));
+    if (m2) {
+        ES_CHECK(!memcmp(es_mesh_xyz(m2), moved, sizeof moved));
+        ES_CHECK(!memcmp(es_mesh_faces(m2), cube_faces, sizeof cube_faces));
+    }
+    es_mesh_free(m2);
+    m2 = NULL;
+
+    /* a parse error and a topology error both name the file */
+    ES_CHECK_FAILS(ctx, es_mesh_read(ctx, SRC "/malformed/obj_face_2.obj", &m2), ES_EFORMAT,
+                   "obj_face_2.obj:5:");
+    ES_CHECK(m2 == NULL);
+    FILE *f = fopen(ES_BUILD_ROOT "/test_io_nonmanifold.obj", "w");
+    if (f) {
+        fputs("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 1\n"
+              "f 1 2 3\nf 1 2 4\nf 2 1 5\n", f);   /* edge 1-2 in three faces */
+        fclose(f);
+        ES_CHECK_FAILS(ctx, es_mesh_read(ctx, ES_BUILD_ROOT "/test_io_nonmanifold.obj", &m2),
+                       ES_ETOPOLOGY, "test_io_nonmanifold.obj: ");
+        ES_CHECK(m2 == NULL);
+        remove(ES_BUILD_ROOT "/test_io_nonmanifold.obj");
+    }
+    remove(tmp);
+    es_mesh_free(mesh);
+}
+
 /* ---------------------------------------------------------------- real data */
 
 /* A plain reference reader: fgets and strtod, triangles only. */
@@ -577,6 +641,11 @@ static void test_shared(es_ctx *ctx)
                      "%s: %" PRId64 " verts %" PRId64 " faces", sets[i].file, md.nverts,
                      md.nfaces);
         es_meshdata_clear(ctx, &md);
+        /* and they are oriented manifolds */
+        es_mesh *mesh = NULL;
+        ES_CHECK_OK(ctx, es_mesh_read(ctx, path, &mesh));
+        ES_CHECK(mesh && es_mesh_nfaces(mesh) == sets[i].nf);
+        es_mesh_free(mesh);
     }
     /* face-study: the first three files (sorted), same face list, and the
      * same arrays as a plain strtod reader */
@@ -624,6 +693,7 @@ int main(void)
     test_malformed(ctx);
     test_prefixes(ctx);
     test_alloc_failures(ctx);
+    test_mesh(ctx);
     test_shared(ctx);
     es_ctx_free(ctx);
     ES_TEST_END();

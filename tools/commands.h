@@ -3,11 +3,17 @@
 #define EDGESPACE_TOOLS_COMMANDS_H
 
 /* -- topology, geometry, synthetic data */
+int cmd_synth(int argc, char **argv);
 /* -- mesh I/O */
 /* -- store, manifest, ingest */
+int cmd_ingest(int argc, char **argv);
+int cmd_info(int argc, char **argv);
+int cmd_export(int argc, char **argv);
 /* -- statistics, point syntax */
 /* -- procrustes, landmarks, comparison */
 /* -- embedding, interpolation */
 /* -- plotting, rendering */
+int cmd_render(int argc, char **argv);
+int cmd_plot(int argc, char **argv);
 
 #endif

@@ -15,12 +15,18 @@ typedef struct command {
 
 static const command commands[] = {
     /* -- topology, geometry, synthetic data */
+    {"synth", cmd_synth, "write a synthetic family of meshes in correspondence"},
     /* -- mesh I/O */
     /* -- store, manifest, ingest */
+    {"ingest", cmd_ingest, "read meshes (manifest or files) into an HDF5 store"},
+    {"info", cmd_info, "describe a store: topology, rows, labels, results"},
+    {"export", cmd_export, "write a store's lengths as CSV or its meshes as files"},
     /* -- statistics, point syntax */
     /* -- procrustes, landmarks, comparison */
     /* -- embedding, interpolation */
     /* -- plotting, rendering */
+    {"render", cmd_render, "draw meshes side by side to PNG/SVG/PDF"},
+    {"plot", cmd_plot, "scatter, lines, scree, histogram or heat map of a CSV table"},
     {NULL, NULL, NULL}
 };
 

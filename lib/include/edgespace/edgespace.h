@@ -10,6 +10,9 @@
 #include "es_io.h"
 #include "es_plot.h"
 #include "es_render.h"
+#include "es_synth.h"
+#include "es_store.h"
+#include "es_ingest.h"
 #include "es_embed.h"
 #include "es_interp.h"
 

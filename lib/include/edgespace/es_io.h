@@ -46,12 +46,18 @@ ES_API es_status es_meshdata_parse(es_ctx *ctx, const char *name, const char *bu
                                    size_t len, es_mesh_format format, es_meshdata *out);
 ES_API void es_meshdata_clear(es_ctx *ctx, es_meshdata *md);
 
-/* Read a file and build its topology (positions kept as reference xyz). */
+/* Read a file and build its topology (positions kept as reference xyz).
+ * Errors: those of es_meshdata_read, then those of es_mesh_new (e.g.
+ * ES_ETOPOLOGY) with the file name put in front of the message. */
 ES_API es_status es_mesh_read(es_ctx *ctx, const char *path, es_mesh **out);
 
 /* Write positions xyz (3 x V) with mesh's faces. Format from the extension
  * when ES_FORMAT_AUTO (.obj, .ply = binary little endian, .off).
- * vertex_rgb: NULL or 3 x V bytes of per-vertex colour (PLY only). */
+ * xyz: NULL writes the mesh's reference positions (ES_EINVAL if it has none).
+ * vertex_rgb: NULL or 3 x V bytes of per-vertex colour (PLY only).
+ * Coordinates are written exactly (%.17g, or binary doubles); reading the
+ * file back gives the same arrays. ES_EIO names the path and the reason;
+ * a partly written file is removed. */
 ES_API es_status es_mesh_write(es_ctx *ctx, const char *path, es_mesh_format format,
                                const es_mesh *mesh, const double *xyz,
                                const uint8_t *vertex_rgb);
