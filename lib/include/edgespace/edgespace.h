@@ -19,5 +19,7 @@
 #include "es_procrustes.h"
 #include "es_landmarks.h"
 #include "es_compare.h"
+#include "es_embed.h"
+#include "es_interp.h"
 
 #endif
