@@ -459,6 +459,14 @@ es_status es_plot_heatmap(es_ctx *ctx, const es_heatmap_spec *spec, const char *
     info.ymin = 0;
     info.ymax = rows;
     double w = info.right - info.left, h = info.bottom - info.top;
+    /* square cells unless the matrix is very elongated */
+    if ((double)rows / cols >= 0.25 && (double)rows / cols <= 4) {
+        double cell = fmin(w / cols, h / rows);
+        w = cell * cols;
+        h = cell * rows;
+        info.right = info.left + w;
+        info.bottom = info.top + h;
+    }
 
     cairo_save(cr);
     cairo_translate(cr, info.left, info.top);

@@ -277,32 +277,6 @@ static void test_needles(es_ctx *ctx)
 
 /* ---- oracle ---- */
 
-static int read_obj_faces(const char *path, int64_t *nv, int64_t *nf, int64_t **faces)
-{
-    FILE *fp = fopen(path, "r");
-    char line[512];
-    int64_t cap = 0;
-    *nv = *nf = 0;
-    *faces = NULL;
-    if (!fp) return -1;
-    while (fgets(line, sizeof line, fp)) {
-        if (line[0] == 'v' && line[1] == ' ') (*nv)++;
-        if (line[0] != 'f' || line[1] != ' ') continue;
-        long long a, b, c;
-        if (sscanf(line + 2, "%lld %lld %lld", &a, &b, &c) != 3) break;
-        if (*nf == cap) {
-            cap = cap ? 2 * cap : 1024;
-            *faces = realloc(*faces, (size_t)cap * 3 * sizeof **faces);
-        }
-        (*faces)[3 * *nf] = a - 1;
-        (*faces)[3 * *nf + 1] = b - 1;
-        (*faces)[3 * *nf + 2] = c - 1;
-        (*nf)++;
-    }
-    fclose(fp);
-    return 0;
-}
-
 static void test_oracle(es_ctx *ctx)
 {
     char buf[8192];
@@ -314,12 +288,11 @@ static void test_oracle(es_ctx *ctx)
     }
     for (int i = 0; i < 3; i++) {
         char path[8400], line[1024];
-        int64_t nv, nf, *faces;
+        es_meshdata md;
         snprintf(path, sizeof path, "%s/%s/mesh.obj", dir, names[i]);
-        if (read_obj_faces(path, &nv, &nf, &faces) != 0) {
-            ES_CHECK_MSG(0, "cannot read %s", path);
-            continue;
-        }
+        ES_CHECK_OK(ctx, es_meshdata_read(ctx, path, ES_FORMAT_OBJ, &md));
+        if (!md.faces) continue;
+        int64_t nv = md.nverts, nf = md.nfaces, *faces = md.faces;
         double *xyz = calloc((size_t)nv * 3, sizeof *xyz);
         snprintf(path, sizeof path, "%s/%s/vertices.csv", dir, names[i]);
         FILE *fp = fopen(path, "r");
@@ -384,8 +357,26 @@ static void test_oracle(es_ctx *ctx)
         }
         es_mesh_free(m);
         free(xyz);
-        free(faces);
+        es_meshdata_clear(ctx, &md);
     }
+}
+
+static void *null_malloc(void *ud, size_t n) { (void)ud; (void)n; return NULL; }
+static void *null_realloc(void *ud, void *p, size_t n) { (void)ud; (void)p; (void)n; return NULL; }
+static void plain_free(void *ud, void *p) { (void)ud; free(p); }
+
+/* The only allocation of the module (face normals) fails cleanly. */
+static void test_alloc_failure(es_ctx *ctx)
+{
+    es_mesh *m = NULL;
+    double al[12];
+    ES_CHECK_OK(ctx, es_mesh_new(ctx, 6, 8, oct_faces, oct_xyz, &m));
+    if (!m) return;
+    es_allocator a = {null_malloc, null_realloc, plain_free, NULL};
+    es_ctx_set_allocator(ctx, &a);
+    ES_CHECK_FAILS(ctx, es_dihedral_angles(ctx, m, oct_xyz, al), ES_ENOMEM, "out of memory");
+    es_ctx_set_allocator(ctx, NULL);
+    es_mesh_free(m);
 }
 
 int main(void)
@@ -398,6 +389,7 @@ int main(void)
     test_cube(ctx);
     test_needles(ctx);
     test_oracle(ctx);
+    test_alloc_failure(ctx);
     es_ctx_free(ctx);
     ES_TEST_END();
 }

@@ -3,7 +3,6 @@
  * rejection with its message; with ../shared present, fans against the
  * embedding oracle and every real mesh of ../shared/data.
  *
- * A minimal OBJ reader lives here until the io module's reader lands.
  */
 #include "edgespace/edgespace.h"
 #include "es_internal.h"
@@ -11,50 +10,29 @@
 
 #include <dirent.h>
 
-/* ---- tiny OBJ reader (v and triangular f lines only) ---- */
+/* ---- meshes from files, through the io module's reader ---- */
 
-typedef struct obj { int64_t nv, nf; double *xyz; int64_t *faces; } obj;
+typedef struct obj { int64_t nv, nf; double *xyz; int64_t *faces; es_meshdata md; } obj;
+
+static es_ctx *io_ctx;
 
 static void obj_free(obj *o)
 {
-    free(o->xyz);
-    free(o->faces);
+    es_meshdata_clear(io_ctx, &o->md);
     memset(o, 0, sizeof *o);
 }
 
 static int obj_read(const char *path, obj *o)
 {
-    FILE *fp = fopen(path, "r");
-    char line[1024];
-    int64_t cv = 0, cf = 0;
     memset(o, 0, sizeof *o);
-    if (!fp) return -1;
-    while (fgets(line, sizeof line, fp)) {
-        if (line[0] == 'v' && line[1] == ' ') {
-            if (o->nv == cv) {
-                cv = cv ? 2 * cv : 1024;
-                o->xyz = realloc(o->xyz, (size_t)cv * 3 * sizeof *o->xyz);
-            }
-            if (sscanf(line + 2, "%lf %lf %lf", &o->xyz[3 * o->nv], &o->xyz[3 * o->nv + 1],
-                       &o->xyz[3 * o->nv + 2]) != 3) break;
-            o->nv++;
-        } else if (line[0] == 'f' && line[1] == ' ') {
-            char *p = line + 2, *end;
-            if (o->nf == cf) {
-                cf = cf ? 2 * cf : 1024;
-                o->faces = realloc(o->faces, (size_t)cf * 3 * sizeof *o->faces);
-            }
-            for (int k = 0; k < 3; k++) {
-                long long x = strtoll(p, &end, 10);
-                if (end == p) { fclose(fp); return -1; }
-                o->faces[3 * o->nf + k] = x - 1;
-                p = end;
-                while (*p && *p != ' ' && *p != '\t') p++;
-            }
-            o->nf++;
-        }
+    if (es_meshdata_read(io_ctx, path, ES_FORMAT_OBJ, &o->md) != ES_OK) {
+        fprintf(stderr, "%s\n", es_ctx_errmsg(io_ctx));
+        return -1;
     }
-    fclose(fp);
+    o->nv = o->md.nverts;
+    o->nf = o->md.nfaces;
+    o->xyz = o->md.xyz;
+    o->faces = o->md.faces;
     return 0;
 }
 
@@ -681,7 +659,7 @@ int main(void)
 {
     es_ctx *ctx = NULL;
     ES_TEST_BEGIN();
-    if (es_ctx_new(&ctx) != ES_OK) return 1;
+    if (es_ctx_new(&ctx) != ES_OK || es_ctx_new(&io_ctx) != ES_OK) return 1;
     test_closed(ctx);
     test_disc(ctx);
     test_torus_and_components(ctx);
@@ -692,5 +670,6 @@ int main(void)
     test_oracle_fans(ctx);
     test_real_meshes(ctx);
     es_ctx_free(ctx);
+    es_ctx_free(io_ctx);
     ES_TEST_END();
 }

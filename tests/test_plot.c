@@ -6,6 +6,7 @@
 #include "plot_util.h"
 
 #include <edgespace/es_plot.h>
+#include <sys/wait.h>
 
 static void test_nice_ticks(void)
 {
@@ -370,6 +371,71 @@ static void test_alloc_failures(es_ctx *ctx)
     }
 }
 
+static int run(const char *cmd)
+{
+    int st = system(cmd);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+/* edgespace plot on small CSV tables: every kind writes a valid file; bad
+ * columns, kinds and numbers are refused with the documented exit codes. */
+static void test_cli(void)
+{
+    const char *exe = getenv("EDGESPACE");
+    char cmd[16384];
+    if (!exe) {
+        fprintf(stderr, "SKIP (section): EDGESPACE not set, command not tested\n");
+        return;
+    }
+    char pts[4096], dist[4096]; /* tp_path's buffers are reused */
+    snprintf(pts, sizeof pts, "%s", tp_path("plot", "cli_points.csv"));
+    snprintf(dist, sizeof dist, "%s", tp_path("plot", "cli_dist.csv"));
+    FILE *f = fopen(pts, "w"), *g = fopen(dist, "w");
+    ES_CHECK(f && g);
+    if (!f || !g) return;
+    fputs("subject,expression,PC1,PC2,var\n", f);
+    for (int i = 0; i < 12; i++)
+        fprintf(f, "s%03d,%s,%g,%g,%g\n", i / 3, i % 3 == 0 ? "neutral" : i % 3 == 1 ? "happy" : "angry",
+                (double)(i % 3) + 0.1 * i, (double)(i % 2) - 0.05 * i, 10.0 / (i + 1));
+    fputs(",a,b,c\na,0,1,2\nb,1,0,1.5\nc,2,1.5,0\n", g);
+    fclose(f);
+    fclose(g);
+    static const char *const jobs[][2] = {
+        {"scatter", "--x PC1 --y PC2 --label expression --title 'PC1 vs PC2'"},
+        {"lines", "--x PC1 --y PC2,var --logy"},
+        {"scree", "--y var"},
+        {"histogram", "--y var --bins 5"},
+    };
+    for (int k = 0; k < 4; k++) {
+        for (int fmt = 0; fmt < 2; fmt++) {
+            char name[64];
+            snprintf(name, sizeof name, "cli_%s.%s", jobs[k][0], fmt ? "svg" : "png");
+            const char *out = tp_path("plot", name);
+            remove(out);
+            snprintf(cmd, sizeof cmd, "'%s' plot %s '%s' -o '%s' %s", exe, jobs[k][0], pts, out,
+                     jobs[k][1]);
+            ES_CHECK_MSG(run(cmd) == 0, "%s", cmd);
+            ES_CHECK_MSG(fmt ? tp_file_has(out, "<?xml", "<svg") : tp_file_has(out, "\x89PNG", NULL),
+                         "%s", out);
+        }
+    }
+    const char *hm = tp_path("plot", "cli_heatmap.png");
+    snprintf(cmd, sizeof cmd, "'%s' plot heatmap '%s' -o '%s' --cmap rdbu", exe, dist, hm);
+    ES_CHECK(run(cmd) == 0);
+    ES_CHECK(tp_file_has(hm, "\x89PNG", NULL));
+    snprintf(cmd, sizeof cmd, "'%s' plot scatter '%s' -o x.png --x PC1 --y nope 2>/dev/null", exe, pts);
+    ES_CHECK(run(cmd) == 1);
+    snprintf(cmd, sizeof cmd, "'%s' plot scatter '%s' -o x.png --x PC1 --y expression 2>/dev/null",
+             exe, pts);
+    ES_CHECK(run(cmd) == 1);
+    snprintf(cmd, sizeof cmd, "'%s' plot pie '%s' -o x.png 2>/dev/null", exe, pts);
+    ES_CHECK(run(cmd) == 2);
+    snprintf(cmd, sizeof cmd, "'%s' plot scatter '%s' 2>/dev/null", exe, pts);
+    ES_CHECK(run(cmd) == 2);
+    snprintf(cmd, sizeof cmd, "'%s' plot --help >/dev/null", exe);
+    ES_CHECK(run(cmd) == 0);
+}
+
 int main(void)
 {
     es_ctx *ctx = NULL;
@@ -383,6 +449,7 @@ int main(void)
     test_heatmap(ctx);
     test_histogram(ctx);
     test_alloc_failures(ctx);
+    test_cli();
     es_ctx_free(ctx);
     ES_TEST_END();
 }

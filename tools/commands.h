@@ -3,11 +3,23 @@
 #define EDGESPACE_TOOLS_COMMANDS_H
 
 /* -- topology, geometry, synthetic data */
+int cmd_synth(int argc, char **argv);
 /* -- mesh I/O */
 /* -- store, manifest, ingest */
+int cmd_ingest(int argc, char **argv);
+int cmd_info(int argc, char **argv);
+int cmd_export(int argc, char **argv);
 /* -- statistics, point syntax */
+int cmd_mean(int argc, char **argv);
+int cmd_pca(int argc, char **argv);
+int cmd_diff(int argc, char **argv);
+int cmd_project(int argc, char **argv);
+int cmd_point(int argc, char **argv);
+int cmd_plot_pca(int argc, char **argv);
 /* -- procrustes, landmarks, comparison */
 /* -- embedding, interpolation */
 /* -- plotting, rendering */
+int cmd_render(int argc, char **argv);
+int cmd_plot(int argc, char **argv);
 
 #endif

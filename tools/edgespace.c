@@ -15,12 +15,24 @@ typedef struct command {
 
 static const command commands[] = {
     /* -- topology, geometry, synthetic data */
+    {"synth", cmd_synth, "write a synthetic family of meshes in correspondence"},
     /* -- mesh I/O */
     /* -- store, manifest, ingest */
+    {"ingest", cmd_ingest, "read meshes (manifest or files) into an HDF5 store"},
+    {"info", cmd_info, "describe a store: topology, rows, labels, results"},
+    {"export", cmd_export, "write a store's lengths as CSV or its meshes as files"},
     /* -- statistics, point syntax */
+    {"mean", cmd_mean, "mean edge lengths of all rows, a filter, or per label value"},
+    {"pca", cmd_pca, "principal components of the edge lengths (stored, CSV)"},
+    {"diff", cmd_diff, "mean paired difference (to - from) with per-edge t statistics"},
+    {"project", cmd_project, "scores of rows or mesh files on a stored PCA, with residuals"},
+    {"point", cmd_point, "evaluate and store a point expression (mean + 2*pc:1, ...)"},
+    {"plot-pca", cmd_plot_pca, "PCA score scatter coloured by a label, or scree plot, from a store"},
     /* -- procrustes, landmarks, comparison */
     /* -- embedding, interpolation */
     /* -- plotting, rendering */
+    {"render", cmd_render, "draw meshes side by side to PNG/SVG/PDF"},
+    {"plot", cmd_plot, "scatter, lines, scree, histogram or heat map of a CSV table"},
     {NULL, NULL, NULL}
 };
 

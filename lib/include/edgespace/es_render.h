@@ -25,13 +25,14 @@
  *
  * Scalars: per vertex (interpolated across faces, then mapped), per edge
  * (each face shows the mean of its three edges) or per face. NaN or inf
- * scalars are drawn in the neutral grey ES_NAN_GREY and counted in the
- * report. Without scalars a mesh is drawn in `base_rgb`.
+ * scalars are drawn in the neutral grey ES_NAN_GREY (shaded like the rest),
+ * counted in the report and keyed "n/a" under the colour bar. Without scalars a mesh is drawn in `base_rgb`.
  */
 #ifndef EDGESPACE_ES_RENDER_H
 #define EDGESPACE_ES_RENDER_H
 
 #include "es_core.h"
+#include "es_mesh.h"
 #include "es_plot.h"
 
 #ifdef __cplusplus
@@ -76,6 +77,8 @@ typedef struct es_render_spec {
     es_projection projection;  /* ES_PROJ_PERSPECTIVE */
     double fov_deg;            /* perspective field of view (25) */
     int has_view, has_up;      /* use view / up below instead of the automatic ones */
+    int same_view;             /* 1: every panel uses the automatic view of mesh 0
+                                * (sequences, shapes in one frame); 0: each its own */
     double view[3];            /* direction the camera looks along (not normalized) */
     double up[3];              /* screen up; made orthogonal to view */
     double fill;               /* fraction of the panel the largest mesh spans (0.9) */
@@ -113,6 +116,13 @@ typedef struct es_render_report {
 
 ES_API void es_render_spec_init(es_render_spec *spec);
 
+/* Fill `item` (all fields reset) from a mesh's topology: faces and the
+ * edge list (so per-edge scalars in es_mesh edge order work), with
+ * positions xyz (3 x V), or the mesh's reference positions when xyz is
+ * NULL. Borrowed pointers: valid as long as mesh and xyz. Then set label,
+ * scalar_kind and scalars as needed. */
+ES_API void es_render_mesh_from(es_render_mesh *item, const es_mesh *mesh, const double *xyz);
+
 /* Draw spec->meshes to `path`. report: NULL or filled.
  * Errors: ES_EINVAL (no meshes, NULL arrays, a face index out of range, a
  * scalar kind without scalars, zero view/up vectors or view parallel to
@@ -127,10 +137,15 @@ ES_API es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *
  *    points back to the camera (the faces look at the camera); if that sum
  *    is nearly orthogonal to it (a closed surface), signed so that the
  *    camera sits on the positive side of the axis's largest component.
- *  - up: of the two other axes, the one closer to the coordinate +y axis
- *    (meshes are mostly stored y-up); if both are far from it (|cos| < 0.3)
- *    the largest-variance axis. Signed to point along +y, or else with its
- *    largest-magnitude component positive.
+ *  - up: if one of the two other axes is within about 11 degrees of the
+ *    coordinate y axis (|cos| > 0.98: the mesh is stored y-up), that axis,
+ *    pointing along +y. Otherwise the largest-variance axis, signed so that
+ *    the skewness of the vertices along it is negative (the longer tail
+ *    points down: a neck under a head, legs under a body); when the
+ *    skewness is below 0.05 in magnitude, with its largest-magnitude
+ *    component positive. Randomly rotated data can still come out upside
+ *    down or sideways: give `up` (or the view of one reference mesh to all
+ *    panels) when it matters.
  * Fails with ES_EINVAL on fewer than 3 vertices or non-finite positions. */
 ES_API es_status es_render_auto_view(es_ctx *ctx, int64_t nverts, const double *xyz,
                                      int64_t nfaces, const int64_t *faces, double view[3],

@@ -8,6 +8,15 @@
  * layout. Rows are named by unique ids.
  *
  * A store handle is not thread-safe; use one per thread.
+ *
+ * Writes are all-or-nothing. The store file is never modified in place: a
+ * handle opened with ES_STORE_WRITE (or made by es_store_create) writes to a
+ * private working copy beside the store (".<name>.tmp-<pid>-<n>", made at
+ * the first write), and es_store_commit (also run by es_store_close)
+ * replaces the store with it by an atomic rename() after fsync. A process
+ * that fails or is killed before the commit leaves the store byte-for-byte
+ * as it was; its stale working copy is removed by the next writer. A commit
+ * refuses (ES_EIO) if the store was replaced by another writer meanwhile.
  */
 #ifndef EDGESPACE_ES_STORE_H
 #define EDGESPACE_ES_STORE_H
@@ -26,16 +35,62 @@ typedef enum es_store_mode {
     ES_STORE_WRITE = 1   /* read and write an existing store */
 } es_store_mode;
 
-/* Open an existing store; checks the format version. */
+/* Open an existing store; checks the format version. Fails with
+ * ES_ENOTFOUND if the file does not exist, ES_EFORMAT if it is not a store
+ * (or of another format version). */
 ES_API es_status es_store_open(es_ctx *ctx, const char *path, es_store_mode mode,
                                es_store **out);
+/* Create a new, empty store (N = 0) for `mesh`'s topology, open for
+ * writing. Nothing appears at `path` until es_store_commit/es_store_close.
+ * Fails with ES_EEXIST if `path` exists. */
+ES_API es_status es_store_create(es_ctx *ctx, const char *path, const es_mesh *mesh,
+                                 es_store **out);
+/* Publish what was written so far (atomic rename over the store; no-op if
+ * nothing was written). The handle stays usable; later writes start a new
+ * working copy. On failure nothing is published and the handle refuses
+ * further writes. */
+ES_API es_status es_store_commit(es_ctx *ctx, es_store *store);
+/* Commit pending writes (failures are reported through the log callback of
+ * the store's ctx) and close. NULL: no-op. */
 ES_API void es_store_close(es_store *store);
+/* Close, discarding every uncommitted write. NULL: no-op. */
+ES_API void es_store_abort(es_store *store);
 
 ES_API int64_t es_store_nrows(const es_store *store);
 ES_API int64_t es_store_nedges(const es_store *store);
 ES_API int64_t es_store_nverts(const es_store *store);
 ES_API int64_t es_store_nfaces(const es_store *store);
 ES_API const char *es_store_path(const es_store *store);
+/* Topology fingerprint (es_mesh_fingerprint of the stored faces), 16 hex
+ * digits. Borrowed, valid until close. */
+ES_API const char *es_store_fingerprint(const es_store *store);
+
+/* The stored face list (3 x F, 0-based) and edge list (2 x E, (min, max),
+ * sorted), as es_mesh defines them. */
+ES_API es_status es_store_read_faces(es_ctx *ctx, es_store *store, int64_t *faces);
+ES_API es_status es_store_read_edges(es_ctx *ctx, es_store *store, int64_t *edges);
+
+/* Rows to append: n shapes in the store's topology. */
+typedef struct es_store_rows {
+    int64_t n;
+    const char *const *ids;            /* n unique, non-empty ids */
+    const char *const *source_paths;   /* n, or NULL (stored as "") */
+    const char *const *content_hashes; /* n, or NULL (stored as "") */
+    const double *lengths;             /* E x n normalized lengths (column = row) */
+    const double *scales;              /* n, finite and > 0 */
+    const double *xyz;                 /* 3V x n positions as ingested */
+    int64_t ncols;                     /* label columns given */
+    const char *const *colnames;       /* ncols names (no '/', not '.' or '..') */
+    const char *const *labels;         /* n x ncols: value of column c of row i is
+                                          labels[i * ncols + c] */
+} es_store_rows;
+
+/* Append rows (to the working copy; see es_store_commit). Label columns
+ * new to the store are added with "" in the existing rows; store columns
+ * not given get "" in the new rows. Fails with ES_EEXIST on an id that is
+ * in the store or given twice, ES_EINVAL on a non-finite length or a bad
+ * scale; nothing is written then. */
+ES_API es_status es_store_append(es_ctx *ctx, es_store *store, const es_store_rows *rows);
 
 /* The stored topology (reference positions: those of row 0, or none for an
  * empty store). Caller owns *out. */
@@ -57,13 +112,17 @@ ES_API es_status es_store_read_positions(es_ctx *ctx, es_store *store, int64_t r
 /* Row ids and labels. Borrowed strings, valid until the store is closed. */
 ES_API const char *es_store_row_id(const es_store *store, int64_t row);
 ES_API int64_t es_store_find_row(const es_store *store, const char *id); /* -1 if absent */
+/* Source path and content hash ("fnv1a64:<16 hex>") recorded at ingest. */
+ES_API const char *es_store_source_path(const es_store *store, int64_t row);
+ES_API const char *es_store_content_hash(const es_store *store, int64_t row);
 ES_API int64_t es_store_ncolumns(const es_store *store);
 ES_API const char *es_store_column_name(const es_store *store, int64_t col);
 ES_API int64_t es_store_find_column(const es_store *store, const char *name);
 ES_API const char *es_store_label(const es_store *store, int64_t row, int64_t col);
 
 /* Rows matching a filter "col=value[,col=value...]" (all must hold; NULL or
- * "" selects every row), in row order. *rows is allocated with the ctx
+ * "" selects every row; the column "id" means the row id unless a label
+ * column has that name), in row order. *rows is allocated with the ctx
  * allocator (es_free). Unknown columns fail with ES_ENOTFOUND. */
 ES_API es_status es_store_select(es_ctx *ctx, const es_store *store, const char *filter,
                                  int64_t **rows, int64_t *nrows);
@@ -72,7 +131,10 @@ ES_API es_status es_store_select(es_ctx *ctx, const es_store *store, const char 
  * Results live under /analysis/<kind>/<name>/ (kind: pca, mean, diff,
  * point, gpa, compare, embed, ...). Writing a result that exists replaces
  * it. Each result group carries provenance attributes (command, tool
- * version, UTC time, rows used) set by es_store_result_begin. */
+ * version, UTC time, rows used) set by es_store_result_begin: attributes
+ * command, tool_version, time, params, store_nrows, and the dataset
+ * input_rows (int64 row indices). Writes go to the working copy and become
+ * visible, all together, at es_store_commit/es_store_close. */
 typedef struct es_provenance {
     const char *command;     /* the command line or API call that made it */
     const int64_t *rows;     /* rows used (NULL with nrows = -1: all rows) */
@@ -106,7 +168,9 @@ ES_API es_status es_store_get_attr(es_ctx *ctx, es_store *store, const char *pat
                                    const char *key, char *buf, size_t n);
 /* 1 if the result or dataset exists, else 0. */
 ES_API int es_store_has(es_store *store, const char *path);
-/* Names of the results of one kind (es_free each and the array). */
+/* Names of the results of one kind, in name order; kind NULL or "": the
+ * kinds present. *names is NULL when there are none. es_free each name and
+ * the array. */
 ES_API es_status es_store_list_results(es_ctx *ctx, es_store *store, const char *kind,
                                        char ***names, int64_t *n);
 

@@ -1,0 +1,148 @@
+/* lib/export.c — rows of a store back out: edge lengths as CSV (for
+ * spreadsheets, R, pandas) and stored positions as mesh files. The CSV
+ * prints %.17g so that every double reads back to the same bits. */
+#include "es_internal.h"
+#include "edgespace/es_ingest.h"
+#include "edgespace/es_io.h"
+#include "edgespace/es_store.h"
+#include "mesh_io_internal.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <sys/stat.h>
+
+/* rows/nrows as given, or all rows (allocated into *own). */
+static es_status row_list(es_ctx *ctx, es_store *s, const int64_t *rows, int64_t nrows,
+                          const int64_t **out, int64_t *n, int64_t **own)
+{
+    *own = NULL;
+    if (rows) {
+        for (int64_t j = 0; j < nrows; j++)
+            if (rows[j] < 0 || rows[j] >= es_store_nrows(s))
+                ES_FAIL(ctx, ES_ERANGE, "export: row %lld is out of range", (long long)rows[j]);
+        *out = rows;
+        *n = nrows;
+        return ES_OK;
+    }
+    *n = es_store_nrows(s);
+    if (!(*own = es__alloc_array(ctx, *n ? *n : 1, sizeof **own))) return ES_ENOMEM;
+    for (int64_t i = 0; i < *n; i++) (*own)[i] = i;
+    *out = *own;
+    return ES_OK;
+}
+
+es_status es_export_lengths_csv(es_ctx *ctx, es_store *s, const int64_t *rows, int64_t nrows,
+                                int raw, const char *path)
+{
+    int64_t E, n, *own = NULL, *edges = NULL;
+    const int64_t *list;
+    double *len = NULL, *scales = NULL;
+    es_status rc;
+    FILE *f = NULL;
+    if (!s || !path) ES_FAIL(ctx, ES_EINVAL, "export: NULL argument");
+    E = es_store_nedges(s);
+    if ((rc = row_list(ctx, s, rows, nrows, &list, &n, &own))) return rc;
+    if (!(len = es__alloc_array(ctx, E, sizeof *len)) ||
+        !(edges = es__alloc_array(ctx, 2 * E, sizeof *edges)) ||
+        !(scales = es__alloc_array(ctx, es_store_nrows(s) ? es_store_nrows(s) : 1,
+                                   sizeof *scales))) {
+        rc = ES_ENOMEM;
+        goto done;
+    }
+    if ((rc = es_store_read_edges(ctx, s, edges)) || (rc = es_store_read_scales(ctx, s, scales)))
+        goto done;
+    if (!(f = fopen(path, "w"))) {
+        rc = es__fail(ctx, ES_EIO, "export: cannot create '%s': %s", path, strerror(errno));
+        goto done;
+    }
+    fputs("id,scale", f);
+    for (int64_t e = 0; e < E; e++)
+        fprintf(f, ",%lld-%lld", (long long)edges[2 * e], (long long)edges[2 * e + 1]);
+    fputc('\n', f);
+    for (int64_t j = 0; j < n; j++) {
+        es_mat m = {len, E, 1, E};
+        const char *id = es_store_row_id(s, list[j]);
+        double sc = scales[list[j]];
+        es__progress(ctx, "exporting lengths", j, n);
+        if ((rc = es_store_read_lengths(ctx, s, list[j], 1, m))) goto done;
+        /* ids are free text: quote them the RFC 4180 way when needed */
+        if (strpbrk(id, ",\"\r\n")) {
+            fputc('"', f);
+            for (const char *p = id; *p; p++) {
+                if (*p == '"') fputc('"', f);
+                fputc(*p, f);
+            }
+            fputc('"', f);
+        } else {
+            fputs(id, f);
+        }
+        fprintf(f, ",%.17g", sc);
+        for (int64_t e = 0; e < E; e++) fprintf(f, ",%.17g", raw ? sc * len[e] : len[e]);
+        fputc('\n', f);
+    }
+    es__progress(ctx, "exporting lengths", n, n);
+    if (ferror(f)) rc = es__fail(ctx, ES_EIO, "export: cannot write '%s'", path);
+done:
+    if (f && fclose(f) != 0 && rc == ES_OK)
+        rc = es__fail(ctx, ES_EIO, "export: cannot write '%s': %s", path, strerror(errno));
+    es__free(ctx, own);
+    es__free(ctx, len);
+    es__free(ctx, edges);
+    es__free(ctx, scales);
+    return rc;
+}
+
+es_status es_export_meshes(es_ctx *ctx, es_store *s, const int64_t *rows, int64_t nrows,
+                           const char *dir, es_mesh_format format)
+{
+    int64_t n, *own = NULL, *faces = NULL;
+    const int64_t *list;
+    double *xyz = NULL;
+    es_status rc;
+    const char *ext;
+    struct stat st;
+    if (!s || !dir) ES_FAIL(ctx, ES_EINVAL, "export: NULL argument");
+    switch (format) {
+    case ES_FORMAT_PLY: case ES_FORMAT_PLY_ASCII: ext = "ply"; break;
+    case ES_FORMAT_OFF: ext = "off"; break;
+    default: ext = "obj"; format = ES_FORMAT_OBJ; break;
+    }
+    if (stat(dir, &st) != 0) {
+        if (mkdir(dir, 0777) != 0)
+            ES_FAIL(ctx, ES_EIO, "export: cannot create directory '%s': %s", dir,
+                    strerror(errno));
+    } else if (!S_ISDIR(st.st_mode)) {
+        ES_FAIL(ctx, ES_EIO, "export: '%s' is not a directory", dir);
+    }
+    if ((rc = row_list(ctx, s, rows, nrows, &list, &n, &own))) return rc;
+    if (!(xyz = es__alloc_array(ctx, 3 * es_store_nverts(s), sizeof *xyz)) ||
+        !(faces = es__alloc_array(ctx, 3 * es_store_nfaces(s), sizeof *faces))) {
+        rc = ES_ENOMEM;
+        goto done;
+    }
+    if ((rc = es_store_read_faces(ctx, s, faces))) goto done;
+    for (int64_t j = 0; j < n; j++) {
+        const char *id = es_store_row_id(s, list[j]);
+        size_t len = strlen(dir) + strlen(id) + 8;
+        char *path;
+        es__progress(ctx, "exporting meshes", j, n);
+        if (strchr(id, '/') || !strcmp(id, ".") || !strcmp(id, "..")) {
+            rc = es__fail(ctx, ES_EINVAL, "export: id '%s' cannot be a file name", id);
+            goto done;
+        }
+        if (!(path = es__malloc(ctx, len))) { rc = ES_ENOMEM; goto done; }
+        snprintf(path, len, "%s/%s.%s", dir, id, ext);
+        if (!(rc = es_store_read_positions(ctx, s, list[j], xyz)))
+            rc = es__meshdata_write(ctx, path, format, es_store_nverts(s), es_store_nfaces(s),
+                                    faces, xyz, NULL);
+        es__free(ctx, path);
+        if (rc) goto done;
+    }
+    es__progress(ctx, "exporting meshes", n, n);
+done:
+    es__free(ctx, faces);
+    es__free(ctx, xyz);
+    es__free(ctx, own);
+    return rc;
+}
