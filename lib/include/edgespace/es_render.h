@@ -75,7 +75,11 @@ typedef struct es_render_spec {
     const es_render_mesh *meshes;
     int width, height;         /* of each panel, device units (480 x 480) */
     es_projection projection;  /* ES_PROJ_PERSPECTIVE */
-    double fov_deg;            /* perspective field of view (25) */
+    /* Perspective strength (25): the eye sits where the mesh's bounding
+     * sphere just fills this field of view; the picture is then scaled to
+     * `fill` the panel, so a smaller angle means a flatter, more distant
+     * look, not a smaller mesh. */
+    double fov_deg;
     int has_view, has_up;      /* use view / up below instead of the automatic ones */
     int same_view;             /* 1: every panel uses the automatic view of mesh 0
                                 * (sequences, shapes in one frame); 0: each its own */
