@@ -1,7 +1,7 @@
 /* tools/bench/bench_ingest.c — how fast is ingest? Meshes per second, MB/s
  * of mesh files parsed, peak memory, and where the time goes.
  *
- *   bench_ingest [MANIFEST] [--repeat N] [--dir DIR]
+ *   bench_ingest [MANIFEST] [--repeat N] [--threads T] [--dir DIR]
  *
  * MANIFEST defaults to ../shared/data/face-study/manifest.csv (90 meshes,
  * 9,409 vertices, 27,871 edges each). Each repeat runs one whole ingest
@@ -65,7 +65,7 @@ int main(int argc, char **argv)
 {
     const char *manifest = ES_SHARED_DIR "/data/face-study/manifest.csv", *dir = NULL;
     char store[4300], tmpl[4200];
-    int repeat = 5;
+    int repeat = 5, threads = 0;
     es_ctx *ctx;
     es_manifest *m = NULL;
     es_status rc;
@@ -73,8 +73,9 @@ int main(int argc, char **argv)
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--dir") && i + 1 < argc) dir = argv[++i];
+        else if (!strcmp(argv[i], "--threads") && i + 1 < argc) threads = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--help")) {
-            puts("usage: bench_ingest [MANIFEST] [--repeat N] [--dir DIR]");
+            puts("usage: bench_ingest [MANIFEST] [--repeat N] [--threads T] [--dir DIR]");
             return 0;
         } else manifest = argv[i];
     }
@@ -112,9 +113,12 @@ int main(int argc, char **argv)
         t0 = now();
         if ((pid = fork()) == 0) {
             es_ingest_report rep;
+            es_ingest_opts o;
             es_ctx *c2;
+            es_ingest_opts_init(&o);
+            o.threads = threads;
             if (es_ctx_new(&c2) != ES_OK) _exit(1);
-            if ((rc = es_ingest_manifest(c2, store, manifest, NULL, &rep))) die(c2, rc, "ingest");
+            if ((rc = es_ingest_manifest(c2, store, manifest, &o, &rep))) die(c2, rc, "ingest");
             _exit(rep.rows_added == m->nrows ? 0 : 1);
         }
         if (wait4(pid, &status, 0, &ru) < 0 || !WIFEXITED(status) || WEXITSTATUS(status)) {
@@ -132,7 +136,8 @@ int main(int argc, char **argv)
         stat(store, &st);
         printf("store      %.1f MB\n", (double)st.st_size / 1e6);
     }
-    printf("ingest     best %.3f s, median %.3f s wall (%d runs); CPU (user+sys) best %.3f s\n",
+    printf("ingest     threads %d (0: one per CPU, here %ld); best %.3f s, median %.3f s wall "
+           "(%d runs); CPU (user+sys) best %.3f s\n", threads, sysconf(_SC_NPROCESSORS_ONLN),
            wall[0], wall[repeat / 2], repeat, cpu[0]);
     printf("rate       %.1f meshes/s, %.1f MB/s of mesh files (best wall)\n",
            (double)m->nrows / wall[0], total_bytes / 1e6 / wall[0]);
