@@ -11,6 +11,9 @@ int cmd_info(int argc, char **argv);
 int cmd_export(int argc, char **argv);
 /* -- statistics, point syntax */
 /* -- procrustes, landmarks, comparison */
+int cmd_gpa(int argc, char **argv);
+int cmd_compare(int argc, char **argv);
+int cmd_ingest_landmarks(int argc, char **argv);
 /* -- embedding, interpolation */
 /* -- plotting, rendering */
 int cmd_render(int argc, char **argv);

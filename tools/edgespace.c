@@ -23,6 +23,9 @@ static const command commands[] = {
     {"export", cmd_export, "write a store's lengths as CSV or its meshes as files"},
     /* -- statistics, point syntax */
     /* -- procrustes, landmarks, comparison */
+    {"gpa", cmd_gpa, "generalized Procrustes analysis of a store's positions"},
+    {"compare", cmd_compare, "Procrustes vs edge-length space: distances, Mantel, groups"},
+    {"ingest-landmarks", cmd_ingest_landmarks, "landmarks (TPS, CSV) + triangulation into a store"},
     /* -- embedding, interpolation */
     /* -- plotting, rendering */
     {"render", cmd_render, "draw meshes side by side to PNG/SVG/PDF"},
