@@ -29,6 +29,9 @@ static const command commands[] = {
     {"point", cmd_point, "evaluate and store a point expression (mean + 2*pc:1, ...)"},
     {"plot-pca", cmd_plot_pca, "PCA score scatter coloured by a label, or scree plot, from a store"},
     /* -- procrustes, landmarks, comparison */
+    {"gpa", cmd_gpa, "generalized Procrustes analysis of a store's positions"},
+    {"compare", cmd_compare, "Procrustes vs edge-length space: distances, Mantel, groups"},
+    {"ingest-landmarks", cmd_ingest_landmarks, "landmarks (TPS, CSV) + triangulation into a store"},
     /* -- embedding, interpolation */
     /* -- plotting, rendering */
     {"render", cmd_render, "draw meshes side by side to PNG/SVG/PDF"},
