@@ -12,6 +12,8 @@ int cmd_export(int argc, char **argv);
 /* -- statistics, point syntax */
 /* -- procrustes, landmarks, comparison */
 /* -- embedding, interpolation */
+int cmd_embed(int argc, char **argv);
+int cmd_interp(int argc, char **argv);
 /* -- plotting, rendering */
 int cmd_render(int argc, char **argv);
 int cmd_plot(int argc, char **argv);

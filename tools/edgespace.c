@@ -24,6 +24,8 @@ static const command commands[] = {
     /* -- statistics, point syntax */
     /* -- procrustes, landmarks, comparison */
     /* -- embedding, interpolation */
+    {"embed", cmd_embed, "realize a point of edge-length space as a mesh, with a quality report"},
+    {"interp", cmd_interp, "interpolate/extrapolate stored shapes in edge-length space and embed"},
     /* -- plotting, rendering */
     {"render", cmd_render, "draw meshes side by side to PNG/SVG/PDF"},
     {"plot", cmd_plot, "scatter, lines, scree, histogram or heat map of a CSV table"},
