@@ -21,6 +21,8 @@ int cmd_gpa(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
 int cmd_ingest_landmarks(int argc, char **argv);
 /* -- embedding, interpolation */
+int cmd_embed(int argc, char **argv);
+int cmd_interp(int argc, char **argv);
 /* -- plotting, rendering */
 int cmd_render(int argc, char **argv);
 int cmd_plot(int argc, char **argv);

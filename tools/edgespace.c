@@ -33,6 +33,8 @@ static const command commands[] = {
     {"compare", cmd_compare, "Procrustes vs edge-length space: distances, Mantel, groups"},
     {"ingest-landmarks", cmd_ingest_landmarks, "landmarks (TPS, CSV) + triangulation into a store"},
     /* -- embedding, interpolation */
+    {"embed", cmd_embed, "realize a point of edge-length space as a mesh, with a quality report"},
+    {"interp", cmd_interp, "interpolate/extrapolate stored shapes in edge-length space and embed"},
     /* -- plotting, rendering */
     {"render", cmd_render, "draw meshes side by side to PNG/SVG/PDF"},
     {"plot", cmd_plot, "scatter, lines, scree, histogram or heat map of a CSV table"},
