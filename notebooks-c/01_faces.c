@@ -62,6 +62,7 @@ typedef struct study {
     es_validity pt_valid[NPTS];
     double *xyz;               /* 3V x NPTS embedded positions */
     es_embed_report rep[NPTS];
+    double view[3], up[3];     /* camera of every picture: the mean neutral face's */
 } study;
 
 /* ---- 1. data: a manifest of faces, ingested into a store ----------------- */
@@ -541,7 +542,9 @@ static int render_row(notebook *nb, const study *s, const int *idx, int n, const
     sp.nmeshes = n;
     sp.meshes = rm;
     sp.width = sp.height = 360;
-    sp.same_view = 1;
+    sp.has_view = sp.has_up = 1;
+    memcpy(sp.view, s->view, sizeof sp.view);
+    memcpy(sp.up, s->up, sizeof sp.up);
     sp.title = title;
     if ((rc = es_render(nb->ctx, &sp, nb_path(nb, "%s", file), NULL)) != ES_OK)
         return nb_fail(nb, rc, "render");
@@ -582,6 +585,9 @@ static int render_heat(notebook *nb, const study *s)
     sp.nmeshes = 1;
     sp.meshes = &rm;
     sp.width = sp.height = 520;
+    sp.has_view = sp.has_up = 1;
+    memcpy(sp.view, s->view, sizeof sp.view);
+    memcpy(sp.up, s->up, sizeof sp.up);
     sp.cmap = ES_CMAP_RDBU;
     sp.vmin = -lim;
     sp.vmax = lim;
@@ -599,7 +605,13 @@ static int pictures(notebook *nb, study *s)
 {
     static const int expr[3] = {0, 1, 2}, pc1[3] = {4, 3, 5}, pc2[3] = {6, 3, 7},
                      pc3[3] = {8, 3, 9};
+    es_status rc;
     nb_step(nb, "render: embedded faces and the t-statistic heat map");
+    /* one camera for every picture: the automatic view of the mean neutral
+     * face (all embeddings are aligned to it), so that faces compare */
+    if ((rc = es_render_auto_view(nb->ctx, s->V, s->xyz, s->F, es_mesh_faces(s->mesh), s->view,
+                                  s->up)) != ES_OK)
+        return nb_fail(nb, rc, "camera");
     nb_h(nb, 2, "What the points look like");
     if (render_row(nb, s, expr, 3, "expressions.png",
                    "Mean neutral face, and with the mean expression differences added"))
