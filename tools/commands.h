@@ -10,6 +10,12 @@ int cmd_ingest(int argc, char **argv);
 int cmd_info(int argc, char **argv);
 int cmd_export(int argc, char **argv);
 /* -- statistics, point syntax */
+int cmd_mean(int argc, char **argv);
+int cmd_pca(int argc, char **argv);
+int cmd_diff(int argc, char **argv);
+int cmd_project(int argc, char **argv);
+int cmd_point(int argc, char **argv);
+int cmd_plot_pca(int argc, char **argv);
 /* -- procrustes, landmarks, comparison */
 /* -- embedding, interpolation */
 /* -- plotting, rendering */

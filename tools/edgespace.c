@@ -22,6 +22,12 @@ static const command commands[] = {
     {"info", cmd_info, "describe a store: topology, rows, labels, results"},
     {"export", cmd_export, "write a store's lengths as CSV or its meshes as files"},
     /* -- statistics, point syntax */
+    {"mean", cmd_mean, "mean edge lengths of all rows, a filter, or per label value"},
+    {"pca", cmd_pca, "principal components of the edge lengths (stored, CSV)"},
+    {"diff", cmd_diff, "mean paired difference (to - from) with per-edge t statistics"},
+    {"project", cmd_project, "scores of rows or mesh files on a stored PCA, with residuals"},
+    {"point", cmd_point, "evaluate and store a point expression (mean + 2*pc:1, ...)"},
+    {"plot-pca", cmd_plot_pca, "PCA score scatter coloured by a label, or scree plot, from a store"},
     /* -- procrustes, landmarks, comparison */
     /* -- embedding, interpolation */
     /* -- plotting, rendering */

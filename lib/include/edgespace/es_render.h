@@ -25,13 +25,14 @@
  *
  * Scalars: per vertex (interpolated across faces, then mapped), per edge
  * (each face shows the mean of its three edges) or per face. NaN or inf
- * scalars are drawn in the neutral grey ES_NAN_GREY and counted in the
- * report. Without scalars a mesh is drawn in `base_rgb`.
+ * scalars are drawn in the neutral grey ES_NAN_GREY (shaded like the rest),
+ * counted in the report and keyed "n/a" under the colour bar. Without scalars a mesh is drawn in `base_rgb`.
  */
 #ifndef EDGESPACE_ES_RENDER_H
 #define EDGESPACE_ES_RENDER_H
 
 #include "es_core.h"
+#include "es_mesh.h"
 #include "es_plot.h"
 
 #ifdef __cplusplus
@@ -114,6 +115,13 @@ typedef struct es_render_report {
 } es_render_report;
 
 ES_API void es_render_spec_init(es_render_spec *spec);
+
+/* Fill `item` (all fields reset) from a mesh's topology: faces and the
+ * edge list (so per-edge scalars in es_mesh edge order work), with
+ * positions xyz (3 x V), or the mesh's reference positions when xyz is
+ * NULL. Borrowed pointers: valid as long as mesh and xyz. Then set label,
+ * scalar_kind and scalars as needed. */
+ES_API void es_render_mesh_from(es_render_mesh *item, const es_mesh *mesh, const double *xyz);
 
 /* Draw spec->meshes to `path`. report: NULL or filled.
  * Errors: ES_EINVAL (no meshes, NULL arrays, a face index out of range, a
