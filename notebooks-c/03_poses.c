@@ -14,10 +14,11 @@
  * project's closed bent tube (es_synth "tube-closed"), straight to bent by
  * 180 degrees.
  *
- * Method. l(t) = (1 - t) l_A + t l_B (raw lengths); each frame embedded by
- * es_embed_solve from the linearly interpolated dihedral angles of the two
- * poses (es_dihedral_angles; the paper's initialization), aligned to the
- * previous frame. Along t: RMS(l_out - l(t)) / mean l(t) and the largest
+ * Method. l(t): the weighted mean of the two poses' scaled lengths at the
+ * weighted mean scale (es_interp_targets; the poses share a scale, so this
+ * is (1 - t) l_A + t l_B); each frame embedded by es_interp_embed from the
+ * interpolated dihedral angles of the two poses (the paper's
+ * initialization, along the shortest arc), aligned to the previous frame. Along t: RMS(l_out - l(t)) / mean l(t) and the largest
  * relative edge error, for the embedded frames and for the vertex
  * interpolation (1 - t) x_A + t x_B (B rigidly aligned to A first).
  *
@@ -42,6 +43,7 @@ typedef struct study {
     double *frames;           /* 3V x nt embedded frames */
     double *rms_emb, *max_emb, *rms_lin, *max_lin;   /* nt each */
     double secs;
+    int64_t n_wrapped;        /* edges whose dihedral crosses +-pi between the poses */
 } study;
 
 /* ---- 1. data ------------------------------------------------------------------ */
@@ -154,12 +156,13 @@ static int load(notebook *nb, study *s)
 static int interpolate(notebook *nb, study *s)
 {
     const int64_t E = s->E, V3 = 3 * s->V;
-    double *la = malloc(sizeof(double) * (size_t)E), *lb = malloc(sizeof(double) * (size_t)E);
-    double *aa = malloc(sizeof(double) * (size_t)E), *ab = malloc(sizeof(double) * (size_t)E);
-    double *lt = malloc(sizeof(double) * (size_t)E), *at = malloc(sizeof(double) * (size_t)E);
+    const double *in[2] = {s->xa, s->xb};
+    double *lt = malloc(sizeof(double) * (size_t)E);
     double *lin = malloc(sizeof(double) * (size_t)V3), rms, p99;
     es_embedder *emb = NULL;
+    es_interp_info info;
     es_status rc = ES_ENOMEM;
+    int64_t wrapped = 0;
     double t0 = nb_now();
 
     nb_step(nb, "interpolate: lengths along t, each frame embedded");
@@ -167,33 +170,30 @@ static int interpolate(notebook *nb, study *s)
     s->t = malloc(sizeof(double) * (size_t)s->nt);
     s->frames = malloc(sizeof(double) * (size_t)(V3 * s->nt));
     s->rms_emb = malloc(sizeof(double) * (size_t)(4 * s->nt));
-    if (!la || !lb || !aa || !ab || !lt || !at || !lin || !s->t || !s->frames || !s->rms_emb)
-        goto done;
+    if (!lt || !lin || !s->t || !s->frames || !s->rms_emb) goto done;
     s->max_emb = s->rms_emb + s->nt;
     s->rms_lin = s->rms_emb + 2 * s->nt;
     s->max_lin = s->rms_emb + 3 * s->nt;
     if ((rc = es_kabsch_align(nb->ctx, s->V, s->xb, s->xa, NULL, &rms)) != ES_OK ||
-        (rc = es_edge_lengths(nb->ctx, s->mesh, s->xa, la)) != ES_OK ||
-        (rc = es_edge_lengths(nb->ctx, s->mesh, s->xb, lb)) != ES_OK ||
-        (rc = es_dihedral_angles(nb->ctx, s->mesh, s->xa, aa)) != ES_OK ||
-        (rc = es_dihedral_angles(nb->ctx, s->mesh, s->xb, ab)) != ES_OK ||
         (rc = es_embedder_new(nb->ctx, s->mesh, &emb)) != ES_OK)
         goto done;
     for (int64_t k = 0; k < s->nt; k++) {
-        double t = (double)k / (double)(s->nt - 1);
+        double t = (double)k / (double)(s->nt - 1), w[2] = {1 - t, t};
         es_embed_report r;
         s->t[k] = t;
-        for (int64_t e = 0; e < E; e++) {
-            lt[e] = (1 - t) * la[e] + t * lb[e];
-            at[e] = (1 - t) * aa[e] + t * ab[e];
-        }
+        /* the target l(t), for the vertex-interpolation baseline */
+        if ((rc = es_interp_targets(nb->ctx, s->mesh, 2, in, w, lt, NULL, &info)) != ES_OK)
+            goto done;
         for (int64_t i = 0; i < V3; i++) lin[i] = (1 - t) * s->xa[i] + t * s->xb[i];
         if ((rc = es_embed_length_error(nb->ctx, s->mesh, lin, lt, 0, &s->rms_lin[k],
                                         &s->max_lin[k], &p99)) != ES_OK)
             goto done;
-        rc = es_embed_solve(emb, lt, 0, at, k ? s->frames + V3 * (k - 1) : s->xa, NULL,
-                            s->frames + V3 * k, &r);
+        /* the frame: embedded from the (shortest-arc) interpolated dihedrals,
+         * aligned to the previous frame */
+        rc = es_interp_embed(emb, 2, in, w, k ? s->frames + V3 * (k - 1) : s->xa, NULL,
+                             s->frames + V3 * k, &r, &info);
         if (rc != ES_OK) goto done;
+        if (info.n_wrapped > wrapped) wrapped = info.n_wrapped;
         s->rms_emb[k] = r.rms_ratio;
         s->max_emb[k] = r.max_rel;
         printf("%s:   t = %.2f: embedded rms %.3g max %.3g; vertex lerp rms %.3g max %.3g "
@@ -203,17 +203,14 @@ static int interpolate(notebook *nb, study *s)
         if ((rc = es_mesh_write(nb->ctx, nb_path(nb, "frame_%02lld.obj", (long long)k),
                                 ES_FORMAT_OBJ, s->mesh, s->frames + V3 * k, NULL)) != ES_OK)
             goto done;
+        nb_output(nb, nb_path(nb, "frame_%02lld.obj", (long long)k) + strlen(nb->outdir) + 1);
     }
     s->secs = nb_now() - t0;
+    s->n_wrapped = wrapped;
     rc = ES_OK;
 done:
     es_embedder_free(emb);
-    free(la);
-    free(lb);
-    free(aa);
-    free(ab);
     free(lt);
-    free(at);
     free(lin);
     if (rc != ES_OK) return nb_fail(nb, rc, "interpolation");
     return 0;
@@ -234,8 +231,9 @@ static int report(notebook *nb, study *s)
     nb_step(nb, "report: error curves and frames");
     nb_h(nb, 2, "Interpolation from %s to %s", s->id_a, s->id_b);
     nb_p(nb, "%lld vertices, %lld edges; %lld frames at t = 0, %.3g, ..., 1, embedded in "
-         "%.1f s in all.", (long long)s->V, (long long)s->E, (long long)s->nt,
-         s->t[1], s->secs);
+         "%.1f s in all (%lld edges' dihedrals cross +-pi between the poses and are "
+         "interpolated along the shortest arc).", (long long)s->V, (long long)s->E,
+         (long long)s->nt, s->t[1], s->secs, (long long)s->n_wrapped);
     if (!(f = nb_csv_open(nb, "errors.csv", "t,embedded_rms_ratio,embedded_max_rel,"
                                             "vertex_lerp_rms_ratio,vertex_lerp_max_rel")))
         return 1;
