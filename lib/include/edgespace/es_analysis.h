@@ -1,6 +1,6 @@
 /* lib/include/edgespace/es_analysis.h — the statistics of es_stats.h and
  * the points of es_point.h run on a shape store, with their results kept in
- * the store under /analysis/<kind>/<name> (datasets-spec/store-format.md):
+ * the store under /analysis/<kind>/<name> (datasets-spec/analysis-results.md):
  *
  *   mean/<name>:  means (G x E: row g = mean of group g), counts (G),
  *                 groups (G strings), scales (G: mean scale of the group);
