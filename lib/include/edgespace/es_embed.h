@@ -1,0 +1,189 @@
+/* lib/include/edgespace/es_embed.h — realize an edge-length vector as a mesh.
+ *
+ * Given a topology, target edge lengths and an initialization (dihedral
+ * angles and/or vertex positions), compute vertex positions whose edge
+ * lengths match the target as well as possible, plus a quality report.
+ * Stages (Section 2 of edge-length-interpolation, with the changes below):
+ *   1. dihedrals: Levenberg-Marquardt on the 9 closure residuals P_v - I of
+ *      every interior vertex figure (eq. 1-2), sparse Cholesky (CHOLMOD);
+ *   2. frames: sparse least squares on G_u = G_v R_vu, SVD-orthonormalized;
+ *   3. positions: sparse least squares on x_u - x_v = G_v u_v;
+ *   4. refinement: Levenberg-Marquardt on the relative edge-length residuals
+ *      (|x_a - x_b| - l_e) / l_e in position space. Vertex closure does not
+ *      fix the holonomy around holes and handles (oracle README, failure A)
+ *      and leaves edges between two boundary vertices free (failure B);
+ *      this stage closes both. Rigid motions (and, on open meshes, flexes)
+ *      are held by the damping, so the result stays near the stage-3 mesh.
+ * Optionally (continuation_steps > 0 with initial positions) stage 4 runs
+ * along the path from the initial mesh's own lengths (which it realizes
+ * exactly) to the target, warm-started step by step.
+ *
+ * Conventions are those of ../shared/oracle/embed (es_geom.h signs): the
+ * angle alpha_e is the signed bending angle, alpha = 0 flat, < 0 convex;
+ * boundary vertices carry no closure term and boundary edges no variable.
+ * Frames: x along the spoke with the smallest edge id (a boundary vertex:
+ * its first fan spoke), y in the plane of the triangle to its left; at the
+ * lowest vertex of every component G = I and x = 0 (before alignment).
+ *
+ * An embedder is made once per topology: it holds the symbolic Cholesky
+ * analyses (and the factor of the position Laplacian, which depends on the
+ * topology only), and its work buffers, reused by every solve. It borrows
+ * the mesh, which must outlive it. Not thread-safe: one per thread.
+ */
+#ifndef EDGESPACE_ES_EMBED_H
+#define EDGESPACE_ES_EMBED_H
+
+#include "es_core.h"
+#include "es_mesh.h"
+#include "es_store.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct es_embedder es_embedder;
+
+typedef enum es_embed_dihedral_mode {
+    ES_EMBED_DIHEDRAL_AUTO = 0, /* stages 2-3 from the initial and from the stage-1
+                                   dihedrals; refine the one with smaller edge error */
+    ES_EMBED_DIHEDRAL_ON,       /* always stage 1 (the paper) */
+    ES_EMBED_DIHEDRAL_OFF       /* skip stage 1: stages 2-3 from the initial dihedrals */
+} es_embed_dihedral_mode;
+
+typedef struct es_embed_opts {
+    es_embed_dihedral_mode dihedral_mode;   /* default AUTO */
+    int dihedral_max_iter;    /* stage 1 LM iterations; 0 skips stage 1 (default 30) */
+    double dihedral_rtol;     /* stage 1 stops when E drops by less than this fraction
+                                 per iteration, or E <= dihedral_tol * #interior verts
+                                 (defaults 1e-4, 1e-24) */
+    double dihedral_tol;
+    int refine_max_iter;      /* stage 4 LM iterations per step; 0 skips (default 40) */
+    double refine_rtol;       /* stage 4 stops when the cost dropped by less than this
+                                 fraction per iteration over the last 3 iterations, or
+                                 the RMS relative edge error is below refine_tol
+                                 (defaults 1e-3, 1e-13) */
+    double refine_tol;
+    int continuation_steps;   /* > 0 and initial positions given: run stage 4 along the
+                                 length path from the initial mesh in this many steps
+                                 instead of stages 1-3 (default 0) */
+    int try_both;             /* with initial positions and dihedrals: also run the
+                                 continuation (or the dihedral path) and keep the better
+                                 result by max relative edge error (default 0) */
+    int align;                /* 1: rigidly align (Kabsch, proper rotation) the output to
+                                 the initial positions, else to the mesh's reference
+                                 positions if it has them (default 1) */
+    double bad_face_rtol;     /* triangle-inequality tolerance of the report (1e-12) */
+    double realized_rtol;     /* report.realized = max relative error <= this (1e-2) */
+    int verbose;              /* 1: one note per iteration to the log callback (0) */
+} es_embed_opts;
+
+ES_API void es_embed_opts_init(es_embed_opts *opts);
+
+typedef struct es_embed_report {
+    double closure_before;    /* E(alpha) (eq. 3) at the initial dihedrals */
+    double closure_after;     /* E at the output mesh's dihedrals, target corner angles */
+    double closure_stage1;    /* E after stage 1 */
+    int64_t dihedral_iters;   /* stage 1 LM iterations (AUTO: 5 first, the rest only
+                                 if stage 1 improves the linear reconstruction) */
+    int64_t refine_iters;     /* stage 4 LM iterations (all continuation steps) */
+    int64_t continuation_steps; /* steps used (0: dihedral path) */
+    int used_continuation;    /* 1 if the returned result came from continuation */
+    int used_stage1;          /* 1 if stage 1's dihedrals were kept (AUTO may drop them) */
+    double t_dihedral, t_frames, t_positions, t_refine, t_total;   /* seconds */
+    double rms_ratio_linear;  /* RMS ratio after stage 3, before refinement */
+    double rms_ratio;         /* RMS(l_out - l_target) / mean(l_target) */
+    double max_rel;           /* max_e |l_out - l_target| / l_target */
+    double p99_rel;           /* 99th percentile of the same */
+    int64_t worst_edge;       /* edge of max_rel */
+    int64_t n_bad_faces;      /* target faces violating the triangle inequality */
+    double scale;             /* sum of the output's target lengths */
+    int realized;             /* 1 if max_rel <= opts.realized_rtol */
+} es_embed_report;
+
+/* Make an embedder for `mesh` (borrowed; must outlive the embedder).
+ * Fails with ES_EINVAL on a mesh without faces, ES_ENUMERIC if CHOLMOD
+ * fails. */
+ES_API es_status es_embedder_new(es_ctx *ctx, const es_mesh *mesh, es_embedder **out);
+ES_API void es_embedder_free(es_embedder *emb);
+
+/* Embed target lengths.
+ *   target     [in]  E edge lengths (any positive scale).
+ *   scale      [in]  > 0: embed at sum of lengths = scale; 0: at the target's own sum.
+ *   init_alpha [in]  E dihedral angles to start stage 1 from, or NULL.
+ *   init_xyz   [in]  3 x V positions of a mesh with this topology, or NULL: its
+ *                    dihedrals are the start when init_alpha is NULL, it is the
+ *                    start of continuation, and the output is aligned to it.
+ *                    At least one of init_alpha, init_xyz is required.
+ *   opts       [in]  NULL for defaults.
+ *   xyz        [out] 3 x V positions (isolated vertices: at the origin).
+ *   report     [out] quality report, or NULL.
+ * Errors: ES_EINVAL on a length that is not finite and positive (names the
+ * edge), a non-finite initial angle or position, neither initialization;
+ * ES_ENUMERIC if a factorization fails beyond repair. Targets whose faces
+ * violate the triangle inequality are embedded as well as possible and
+ * counted in the report (realized = 0); the output is always finite. */
+ES_API es_status es_embed_solve(es_embedder *emb, const double *target, double scale,
+                                const double *init_alpha, const double *init_xyz,
+                                const es_embed_opts *opts, double *xyz,
+                                es_embed_report *report);
+
+/* Per-vertex results of the last solve (V entries each), borrowed until
+ * the next solve or es_embedder_free; NULL before the first solve:
+ * closure residual E_v at the output dihedrals and target corner angles
+ * (0 at boundary vertices), and the mean relative edge-length error of the
+ * edges around the vertex. */
+ES_API const double *es_embedder_vertex_closure(const es_embedder *emb);
+ES_API const double *es_embedder_vertex_edge_error(const es_embedder *emb);
+ES_API const es_mesh *es_embedder_mesh(const es_embedder *emb);
+
+/* Closure energy E(alpha) = sum_v ||P_v - I||_F^2 (eq. 2-3) with corner
+ * angles from `len` (E) and dihedrals `alpha` (E). Optional outputs (NULL
+ * to skip): grad (E, dE/dalpha, 0 on boundary edges), vertex_energy (V). */
+ES_API es_status es_embed_closure(es_ctx *ctx, const es_mesh *mesh, const double *len,
+                                  const double *alpha, double *energy, double *grad,
+                                  double *vertex_energy);
+
+/* Edge-length error metrics of positions xyz against target lengths
+ * (scaled to the same sum first when normalize is 1). */
+ES_API es_status es_embed_length_error(es_ctx *ctx, const es_mesh *mesh, const double *xyz,
+                                       const double *target, int normalize, double *rms_ratio,
+                                       double *max_rel, double *p99_rel);
+
+/* Rigidly align xyz (3 x V, in place) onto ref (3 x V) by the proper
+ * rotation and translation of least squares (Kabsch 1976); vertices with
+ * weight 0 (w NULL: all 1) do not count. *rms gets the RMS distance after. */
+ES_API es_status es_kabsch_align(es_ctx *ctx, int64_t nverts, double *xyz, const double *ref,
+                                 const double *w, double *rms);
+
+/* ---- with a store (lib/embed_store.c) --------------------------------
+ * One-line and multi-line text of a report (for commands and notebooks):
+ * writes at most n bytes with NUL, returns buf. */
+ES_API const char *es_embed_report_format(const es_embed_report *rep, char *buf, size_t n);
+
+/* The stored row nearest to normalized lengths `target` (E) in Euclidean
+ * edge-length distance: the default initialization. rows/nrows restrict the
+ * search (NULL: all rows). */
+ES_API es_status es_embed_nearest_row(es_ctx *ctx, es_store *store, const double *target,
+                                      const int64_t *rows, int64_t nrows, int64_t *row,
+                                      double *dist);
+
+/* Circular mean of the dihedrals of stored rows (E): the angle of the mean
+ * unit vector per edge (oracle README, failure F). */
+ES_API es_status es_embed_mean_dihedrals(es_ctx *ctx, es_store *store, const es_mesh *mesh,
+                                         const int64_t *rows, int64_t nrows, double *alpha);
+
+/* Store an embedding as /analysis/embed/<name>: datasets positions (V x 3),
+ * target_lengths (E, normalized), vertex_closure and vertex_edge_error
+ * (V, for heat maps, from the embedder's last solve), and the report as
+ * attributes (closure_before, closure_after, rms_ratio, max_rel, p99_rel,
+ * n_bad_faces, realized, iterations, seconds per stage, init). Commit is
+ * the caller's. */
+ES_API es_status es_embed_store_result(es_ctx *ctx, es_store *store, const char *name,
+                                       const es_provenance *prov, const es_embedder *emb,
+                                       const double *target, const double *xyz,
+                                       const es_embed_report *rep, const char *init);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
