@@ -4,8 +4,8 @@
  * Edges are found by bucketing the 3F half-edges by their smaller vertex
  * (a counting sort, O(V + F)) and sorting each bucket by the larger one;
  * buckets hold a vertex's degree, so this is O(F log max-degree) overall.
- * Duplicate faces are found by sorting the faces by their sorted vertex
- * triple (O(F log F)). Vertex stars are built in mesh_stars.c, boundary
+ * Duplicate faces share all three edges, so they are found by comparing
+ * the faces within each edge's group. Vertex stars are built in mesh_stars.c, boundary
  * loops and components in mesh_boundary.c. The conventions (edge order,
  * edge_faces rows, fan order) are those of es_mesh.h and of the embedding
  * oracle (../shared/oracle/README.md, conventions 2 and 6).
@@ -32,40 +32,13 @@ static es_status check_indices(es_ctx *ctx, int64_t nv, int64_t nf, const int64_
     return ES_OK;
 }
 
-typedef struct sorted_face { int64_t v[3], f; } sorted_face;
-
-static int cmp_sorted_face(const void *pa, const void *pb)
+/* Two faces with the same vertex set (in any order). */
+static int same_vertex_set(const int64_t *faces, int64_t f, int64_t g)
 {
-    const sorted_face *a = pa, *b = pb;
+    const int64_t *a = faces + 3 * f, *b = faces + 3 * g;
     for (int k = 0; k < 3; k++)
-        if (a->v[k] != b->v[k]) return a->v[k] < b->v[k] ? -1 : 1;
-    return a->f < b->f ? -1 : a->f > b->f;
-}
-
-static es_status check_duplicates(es_ctx *ctx, int64_t nf, const int64_t *faces)
-{
-    es_status rc = ES_OK;
-    sorted_face *s = es__alloc_array(ctx, nf, sizeof *s);
-    if (!s && nf > 0) return ES_ENOMEM;
-    for (int64_t f = 0; f < nf; f++) {
-        int64_t a = faces[3 * f], b = faces[3 * f + 1], c = faces[3 * f + 2], t;
-        if (a > b) { t = a; a = b; b = t; }
-        if (b > c) { t = b; b = c; c = t; }
-        if (a > b) { t = a; a = b; b = t; }
-        s[f] = (sorted_face){{a, b, c}, f};
-    }
-    if (nf > 1) qsort(s, (size_t)nf, sizeof *s, cmp_sorted_face);
-    for (int64_t i = 1; i < nf; i++)
-        if (s[i].v[0] == s[i - 1].v[0] && s[i].v[1] == s[i - 1].v[1] &&
-            s[i].v[2] == s[i - 1].v[2]) {
-            rc = es__fail(ctx, ES_ETOPOLOGY,
-                          "mesh: faces %lld and %lld are duplicates (vertices %lld, %lld, %lld)",
-                          (long long)s[i - 1].f, (long long)s[i].f, (long long)s[i].v[0],
-                          (long long)s[i].v[1], (long long)s[i].v[2]);
-            break;
-        }
-    es__free(ctx, s);
-    return rc;
+        if (a[k] != b[0] && a[k] != b[1] && a[k] != b[2]) return 0;
+    return 1;
 }
 
 /* ---- canonical edges ---- */
@@ -140,6 +113,18 @@ static es_status build_edges(es_ctx *ctx, es_mesh *m)
             j++;
         int64_t a = he_from(faces, h[i].he), b = he_to(faces, h[i].he);
         int64_t emin = a < b ? a : b, emax = a < b ? b : a;
+        /* duplicated faces share all their edges, so they meet in a group */
+        for (int64_t p = i; p < j && j - i <= 16; p++)
+            for (int64_t q = p + 1; q < j; q++)
+                if (same_vertex_set(faces, h[p].he / 3, h[q].he / 3)) {
+                    const int64_t *t = faces + h[p].he - h[p].he % 3;
+                    rc = es__fail(ctx, ES_ETOPOLOGY,
+                                  "mesh: faces %lld and %lld are duplicates "
+                                  "(vertices %lld, %lld, %lld)",
+                                  (long long)(h[p].he / 3), (long long)(h[q].he / 3),
+                                  (long long)t[0], (long long)t[1], (long long)t[2]);
+                    goto done;
+                }
         if (j - i > 2) {
             rc = es__fail(ctx, ES_ETOPOLOGY,
                           "mesh: edge (%lld, %lld) is shared by %lld faces (%lld, %lld, %lld%s)",
@@ -224,7 +209,6 @@ es_status es_mesh_new(es_ctx *ctx, int64_t nverts, int64_t nfaces, const int64_t
         ES_FAIL(ctx, ES_ERANGE, "mesh: %lld faces / %lld vertices overflow",
                 (long long)nfaces, (long long)nverts);
     if ((rc = check_indices(ctx, nverts, nfaces, faces)) != ES_OK) return rc;
-    if ((rc = check_duplicates(ctx, nfaces, faces)) != ES_OK) return rc;
 
     m = es__calloc(ctx, 1, sizeof *m);
     if (!m) return ES_ENOMEM;

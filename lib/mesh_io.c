@@ -1,17 +1,10 @@
 /* lib/mesh_io.c — mesh file reading and writing: format dispatch, the
- * shared builder, the exact fast number parser, whole-file reading.
+ * shared builder, whole-file reading, es_mesh_read and es_mesh_write.
  *
  * Files are read whole into memory and parsed in place: for the OBJ files
  * this project reads (tens of MB per study) that is far faster than stdio
- * line reading and lets the parsers report exact line numbers. Numbers go
- * through es__parse_double, which is Clinger's fast path (Clinger 1990,
- * "How to read floating point numbers accurately"): a decimal with at most
- * 19 significant digits whose value m * 10^e has m <= 2^53 and |e| <= 22 is
- * m and 10^|e| exactly represented, so one IEEE multiply or divide gives the
- * correctly rounded result, identical to strtod's. Everything else (long
- * mantissas, large exponents, hex, inf/nan) goes to strtod on a
- * NUL-terminated copy of the token. strtod follows LC_NUMERIC; programs
- * that change it must expect '.' decimals to fail on the slow path.
+ * line reading and lets the parsers report exact line numbers. Numbers are
+ * parsed by mesh_io_num.c.
  *
  * Formats (datasets-spec/mesh-formats.md): mesh_io_obj.c, mesh_io_ply.c,
  * mesh_io_off.c.
@@ -19,7 +12,6 @@
 #include "mesh_io_internal.h"
 
 #include <errno.h>
-#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -89,110 +81,6 @@ void es__mdbuild_finish(es__mdbuild *b)
     if (md->faces && md->nfaces > 0 && md->nfaces < b->fcap &&
         (p = es__realloc(b->ctx, md->faces, (size_t)md->nfaces * 3 * sizeof(int64_t))))
         md->faces = p;
-}
-
-/* ---------------------------------------------------------------- numbers */
-
-static const double pow10_exact[23] = {
-    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11,
-    1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
-
-#define MAX_TOKEN 512
-
-static const char *parse_double_slow(const char *p, const char *end, double *out)
-{
-    char tok[MAX_TOKEN + 1];
-    size_t n = 0;
-    char *stop;
-    while (p + n < end && !es__is_delim(p[n])) {
-        if (n == MAX_TOKEN) return NULL;
-        tok[n] = p[n];
-        n++;
-    }
-    if (n == 0) return NULL;
-    tok[n] = '\0';
-    errno = 0;
-    *out = strtod(tok, &stop);
-    /* ERANGE is not an error here: strtod's rounded result (0, a
-     * subnormal or inf) is the value, and the callers reject inf. */
-    if (stop != tok + n) return NULL;
-    return p + n;
-}
-
-const char *es__parse_double(const char *p, const char *end, double *out)
-{
-    const char *s = p, *d0;
-    bool neg = false, any;
-    uint64_t m = 0;
-    int nd = 0, e10 = 0;
-
-    if (p < end && (*p == '-' || *p == '+')) neg = *p++ == '-';
-    d0 = p;
-    for (; p < end && (unsigned)(*p - '0') < 10; p++) {
-        if (nd == 19) return parse_double_slow(s, end, out);
-        m = m * 10 + (uint64_t)(*p - '0');
-        nd += m != 0;
-    }
-    any = p > d0;
-    if (p < end && *p == '.') {
-        const char *f0 = ++p;
-        for (; p < end && (unsigned)(*p - '0') < 10; p++) {
-            if (nd == 19) return parse_double_slow(s, end, out);
-            m = m * 10 + (uint64_t)(*p - '0');
-            nd += m != 0;
-            e10--;
-        }
-        any = any || p > f0;
-    }
-    if (!any) return parse_double_slow(s, end, out);
-    if (p < end && (*p == 'e' || *p == 'E')) {
-        bool eneg = false;
-        int x = 0;
-        const char *x0;
-        p++;
-        if (p < end && (*p == '-' || *p == '+')) eneg = *p++ == '-';
-        x0 = p;
-        for (; p < end && (unsigned)(*p - '0') < 10; p++)
-            if (x < 100000) x = x * 10 + (*p - '0');
-        if (p == x0) return parse_double_slow(s, end, out);
-        e10 += eneg ? -x : x;
-    }
-    if (p < end && !es__is_delim(*p)) return parse_double_slow(s, end, out);
-#if defined(FLT_EVAL_METHOD) && FLT_EVAL_METHOD == 0
-    if (m == 0) {
-        *out = neg ? -0.0 : 0.0;
-        return p;
-    }
-    if (m <= (UINT64_C(1) << 53) && e10 >= -22 && e10 <= 22) {
-        double v = (double)m;
-        v = e10 < 0 ? v / pow10_exact[-e10] : v * pow10_exact[e10];
-        *out = neg ? -v : v;
-        return p;
-    }
-#endif
-    return parse_double_slow(s, end, out);
-}
-
-const char *es__parse_int64(const char *p, const char *end, int64_t *out)
-{
-    bool neg = false;
-    uint64_t v = 0;
-    const char *d0;
-    if (p < end && (*p == '-' || *p == '+')) neg = *p++ == '-';
-    d0 = p;
-    for (; p < end && (unsigned)(*p - '0') < 10; p++) {
-        if (v > (UINT64_MAX - 9) / 10) return NULL;
-        v = v * 10 + (uint64_t)(*p - '0');
-    }
-    if (p == d0) return NULL;
-    if (neg) {
-        if (v > (uint64_t)INT64_MAX + 1) return NULL;
-        *out = v == (uint64_t)INT64_MAX + 1 ? INT64_MIN : -(int64_t)v;
-    } else {
-        if (v > (uint64_t)INT64_MAX) return NULL;
-        *out = (int64_t)v;
-    }
-    return p;
 }
 
 /* ---------------------------------------------------------------- files */
@@ -319,6 +207,13 @@ es_status es_meshdata_parse(es_ctx *ctx, const char *name, const char *buf, size
     if (!buf && len) ES_FAIL(ctx, ES_EINVAL, "%s: buffer is NULL", name);
     if (!buf) buf = "";
     if (format == ES_FORMAT_AUTO) format = es_mesh_format_from_path(name);
+    /* a UTF-8 byte order mark before a text format (editors on Windows);
+     * PLY keeps it so that binary byte offsets stay those of the file */
+    if (len >= 3 && !memcmp(buf, "\xEF\xBB\xBF", 3) && format != ES_FORMAT_PLY &&
+        format != ES_FORMAT_PLY_ASCII) {
+        buf += 3;
+        len -= 3;
+    }
     if (format == ES_FORMAT_AUTO) format = sniff(buf, len);
     switch (format) {
     case ES_FORMAT_OBJ: rc = es__obj_parse(ctx, name, buf, len, out); break;

@@ -110,8 +110,8 @@ es_status es__off_parse(es_ctx *ctx, const char *name, const char *buf, size_t l
     es__mdbuild b;
     es_status rc;
     int64_t nv, nf, npoly = 0, poly_line = 0;
-    const char *w;
-    size_t n;
+    const char *w = buf;
+    size_t n = 0;
 
     es__mdbuild_init(&b, ctx, md);
     if (!next_line(&P, true)) ES_FAIL(ctx, ES_EFORMAT, "%s:%" PRId64 ": empty file", name, P.line);

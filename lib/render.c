@@ -47,6 +47,17 @@ void es_render_spec_init(es_render_spec *spec)
     spec->supersample = 3;
 }
 
+void es_render_mesh_from(es_render_mesh *item, const es_mesh *mesh, const double *xyz)
+{
+    memset(item, 0, sizeof *item);
+    item->nverts = es_mesh_nverts(mesh);
+    item->nfaces = es_mesh_nfaces(mesh);
+    item->faces = es_mesh_faces(mesh);
+    item->xyz = xyz ? xyz : es_mesh_xyz(mesh);
+    item->nedges = es_mesh_nedges(mesh);
+    item->edges = es_mesh_edges(mesh);
+}
+
 /* ---- small vector helpers ---------------------------------------------- */
 
 static double dot3(const double *a, const double *b)
@@ -353,7 +364,7 @@ static void project(const camera *cam, const double *q, double W, double H, doub
 
 typedef struct raster {
     int w, h;                  /* supersampled size */
-    float *rgb;                /* 3 x w x h */
+    uint32_t *rgb;             /* w x h, 0x00RRGGBB: 8 bits are plenty before averaging */
     float *depth;              /* w x h, +inf: empty */
 } raster;
 
@@ -367,8 +378,18 @@ typedef struct shade_in {
     int64_t drawn, back;
 } shade_in;
 
-static void shade(const shade_in *in, const double n_in[3], double value, int back,
-                  const double light[3], float out[3])
+static uint32_t pack_rgb(const double c[3])
+{
+    uint32_t p = 0;
+    for (int k = 0; k < 3; k++) {
+        double v = c[k] < 0 ? 0 : c[k] > 1 ? 1 : c[k];
+        p |= (uint32_t)(v * 255 + 0.5) << (16 - 8 * k);
+    }
+    return p;
+}
+
+static uint32_t shade(const shade_in *in, const double n_in[3], double value, int back,
+                      const double light[3])
 {
     const es_render_spec *spec = in->spec;
     double n[3] = {n_in[0], n_in[1], n_in[2]}, base[3];
@@ -378,12 +399,13 @@ static void shade(const shade_in *in, const double n_in[3], double value, int ba
     if (in->m->scalar_kind == ES_SCALARS_NONE) memcpy(base, spec->base_rgb, sizeof base);
     else es_colormap_rgb(spec->cmap, isfinite(value) ? (value - in->vmin) / (in->vmax - in->vmin)
                                                      : NAN, base);
-    double k = 0.25 + 0.75 * lam, spec_term = 0.12 * pow(lam, 40);
+    /* a small Blinn-Phong highlight (exponent 40) under the headlight */
+    double l2 = lam * lam, l4 = l2 * l2, l8 = l4 * l4, l32 = l8 * l8 * l8 * l8;
+    double k = 0.25 + 0.75 * lam, spec_term = 0.12 * l32 * l8;
     if (back) k *= 0.55, spec_term = 0;
-    for (int c = 0; c < 3; c++) {
-        double v = base[c] * k + spec_term;
-        out[c] = (float)(v < 0 ? 0 : v > 1 ? 1 : v);
-    }
+    double c[3];
+    for (int j = 0; j < 3; j++) c[j] = base[j] * k + spec_term;
+    return pack_rgb(c);
 }
 
 static void raster_mesh(raster *R, const camera *cam, shade_in *in, const double *q,
@@ -435,7 +457,7 @@ static void raster_mesh(raster *R, const camera *cam, shade_in *in, const double
                 double val = fval;
                 if (m->scalar_kind == ES_SCALARS_VERTEX)
                     val = w0 * m->scalars[a] + w1 * m->scalars[b] + w2 * m->scalars[c];
-                shade(in, n, val, back, light, R->rgb + 3 * idx);
+                R->rgb[idx] = shade(in, n, val, back, light);
             }
         }
         if (any) in->drawn++;
@@ -469,13 +491,11 @@ static void downsample(const raster *R, int ss, unsigned char *data, int stride,
             double acc[3] = {0, 0, 0};
             for (int j = 0; j < ss; j++)
                 for (int i = 0; i < ss; i++) {
-                    const float *p = R->rgb + 3 * ((size_t)(y * ss + j) * (size_t)R->w +
-                                                   (size_t)(x * ss + i));
-                    acc[0] += p[0], acc[1] += p[1], acc[2] += p[2];
+                    uint32_t p = R->rgb[(size_t)(y * ss + j) * (size_t)R->w + (size_t)(x * ss + i)];
+                    acc[0] += (p >> 16) & 0xff, acc[1] += (p >> 8) & 0xff, acc[2] += p & 0xff;
                 }
             uint32_t px = 0xffu << 24;
-            for (int k = 0; k < 3; k++)
-                px |= (uint32_t)lrint(fmin(1, fmax(0, acc[k] * inv)) * 255) << (16 - 8 * k);
+            for (int k = 0; k < 3; k++) px |= (uint32_t)(acc[k] * inv + 0.5) << (16 - 8 * k);
             row[x] = px;
         }
     }
@@ -580,13 +600,17 @@ es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
         cairo_destroy(tcr);
         cairo_surface_destroy(tmp);
     }
-    if ((int64_t)W * n + cb_w > 16384) {
-        rc = es__fail(ctx, ES_ERANGE, "render: %lld panels of width %d are too wide",
-                      (long long)n, W);
+    int64_t ncols = spec->ncols > 0 && spec->ncols < n ? spec->ncols : n;
+    int64_t nrows = (n + ncols - 1) / ncols, pitch = H + label_h;
+    if ((int64_t)W * ncols + cb_w > 16384 || title_h + pitch * nrows > 16384) {
+        rc = es__fail(ctx, ES_ERANGE, "render: %lld panels of %d x %d in %lld columns make "
+                      "a picture over 16384 pixels", (long long)n, W, H, (long long)ncols);
         goto done;
     }
-    rep.width = (int)(W * n) + cb_w;
-    rep.height = title_h + H + label_h;
+    rep.width = (int)(W * ncols) + cb_w;
+    rep.height = (int)(title_h + pitch * nrows);
+    rep.ncols = (int)ncols;
+    rep.row_pitch = (double)pitch;
     rep.panel_x0 = 0;
     rep.panel_y0 = title_h;
 
@@ -598,8 +622,10 @@ es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
     }
     R.w = W * ss;
     R.h = H * ss;
-    R.rgb = es__alloc_array(ctx, (int64_t)npx * 3, sizeof *R.rgb);
-    R.depth = es__alloc_array(ctx, (int64_t)npx, sizeof *R.depth);
+    /* not zeroed: every panel clears them (npx * 4 bytes cannot overflow:
+     * npx <= 8192^2 * 16) */
+    R.rgb = es__malloc(ctx, npx * sizeof *R.rgb);
+    R.depth = es__malloc(ctx, npx * sizeof *R.depth);
     q = es__alloc_array(ctx, 3 * maxv, sizeof *q);
     sx = es__alloc_array(ctx, maxv, sizeof *sx);
     sy = es__alloc_array(ctx, maxv, sizeof *sy);
@@ -626,9 +652,10 @@ es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
         const es_render_mesh *m = &spec->meshes[i];
         const camera *cam = &cams[i];
         es__progress(ctx, "render", i, n);
+        uint32_t bg = pack_rgb(spec->background_rgb);
         for (size_t p = 0; p < npx; p++) {
             R.depth[p] = INFINITY;
-            for (int k = 0; k < 3; k++) R.rgb[3 * p + k] = (float)spec->background_rgb[k];
+            R.rgb[p] = bg;
         }
         for (int64_t v = 0; v < m->nverts; v++) {
             to_camera(cam, m->xyz + 3 * v, q + 3 * v);
@@ -648,7 +675,8 @@ es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
         downsample(&R, ss, cairo_image_surface_get_data(panel),
                    cairo_image_surface_get_stride(panel), W, H);
         cairo_surface_mark_dirty(panel);
-        cairo_set_source_surface(cr, panel, (double)(W * i), title_h);
+        double px0 = (double)(W * (i % ncols)), py0 = (double)(title_h + pitch * (i / ncols));
+        cairo_set_source_surface(cr, panel, px0, py0);
         cairo_paint(cr);
         if (cv.kind != ES__CANVAS_PNG) {
             /* vector surfaces may keep a reference to the image: give the
@@ -662,20 +690,31 @@ es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
         }
         if (m->label && *m->label) {
             cairo_set_source_rgb(cr, 0, 0, 0);
-            es__text(cr, W * (i + 0.5), title_h + H + 0.4 * fs, m->label, fs, 0.5, 0, 0);
+            es__text(cr, px0 + 0.5 * W, py0 + H + 0.4 * fs, m->label, fs, 0.5, 0, 0);
         }
     }
     es__progress(ctx, "render", n, n);
     if (title_h) {
         cairo_set_source_rgb(cr, 0, 0, 0);
-        es__text(cr, 0.5 * (double)(W * n), 0.6 * fs, spec->title, 1.15 * fs, 0.5, 0, 0);
+        es__text(cr, 0.5 * (double)(W * ncols), 0.6 * fs, spec->title, 1.15 * fs, 0.5, 0, 0);
     }
     if (cbar) {
-        double x = round((double)(W * n) + fs), y = round(title_h + 0.1 * H),
-               w = round(fs), h = round(0.8 * H);
+        /* beside the first row, or centred on all rows */
+        double span = (double)(pitch * (nrows - 1) + H);
+        double x = round((double)(W * ncols) + fs), y = round(title_h + 0.1 * span),
+               w = round(fs), h = round(0.8 * span);
         es__draw_colorbar(cr, x, y, w, h, spec->cmap, rep.vmin, rep.vmax, spec->colorbar_label,
                           fs);
         rep.colorbar[0] = x, rep.colorbar[1] = y, rep.colorbar[2] = w, rep.colorbar[3] = h;
+        if (rep.n_nan_scalars > 0) {
+            /* a key for the grey of missing values, under the bar */
+            double ky = y + h + 0.6 * fs;
+            cairo_set_source_rgb(cr, ES_NAN_GREY, ES_NAN_GREY, ES_NAN_GREY);
+            cairo_rectangle(cr, x, ky, w, w);
+            cairo_fill(cr);
+            cairo_set_source_rgb(cr, 0, 0, 0);
+            es__text(cr, x + w + 6, ky + 0.5 * w, "n/a", 0.85 * fs, 0, 0.5, 0);
+        }
     }
     rc = es__canvas_close(ctx, &cv);
 done:

@@ -4,8 +4,9 @@
  * The shapes themselves are in synth_shapes.c. Subdivision numbers the new
  * vertices by edge id, so a subdivided family stays in correspondence and
  * the result is the same on every run. Members are written with the io
- * module's writer (es__meshdata_write: OBJ, %.17g, exact round trips),
- * which needs no topology; es_mesh_write is not on main yet.
+ * module's writer core es__meshdata_write (the body of es_mesh_write: OBJ,
+ * %.17g, exact round trips), which takes the raw face list, so no topology
+ * is built just to write files.
  */
 #include "synth_internal.h"
 #include "edgespace/es_mesh.h"

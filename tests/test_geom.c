@@ -361,6 +361,24 @@ static void test_oracle(es_ctx *ctx)
     }
 }
 
+static void *null_malloc(void *ud, size_t n) { (void)ud; (void)n; return NULL; }
+static void *null_realloc(void *ud, void *p, size_t n) { (void)ud; (void)p; (void)n; return NULL; }
+static void plain_free(void *ud, void *p) { (void)ud; free(p); }
+
+/* The only allocation of the module (face normals) fails cleanly. */
+static void test_alloc_failure(es_ctx *ctx)
+{
+    es_mesh *m = NULL;
+    double al[12];
+    ES_CHECK_OK(ctx, es_mesh_new(ctx, 6, 8, oct_faces, oct_xyz, &m));
+    if (!m) return;
+    es_allocator a = {null_malloc, null_realloc, plain_free, NULL};
+    es_ctx_set_allocator(ctx, &a);
+    ES_CHECK_FAILS(ctx, es_dihedral_angles(ctx, m, oct_xyz, al), ES_ENOMEM, "out of memory");
+    es_ctx_set_allocator(ctx, NULL);
+    es_mesh_free(m);
+}
+
 int main(void)
 {
     es_ctx *ctx = NULL;
@@ -371,6 +389,7 @@ int main(void)
     test_cube(ctx);
     test_needles(ctx);
     test_oracle(ctx);
+    test_alloc_failure(ctx);
     es_ctx_free(ctx);
     ES_TEST_END();
 }

@@ -101,8 +101,8 @@ static void test_numbers(void)
     es__rng rng;
     char s[128];
     es__rng_init(&rng, 12345);
-    for (int it = 0; it < 300000; it++) {
-        int kind = (int)es__rng_below(&rng, 6);
+    for (int it = 0; it < 600000; it++) {
+        int kind = (int)es__rng_below(&rng, 11);
         uint64_t bits = es__rng_next(&rng);
         double d;
         memcpy(&d, &bits, sizeof d);
@@ -115,6 +115,28 @@ static void test_numbers(void)
                      (es__rng_uniform(&rng) - 0.5) * pow(10, (double)es__rng_below(&rng, 12)));
         } else if (kind == 3 && isfinite(d)) {
             snprintf(s, sizeof s, "%a", d);
+        } else if (kind == 6) {
+            /* what the writers produce: %.17g of coordinate-sized values */
+            snprintf(s, sizeof s, "%.17g", (es__rng_uniform(&rng) - 0.5) *
+                     pow(10, (double)es__rng_below(&rng, 81) - 40));
+        } else if (kind == 7) {
+            snprintf(s, sizeof s, "%.*e", 15 + (int)es__rng_below(&rng, 4),
+                     (es__rng_uniform(&rng) - 0.5) *
+                         pow(10, (double)es__rng_below(&rng, 221) - 110));
+        } else if (kind == 8) {
+            /* 16 to 19 digit mantissas with exponents around the table's
+             * range (+-100) and beyond */
+            uint64_t w = es__rng_next(&rng) % UINT64_C(10000000000000000000);
+            snprintf(s, sizeof s, "%" PRIu64 "e%d", w, (int)es__rng_below(&rng, 261) - 130);
+        } else if (kind == 9) {
+            /* exact halfway cases: odd integers in (2^53, 2^54) and those
+             * = 2 mod 4 in (2^54, 2^55), times small powers of ten */
+            uint64_t w = (UINT64_C(1) << 53) + (es__rng_next(&rng) >> 11);
+            if (es__rng_below(&rng, 2)) w = ((UINT64_C(1) << 54) + (es__rng_next(&rng) >> 10)) | 2;
+            w |= 1 & ~(w >> 54);
+            int q = (int)es__rng_below(&rng, 8) - 4;
+            if (q < 0 && es__rng_below(&rng, 2)) q = 0;
+            snprintf(s, sizeof s, "%" PRIu64 "e%d", w, q);
         } else {
             /* digits with a random point, sign and exponent */
             int nd = 1 + (int)es__rng_below(&rng, 24), dot = (int)es__rng_below(&rng, nd + 2);
@@ -229,6 +251,12 @@ static void test_syntax(es_ctx *ctx)
              strstr(last_warning, "line 2"));
     es_meshdata_clear(ctx, &md);
 
+    /* a UTF-8 byte order mark is skipped */
+    ES_CHECK_OK(ctx, parse_str(ctx, "bom.obj", "\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                               "f 1 2 3\n", &md));
+    ES_CHECK(md.nverts == 3 && md.nfaces == 1);
+    es_meshdata_clear(ctx, &md);
+
     /* a pentagon: fan (0,1,2) (0,2,3) (0,3,4) */
     ES_CHECK_OK(ctx, parse_str(ctx, "pent.obj", "v 0 0 0\nv 1 0 0\nv 2 1 0\nv 1 2 0\n"
                                "v 0 1 0\nf 1 2 3 4 5\n", &md));
@@ -254,6 +282,7 @@ static void test_syntax(es_ctx *ctx)
     }
 
     /* PLY ascii with a quad and vertex_index */
+    n_warnings = 0;
     ES_CHECK_OK(ctx, parse_str(ctx, "quad.ply", "ply\nformat ascii 1.0\nelement vertex 4\n"
                                "property int x\nproperty int y\nproperty int z\n"
                                "element face 1\nproperty list uchar uint vertex_index\n"
@@ -261,7 +290,8 @@ static void test_syntax(es_ctx *ctx)
     {
         static const int64_t f[6] = {0, 2, 1, 0, 1, 3};
         check_arrays(&md, 4, tet_xyz, 2, f, "quad.ply");
-        ES_CHECK(md.n_polygons_split == 1);
+        ES_CHECK(md.n_polygons_split == 1 && n_warnings == 1 &&
+                 strstr(last_warning, "quad.ply: 1 polygon with more than 3 corners"));
     }
     es_meshdata_clear(ctx, &md);
 

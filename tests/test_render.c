@@ -386,6 +386,22 @@ static void test_auto_view(es_ctx *ctx)
         ES_CHECK_MSG(diff < 0.005, "mean difference %g", diff);
         tp_free(&im);
     }
+    /* the same four in a 2 x 2 grid: panel 3 is at column 1, row 1 */
+    spec.ncols = 2;
+    const char *grid = tp_path("render", "grid.png");
+    es_render_report rg;
+    ES_CHECK_OK(ctx, es_render(ctx, &spec, grid, &rg));
+    ES_CHECK(rg.ncols == 2 && rg.width == 2 * 320 && rg.height == (int)(rg.panel_y0 + 2 * rg.row_pitch));
+    ES_CHECK(tp_load(grid, &im) == 0);
+    if (im.s) {
+        for (int i = 0; i < 4; i++) {
+            int x0 = (int)rg.panel_x0 + 320 * (i % 2), y0 = (int)(rg.panel_y0 + rg.row_pitch * (i / 2));
+            int64_t c = count_foreground(&im, x0, y0, x0 + 320, y0 + 320);
+            ES_CHECK_MSG(c > 0.2 * 320 * 320, "grid panel %d: %lld pixels", i, (long long)c);
+        }
+        tp_free(&im);
+    }
+    spec.ncols = 0;
     const char *svg = tp_path("render", "row.svg");
     ES_CHECK_OK(ctx, es_render(ctx, &spec, svg, &rep));
     ES_CHECK(tp_file_has(svg, "<?xml", "<svg") && tp_file_size(svg) > 20000);
@@ -511,6 +527,40 @@ static void test_shared_faces(es_ctx *ctx)
             es_mesh_free(m);
         }
     }
+    /* per-edge scalars through es_render_mesh_from: the log ratio of the
+     * happy and neutral edge lengths, drawn on the happy face */
+    es_mesh *topo = NULL;
+    ES_CHECK_OK(ctx, es_mesh_new(ctx, md[0].nverts, md[0].nfaces, md[0].faces, md[0].xyz, &topo));
+    if (topo) {
+        es_render_mesh e;
+        es_render_mesh_from(&e, topo, md[1].xyz);
+        ES_CHECK(e.xyz == md[1].xyz && e.nedges == es_mesh_nedges(topo) && e.faces);
+        double *lr = malloc((size_t)e.nedges * sizeof *lr);
+        for (int64_t k = 0; k < e.nedges; k++) {
+            double la = 0, lb = 0;
+            for (int c = 0; c < 3; c++) {
+                double d0 = md[0].xyz[3 * e.edges[2 * k] + c] - md[0].xyz[3 * e.edges[2 * k + 1] + c];
+                double d1 = md[1].xyz[3 * e.edges[2 * k] + c] - md[1].xyz[3 * e.edges[2 * k + 1] + c];
+                la += d0 * d0, lb += d1 * d1;
+            }
+            lr[k] = 0.5 * log(lb / la);
+        }
+        e.scalar_kind = ES_SCALARS_EDGE;
+        e.scalars = lr;
+        e.label = "log(happy / neutral) per edge";
+        es_render_spec sp;
+        es_render_spec_init(&sp);
+        sp.meshes = &e;
+        sp.nmeshes = 1;
+        sp.cmap = ES_CMAP_RDBU;
+        sp.vmin = -0.3, sp.vmax = 0.3;
+        es_render_report r2;
+        ES_CHECK_OK(ctx, es_render(ctx, &sp, tp_path("render", "face_study_edge_ratio.png"), &r2));
+        ES_CHECK(r2.vmin == -0.3 && r2.vmax == 0.3);
+        free(lr);
+        es_mesh_free(topo);
+    }
+
     es_render_spec spec;
     es_render_spec_init(&spec);
     spec.meshes = items;
@@ -585,6 +635,51 @@ static void test_cli(void)
     tm_free(&s);
 }
 
+typedef struct failing_alloc { int64_t count, fail_at; } failing_alloc;
+static void *fa_malloc(void *ud, size_t n)
+{
+    failing_alloc *fa = ud;
+    return ++fa->count == fa->fail_at ? NULL : malloc(n);
+}
+static void *fa_realloc(void *ud, void *p, size_t n)
+{
+    failing_alloc *fa = ud;
+    return ++fa->count == fa->fail_at ? NULL : realloc(p, n);
+}
+static void fa_free(void *ud, void *p) { (void)ud; free(p); }
+
+/* Fail the k-th allocation of a two-panel render with per-edge scalars for
+ * k = 1, 2, ... until it succeeds: ES_ENOMEM each time, no leak (ASan). */
+static void test_alloc_failures(es_ctx *ctx)
+{
+    tm_mesh sq = make_square();
+    const int64_t edges[10] = {0, 1, 1, 2, 2, 0, 2, 3, 3, 0};
+    const double ev[5] = {1, 2, 3, 4, NAN};
+    es_render_mesh it[2] = {as_item(&sq, "a"), as_item(&sq, "b")};
+    it[1].scalar_kind = ES_SCALARS_EDGE;
+    it[1].scalars = ev;
+    it[1].edges = edges;
+    it[1].nedges = 5;
+    es_render_spec spec;
+    es_render_spec_init(&spec);
+    spec.meshes = it;
+    spec.nmeshes = 2;
+    spec.width = spec.height = 64;
+    const char *png = tp_path("render", "alloc.png");
+    es_status rc = ES_ENOMEM;
+    int k;
+    for (k = 1; k < 40 && rc == ES_ENOMEM; k++) {
+        failing_alloc fa = {0, k};
+        es_allocator a = {fa_malloc, fa_realloc, fa_free, &fa};
+        es_ctx_set_allocator(ctx, &a);
+        rc = es_render(ctx, &spec, png, NULL);
+        es_ctx_set_allocator(ctx, NULL);
+        ES_CHECK(rc == ES_OK || rc == ES_ENOMEM);
+    }
+    ES_CHECK_MSG(rc == ES_OK && k > 5, "rc %d after %d tries", rc, k);
+    tm_free(&sq);
+}
+
 int main(void)
 {
     es_ctx *ctx = NULL;
@@ -596,6 +691,7 @@ int main(void)
     test_scalars(ctx);
     test_auto_view(ctx);
     test_errors(ctx);
+    test_alloc_failures(ctx);
     test_shared_faces(ctx);
     test_cli();
     es_ctx_free(ctx);

@@ -458,6 +458,18 @@ static void test_files(es_ctx *ctx)
     }
     ES_CHECK_MSG(nv == s.nverts && nf == s.nfaces && bad == 0, "%lld v, %lld f, %lld bad",
                  (long long)nv, (long long)nf, (long long)bad);
+    /* every file written has the set's face list (same fingerprint) */
+    char want_fp[17], got_fp[17];
+    es_faces_fingerprint(s.nverts, s.nfaces, s.faces, want_fp);
+    for (int64_t i = 0; i < s.nmembers; i++) {
+        es_meshdata md;
+        snprintf(path, sizeof path, "%s/out/%s.obj", dir, s.names[i]);
+        ES_CHECK_OK(ctx, es_meshdata_read(ctx, path, ES_FORMAT_OBJ, &md));
+        es_faces_fingerprint(md.nverts, md.nfaces, md.faces, got_fp);
+        ES_CHECK_MSG(md.faces && !strcmp(got_fp, want_fp), "%s: fingerprint %s, want %s", path,
+                     got_fp, want_fp);
+        es_meshdata_clear(ctx, &md);
+    }
     snprintf(path, sizeof path, "%s/new/deeper", dir);    /* parents are created */
     ES_CHECK_OK(ctx, es_synth_write(ctx, &s, path));
     snprintf(path, sizeof path, "%s/out/manifest.csv/below", dir); /* under a file */
@@ -490,6 +502,65 @@ static void test_files(es_ctx *ctx)
     ES_CHECK(system(path) == 0);
 }
 
+/* ---- allocation failures: fail the k-th allocation until success ---- */
+
+typedef struct failing_alloc { int64_t count, fail_at, live; } failing_alloc;
+static void *fa_malloc(void *ud, size_t n)
+{
+    failing_alloc *fa = ud;
+    if (++fa->count == fa->fail_at) return NULL;
+    fa->live++;
+    return malloc(n);
+}
+static void *fa_realloc(void *ud, void *p, size_t n)
+{
+    failing_alloc *fa = ud;
+    if (++fa->count == fa->fail_at) return NULL;
+    if (!p) fa->live++;
+    return realloc(p, n);
+}
+static void fa_free(void *ud, void *p)
+{
+    failing_alloc *fa = ud;
+    if (p) fa->live--;
+    free(p);
+}
+
+static void test_alloc_failures(es_ctx *ctx)
+{
+    for (int what = 0; what < 3; what++) {
+        int ok = 0;
+        for (int64_t k = 1; k < 2000 && !ok; k++) {
+            failing_alloc fa = {0, k, 0};
+            es_allocator al = {fa_malloc, fa_realloc, fa_free, &fa};
+            es_synth_opts o;
+            es_synth_set s;
+            es_status rc;
+            es_synth_opts_init(&o);
+            o.n = 2;
+            o.resolution = 1;
+            es_ctx_set_allocator(ctx, &al);
+            if (what < 2) {
+                rc = es_synth_generate(ctx, what ? ES_SYNTH_BARBELL : ES_SYNTH_FACE, &o, &s);
+                if (rc == ES_OK) rc = es_synth_subdivide(ctx, &s, 1);
+                es_synth_set_clear(ctx, &s);
+            } else {
+                int64_t f[] = {0, 1, 2, 0, 2, 3}, nv, *fo = NULL;
+                double x[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, *xo = NULL;
+                rc = es_mesh_subdivide(ctx, 4, 2, f, 1, x, &nv, &fo, &xo);
+                es_free(ctx, fo);
+                es_free(ctx, xo);
+            }
+            if (rc == ES_OK) ok = 1;
+            else ES_CHECK_MSG(rc == ES_ENOMEM, "case %d, k=%lld: rc %d", what, (long long)k, rc);
+            ES_CHECK_MSG(fa.live == 0, "case %d, k=%lld: %lld blocks leaked", what,
+                         (long long)k, (long long)fa.live);
+            es_ctx_set_allocator(ctx, NULL);
+        }
+        ES_CHECK_MSG(ok, "case %d never succeeded", what);
+    }
+}
+
 int main(void)
 {
     es_ctx *ctx = NULL;
@@ -500,6 +571,7 @@ int main(void)
     test_face(ctx);
     test_subdivide(ctx);
     test_files(ctx);
+    test_alloc_failures(ctx);
     es_ctx_free(ctx);
     ES_TEST_END();
 }

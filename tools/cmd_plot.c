@@ -17,7 +17,9 @@
 
 static void usage(FILE *f)
 {
-    fputs("usage: edgespace plot KIND TABLE.csv -o OUT.png|.svg|.pdf [options]\n\n"
+    fputs("usage: edgespace plot KIND TABLE.csv -o OUT.png|.svg|.pdf [options]\n"
+          "       edgespace plot STORE.h5 --pca NAME [--pcs A,B] [--color COL | --scree] -o OUT\n"
+          "               (the PCA figures; see 'edgespace plot-pca --help')\n\n"
           "KIND is one of:\n"
           "  scatter    points (--x, --y), coloured by the category in --label\n"
           "  lines      one curve per --y column against --x (legend: column names)\n"
@@ -188,8 +190,23 @@ static double *column_values(const table *t, int64_t first, int64_t j, const cha
     return v;
 }
 
+/* "edgespace plot STORE --pca NAME ..." (issue 3's form) is the PCA figure:
+ * any argument ending in .h5, or a --pca/--scree option, sends it there. */
+static int wants_pca_figure(int argc, char **argv)
+{
+    for (int i = 1; i < argc; i++) {
+        size_t n = strlen(argv[i]);
+        if (!strcmp(argv[i], "--pca") || !strncmp(argv[i], "--pca=", 6) ||
+            !strcmp(argv[i], "--scree") || (n > 3 && !strcmp(argv[i] + n - 3, ".h5")))
+            return 1;
+    }
+    return 0;
+}
+
 int cmd_plot(int argc, char **argv)
 {
+    if (wants_pca_figure(argc, argv)) return cmd_plot_pca(argc, argv);
+
     static const struct option opts[] = {
         {"output", required_argument, NULL, 'o'}, {"x", required_argument, NULL, 'x'},
         {"y", required_argument, NULL, 'y'}, {"label", required_argument, NULL, 'l'},

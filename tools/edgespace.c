@@ -22,7 +22,16 @@ static const command commands[] = {
     {"info", cmd_info, "describe a store: topology, rows, labels, results"},
     {"export", cmd_export, "write a store's lengths as CSV or its meshes as files"},
     /* -- statistics, point syntax */
+    {"mean", cmd_mean, "mean edge lengths of all rows, a filter, or per label value"},
+    {"pca", cmd_pca, "principal components of the edge lengths (stored, CSV)"},
+    {"diff", cmd_diff, "mean paired difference (to - from) with per-edge t statistics"},
+    {"project", cmd_project, "scores of rows or mesh files on a stored PCA, with residuals"},
+    {"point", cmd_point, "evaluate and store a point expression (mean + 2*pc:1, ...)"},
+    {"plot-pca", cmd_plot_pca, "PCA score scatter coloured by a label, or scree plot, from a store"},
     /* -- procrustes, landmarks, comparison */
+    {"gpa", cmd_gpa, "generalized Procrustes analysis of a store's positions"},
+    {"compare", cmd_compare, "Procrustes vs edge-length space: distances, Mantel, groups"},
+    {"ingest-landmarks", cmd_ingest_landmarks, "landmarks (TPS, CSV) + triangulation into a store"},
     /* -- embedding, interpolation */
     {"embed", cmd_embed, "realize a point of edge-length space as a mesh, with a quality report"},
     {"interp", cmd_interp, "interpolate/extrapolate stored shapes in edge-length space and embed"},

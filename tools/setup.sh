@@ -10,6 +10,7 @@
 # idempotent: a second run installs nothing). Environment:
 #   BUILD_DIR   build directory (default: build)
 #   MESON_ARGS  extra arguments for 'meson setup' (e.g. -Dwerror=true)
+#   TEST_ARGS   extra arguments for 'meson test' (e.g. --no-suite slow)
 set -euo pipefail
 
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -52,6 +53,7 @@ install_missing
 case "$mode" in
   build) configure_and_build ;;
   demo)  configure_and_build; bash tools/main-job.sh "$build_dir" ;;
-  test)  configure_and_build; meson test -C "$build_dir" --print-errorlogs --num-processes 2 ;;
+  # shellcheck disable=SC2086
+  test)  configure_and_build; meson test -C "$build_dir" --print-errorlogs --num-processes 2 ${TEST_ARGS:-} ;;
   *) echo "usage: $0 [build|demo|test]" >&2; exit 2 ;;
 esac

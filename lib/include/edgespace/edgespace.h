@@ -13,6 +13,12 @@
 #include "es_synth.h"
 #include "es_store.h"
 #include "es_ingest.h"
+#include "es_stats.h"
+#include "es_point.h"
+#include "es_analysis.h"
+#include "es_procrustes.h"
+#include "es_landmarks.h"
+#include "es_compare.h"
 #include "es_embed.h"
 #include "es_interp.h"
 

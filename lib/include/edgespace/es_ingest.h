@@ -68,6 +68,12 @@ ES_API void es_content_hash(const void *buf, size_t len, char out[25]);
 typedef struct es_ingest_opts {
     int create;              /* create the store if it does not exist (1) */
     es_mesh_format format;   /* ES_FORMAT_AUTO: from each file's extension */
+    int threads;             /* files read and parsed at once; 0 (default): one
+                                per online CPU, at most 16. Extra threads use
+                                contexts of their own, so their temporary
+                                buffers come from malloc, not ctx's allocator;
+                                1 keeps every allocation on ctx. Results do not
+                                depend on it. */
 } es_ingest_opts;
 
 ES_API void es_ingest_opts_init(es_ingest_opts *opts);

@@ -1,0 +1,132 @@
+/* lib/compare_store.c — the comparison study on a store: a GPA result's
+ * aligned configurations against the same rows' normalized edge lengths,
+ * grouped by a label column; results to /analysis/compare/<name> and to CSV
+ * files and figures (compare_study.c). */
+#include "es_internal.h"
+#include "edgespace/es_compare.h"
+#include "edgespace/es_store.h"
+
+#include <math.h>
+#include <stdio.h>
+
+/* Group index per row from a label column; names in order of first
+ * appearance (borrowed from the store). */
+static es_status groups_of(es_ctx *ctx, es_store *s, const int64_t *rows, int64_t n,
+                           const char *by, int64_t *group, const char ***names, int64_t *ng)
+{
+    int64_t col = es_store_find_column(s, by);
+    if (col < 0) ES_FAIL(ctx, ES_ENOTFOUND, "compare: no label column '%s'", by);
+    const char **nm = es__alloc_array(ctx, n, sizeof *nm);
+    if (!nm) return ES_ENOMEM;
+    int64_t g = 0;
+    for (int64_t j = 0; j < n; j++) {
+        const char *v = es_store_label(s, rows[j], col);
+        int64_t a = 0;
+        while (a < g && strcmp(nm[a], v)) a++;
+        if (a == g) nm[g++] = v;
+        group[j] = a;
+    }
+    *names = nm;
+    *ng = g;
+    return ES_OK;
+}
+
+es_status es_compare_store_run(es_ctx *ctx, es_store *store, const char *gpa_name,
+                               const char *by, const es_compare_opts *opts, const char *name,
+                               const char *out_dir, int figures, const char *command,
+                               es_compare_result **res)
+{
+    char path[1024];
+    es_status rc;
+    es_mat al = {0}, len = {0};
+    int64_t *rows = NULL, n = 0, *group = NULL, ng = 0, e = es_store_nedges(store);
+    const char **gnames = NULL, **ids = NULL;
+    es_compare_result *r = NULL;
+    if (res) *res = NULL;
+    if (!gpa_name || !*gpa_name || strchr(gpa_name, '/'))
+        ES_FAIL(ctx, ES_EINVAL, "compare: bad GPA result name '%s'", gpa_name ? gpa_name : "");
+    if (e < 1) ES_FAIL(ctx, ES_EINVAL, "compare: the store has no edges (a landmark set needs "
+                       "a triangulation for edge-length statistics)");
+    snprintf(path, sizeof path, "gpa/%s", gpa_name);
+    if (!es_store_has(store, path))
+        ES_FAIL(ctx, ES_ENOTFOUND, "compare: no GPA result '%s' in the store (run 'edgespace gpa "
+                "--name %s' first)", gpa_name, gpa_name);
+    snprintf(path, sizeof path, "gpa/%s/input_rows", gpa_name);
+    if ((rc = es_store_get_ints(ctx, store, path, &rows, &n)) != ES_OK) return rc;
+    snprintf(path, sizeof path, "gpa/%s/aligned", gpa_name);
+    if ((rc = es_store_get_matrix(ctx, store, path, &al)) != ES_OK) goto done;
+    if (al.cols != n) {
+        rc = es__fail(ctx, ES_EFORMAT, "compare: GPA result '%s' has %lld configurations for "
+                      "%lld rows", gpa_name, (long long)al.cols, (long long)n);
+        goto done;
+    }
+    for (int64_t j = 0; j < n; j++)
+        if (rows[j] < 0 || rows[j] >= es_store_nrows(store)) {
+            rc = es__fail(ctx, ES_EFORMAT, "compare: GPA result '%s' names row %lld, the store "
+                          "has %lld", gpa_name, (long long)rows[j], (long long)es_store_nrows(store));
+            goto done;
+        }
+    len.data = es__alloc_array(ctx, e * n, sizeof *len.data);
+    group = es__alloc_array(ctx, n, sizeof *group);
+    ids = es__alloc_array(ctx, n, sizeof *ids);
+    if (!len.data || !group || !ids) { rc = ES_ENOMEM; goto done; }
+    len.rows = e; len.cols = n; len.ld = e;
+    if ((rc = es_store_read_lengths_rows(ctx, store, rows, n, len)) != ES_OK) goto done;
+    for (int64_t j = 0; j < n; j++) ids[j] = es_store_row_id(store, rows[j]);
+    if (by && *by) {
+        if ((rc = groups_of(ctx, store, rows, n, by, group, &gnames, &ng)) != ES_OK) goto done;
+        if (ng < 2) {
+            es__warn(ctx, "compare: column '%s' has one value on these rows; no group tests", by);
+            ng = 0;
+        }
+    }
+    if ((rc = es_compare_study(ctx, len, al, ng ? group : NULL, ng, opts, &r)) != ES_OK) goto done;
+    if (out_dir &&
+        (rc = es_compare_write(ctx, r, ids, ng ? group : NULL, gnames, out_dir, figures)) != ES_OK)
+        goto done;
+    if (!name) name = gpa_name;
+    if (*name) {
+        char params[512], grp[512], v[64];
+        es_compare_opts o;
+        if (opts) o = *opts; else es_compare_opts_init(&o);
+        snprintf(params, sizeof params, "gpa=%s; by=%s; permutations=%lld", gpa_name,
+                 by ? by : "", (long long)o.permutations);
+        es_provenance prov = {command ? command : "es_compare_store_run", rows, n, params};
+        if ((rc = es_store_result_begin(ctx, store, "compare", name, &prov)) != ES_OK) goto done;
+        snprintf(grp, sizeof grp, "compare/%s", name);
+#define PUT(call) do { if ((rc = (call)) != ES_OK) goto done; } while (0)
+#define P(ds) (snprintf(path, sizeof path, "%s/%s", grp, ds), path)
+        PUT(es_store_put_matrix(ctx, store, P("d_lengths"), (es_mat){r->d_len, n, n, n}));
+        PUT(es_store_put_matrix(ctx, store, P("d_procrustes"), (es_mat){r->d_proc, n, n, n}));
+        if (ng) {
+            PUT(es_store_put_matrix(ctx, store, P("group_means_lengths"), (es_mat){r->mean_len, ng, ng, ng}));
+            PUT(es_store_put_matrix(ctx, store, P("group_means_procrustes"), (es_mat){r->mean_proc, ng, ng, ng}));
+            PUT(es_store_put_matrix(ctx, store, P("p_lengths"), (es_mat){r->p_len, ng, ng, ng}));
+            PUT(es_store_put_matrix(ctx, store, P("p_procrustes"), (es_mat){r->p_proc, ng, ng, ng}));
+            PUT(es_store_put_strings(ctx, store, P("group_names"), gnames, ng));
+        }
+        snprintf(v, sizeof v, "%.17g", r->mantel_rho);
+        PUT(es_store_put_attr(ctx, store, grp, "spearman_rho", v));
+        snprintf(v, sizeof v, "%.17g", r->mantel_p);
+        PUT(es_store_put_attr(ctx, store, grp, "mantel_p", v));
+        snprintf(v, sizeof v, "%.17g", r->nn_agreement);
+        PUT(es_store_put_attr(ctx, store, grp, "nn_agreement", v));
+        PUT(es_store_put_attr(ctx, store, grp, "gpa", gpa_name));
+        PUT(es_store_put_attr(ctx, store, grp, "by", by ? by : ""));
+#undef PUT
+#undef P
+    }
+done:
+    if (rc == ES_OK && res) {
+        *res = r;
+        r = NULL;
+    }
+    es_compare_result_free(r);
+    es__free(ctx, al.data);
+    es__free(ctx, len.data);
+    es__free(ctx, rows);
+    es__free(ctx, group);
+    es__free(ctx, gnames);
+    es__free(ctx, ids);
+    return rc;
+}

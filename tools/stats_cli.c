@@ -1,0 +1,102 @@
+/* tools/stats_cli.c — see stats_cli.h. */
+#include "stats_cli.h"
+#include "cli.h"
+
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+
+char *stats_command_line(int argc, char **argv)
+{
+    size_t n = strlen("edgespace") + 1;
+    for (int i = 0; i < argc; i++) n += strlen(argv[i]) + 3;
+    char *s = malloc(n);
+    if (!s) return NULL;
+    strcpy(s, "edgespace");
+    for (int i = 0; i < argc; i++) {
+        strcat(s, " ");
+        int quote = strpbrk(argv[i], " \t\"'") != NULL || !*argv[i];
+        if (quote) strcat(s, "'");
+        strcat(s, argv[i]);
+        if (quote) strcat(s, "'");
+    }
+    return s;
+}
+
+FILE *stats_csv_open(const char *verb, const char *path)
+{
+    if (!strcmp(path, "-")) return stdout;
+    FILE *f = fopen(path, "w");
+    if (!f) fprintf(stderr, "edgespace %s: cannot write '%s': %s\n", verb, path, strerror(errno));
+    return f;
+}
+
+int stats_csv_close(const char *verb, FILE *f, const char *path)
+{
+    int bad = ferror(f);
+    if (f == stdout) return bad ? -1 : (fflush(f) ? -1 : 0);
+    if (fclose(f) != 0) bad = 1;
+    if (bad) fprintf(stderr, "edgespace %s: error writing '%s'\n", verb, path);
+    return bad ? -1 : 0;
+}
+
+void stats_csv_field(FILE *f, const char *s, int first)
+{
+    if (!first) fputc(',', f);
+    if (!s) s = "";
+    if (!strpbrk(s, ",\"\r\n")) {
+        fputs(s, f);
+        return;
+    }
+    fputc('"', f);
+    for (; *s; s++) {
+        if (*s == '"') fputc('"', f);
+        fputc(*s, f);
+    }
+    fputc('"', f);
+}
+
+void stats_csv_number(FILE *f, double v)
+{
+    fprintf(f, ",%.17g", v);
+}
+
+int64_t *stats_edges(const char *verb, es_ctx *ctx, es_store *store)
+{
+    es_mesh *m = NULL;
+    es_status rc = es_store_mesh(ctx, store, &m);
+    if (rc != ES_OK) {
+        cli_fail(verb, ctx, rc);
+        return NULL;
+    }
+    int64_t E = es_mesh_nedges(m);
+    int64_t *e = malloc((size_t)(2 * E > 0 ? 2 * E : 1) * sizeof *e);
+    if (e) memcpy(e, es_mesh_edges(m), (size_t)(2 * E) * sizeof *e);
+    else fprintf(stderr, "edgespace %s: out of memory\n", verb);
+    es_mesh_free(m);
+    return e;
+}
+
+int stats_write_edge_csv(const char *verb, es_ctx *ctx, es_store *store, const char *path,
+                         int64_t ncol, const char *const *names, const double *values)
+{
+    int64_t *edges = stats_edges(verb, ctx, store);
+    if (!edges) return CLI_FAIL;
+    FILE *f = stats_csv_open(verb, path);
+    if (!f) {
+        free(edges);
+        return CLI_FAIL;
+    }
+    const int64_t E = es_store_nedges(store);
+    fputs("edge,v0,v1", f);
+    for (int64_t c = 0; c < ncol; c++) stats_csv_field(f, names[c], 0);
+    fputc('\n', f);
+    for (int64_t e = 0; e < E; e++) {
+        fprintf(f, "%lld,%lld,%lld", (long long)e, (long long)edges[2 * e],
+                (long long)edges[2 * e + 1]);
+        for (int64_t c = 0; c < ncol; c++) stats_csv_number(f, values[e + c * E]);
+        fputc('\n', f);
+    }
+    free(edges);
+    return stats_csv_close(verb, f, path) ? CLI_FAIL : CLI_OK;
+}

@@ -1,0 +1,34 @@
+/* tools/stats_cli.h — glue shared by the statistics commands (mean, pca,
+ * diff, project, point, plot): the command line as provenance, CSV output,
+ * opening a store. */
+#ifndef EDGESPACE_TOOLS_STATS_CLI_H
+#define EDGESPACE_TOOLS_STATS_CLI_H
+
+#include <edgespace/edgespace.h>
+#include <edgespace/es_analysis.h>
+#include <edgespace/es_store.h>
+
+#include <stdio.h>
+
+/* "edgespace VERB ARGS..." (malloc'd; NULL if out of memory). */
+char *stats_command_line(int argc, char **argv);
+
+/* Open a CSV file for writing ("-": stdout); prints the error and returns
+ * NULL on failure. Close with stats_csv_close (0 ok, -1 write error printed). */
+FILE *stats_csv_open(const char *verb, const char *path);
+int stats_csv_close(const char *verb, FILE *f, const char *path);
+/* One field, quoted when it holds a comma, quote or line break (RFC 4180),
+ * preceded by a comma unless first. */
+void stats_csv_field(FILE *f, const char *s, int first);
+void stats_csv_number(FILE *f, double v);
+
+/* Edge end points of the store's topology (2 x E; free()). NULL on failure
+ * (printed). */
+int64_t *stats_edges(const char *verb, es_ctx *ctx, es_store *store);
+
+/* Write the per-edge CSV "edge,v0,v1,<name_0>,...": ncol columns of E
+ * values (column c = values + c * E). 0 ok, 1 failure (printed). */
+int stats_write_edge_csv(const char *verb, es_ctx *ctx, es_store *store, const char *path,
+                         int64_t ncol, const char *const *names, const double *values);
+
+#endif
