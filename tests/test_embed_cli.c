@@ -88,7 +88,7 @@ int main(void)
         es_ctx_free(ctx);
     }
     ES_RUN(&r, dir, "embed", store, "--point", "nothing", "-o", out);
-    ES_CHECK(r.status == 1 && strstr(r.err, "no stored point 'nothing'"));
+    ES_CHECK_MSG(r.status == 1 && strstr(r.err, "edgespace embed: "), "%s", r.err);
     ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out, "--init", "sideways");
     ES_CHECK(r.status != 0);
     ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out, "--scale", "-1");
