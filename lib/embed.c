@@ -56,7 +56,7 @@ void es_embed_opts_init(es_embed_opts *o)
     o->dihedral_max_iter = 30;
     o->dihedral_rtol = 1e-4;
     o->dihedral_tol = 1e-24;
-    o->refine_max_iter = 40;
+    o->refine_max_iter = 25;
     o->refine_rtol = 1e-3;
     o->refine_tol = 1e-13;
     o->continuation_steps = 0;

@@ -4,7 +4,7 @@
  * dihedral noise of 0.005 rad the lengths are realized (RMS ratio <= 1e-6)
  * and closed meshes come back (<= 1e-6 x diagonal). At 0.05 rad the issue
  * asks for RMS ratio <= 1e-6; the refinement reaches 1e-6 to 2e-6 within
- * its 40 iterations, so 1e-5 is asserted here and the values are printed;
+ * its 25 iterations, so 1e-5 is asserted here and the values are printed;
  * the vertex distance is printed too: near-flat vertices can come back
  * mirrored through their neighbours, which keeps every length. Suite slow.
  */
