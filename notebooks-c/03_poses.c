@@ -166,7 +166,7 @@ static int interpolate(notebook *nb, study *s)
     double t0 = nb_now();
 
     nb_step(nb, "interpolate: lengths along t, each frame embedded");
-    s->nt = nb->small ? 5 : 11;
+    s->nt = nb->small ? 3 : 11;
     s->t = malloc(sizeof(double) * (size_t)s->nt);
     s->frames = malloc(sizeof(double) * (size_t)(V3 * s->nt));
     s->rms_emb = malloc(sizeof(double) * (size_t)(4 * s->nt));
