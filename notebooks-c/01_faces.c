@@ -116,7 +116,7 @@ static int load(notebook *nb, study *s)
     char dir[4352];
     es_ingest_report ir;
     es_status rc;
-    int64_t nsub = nb->small ? 15 : 30;
+    int64_t nsub = nb->small ? 12 : 30;
 
     nb_step(nb, "load: manifest and ingest into an HDF5 store");
     s->source = nb_dataset(nb, "face-study");
