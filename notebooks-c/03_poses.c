@@ -226,7 +226,7 @@ static int report(notebook *nb, study *s)
     es_render_spec rs;
     es_status rc;
     FILE *f;
-    int64_t kmax = 0, nshow = 0;
+    int64_t kmax = 0, kmax_lin = 0, nshow = 0;
 
     nb_step(nb, "report: error curves and frames");
     nb_h(nb, 2, "Interpolation from %s to %s", s->id_a, s->id_b);
@@ -245,6 +245,7 @@ static int report(notebook *nb, study *s)
         nb_row(nb, "%.2f|%.2e|%.2e|%.2e|%.2e", s->t[k], s->rms_emb[k], s->max_emb[k],
                s->rms_lin[k], s->max_lin[k]);
         if (s->max_emb[k] > s->max_emb[kmax]) kmax = k;
+        if (s->max_lin[k] > s->max_lin[kmax_lin]) kmax_lin = k;
     }
     if (nb_csv_close(nb, f)) return 1;
 
@@ -272,8 +273,8 @@ static int report(notebook *nb, study *s)
              "length, along t, interior frames (log scale; data: errors.csv, which has the ends too)");
     nb_image(nb, "max_rel.png", "Largest relative edge-length error along t");
     nb_p(nb, "The embedded frames' worst edge is %.2f%% off its interpolated length (at "
-         "t = %.2f); vertex interpolation's worst edge along the way is %.1f%% off.",
-         100 * s->max_emb[kmax], s->t[kmax], 100 * s->max_lin[s->nt / 2]);
+         "t = %.2f); vertex interpolation's worst edge is %.1f%% off (at t = %.2f).",
+         100 * s->max_emb[kmax], s->t[kmax], 100 * s->max_lin[kmax_lin], s->t[kmax_lin]);
 
     for (int64_t k = 0; k < s->nt && nshow < 11; k += (s->nt > 6 ? 2 : 1)) {
         static char labels[11][32];
