@@ -91,14 +91,16 @@ void es_ctx_set_allocator(es_ctx *ctx, const es_allocator *alloc)
 
 es_status es__fail(es_ctx *ctx, es_status code, const char *fmt, ...)
 {
-    if (!ctx) return code;
     va_list ap;
+    if (!ctx) return code;
     va_start(ap, fmt);
     vsnprintf(ctx->errmsg, sizeof ctx->errmsg, fmt, ap);
     va_end(ap);
     return code;
 }
 
+static void log_message(es_ctx *ctx, es_log_level level, const char *fmt, va_list ap)
+    ES__PRINTF(3, 0);
 static void log_message(es_ctx *ctx, es_log_level level, const char *fmt, va_list ap)
 {
     char buf[ES_ERRMSG_SIZE];

@@ -57,13 +57,14 @@ void es_embed_opts_init(es_embed_opts *o)
     o->dihedral_rtol = 1e-4;
     o->dihedral_tol = 1e-24;
     o->refine_max_iter = 40;
-    o->refine_rtol = 1e-6;
+    o->refine_rtol = 1e-3;
     o->refine_tol = 1e-13;
     o->continuation_steps = 0;
     o->try_both = 0;
     o->align = 1;
     o->bad_face_rtol = 1e-12;
-    o->realized_rtol = 1e-3;
+    o->realized_rtol = 1e-2;
+    o->verbose = 0;
 }
 
 static double now_s(void)
@@ -385,10 +386,6 @@ es_status es_embedder_new(es_ctx *ctx, const es_mesh *mesh, es_embedder **out)
             goto fail;
         }
     }
-    es__info(ctx, "embed: analysis: positions n %lld nnz(L) %.0f flops %.3g (ordering %d); "
-             "closure n %lld nnz(L) %.0f", (long long)(3 * emb->nv), (double)emb->L3->xsize,
-             emb->cm.fl, emb->L3->ordering, (long long)emb->nvar,
-             emb->LA ? (double)emb->LA->xsize : 0.0);
     *out = emb;
     return ES_OK;
 fail:
@@ -548,19 +545,18 @@ static double closure_eval(es_embedder *emb, const double *alpha, int with_jac, 
     return total;
 }
 
-static es_status stage_dihedrals(es_embedder *emb, const es_embed_opts *o, double *alpha,
-                                 double *e_out, int64_t *iters)
+static es_status stage_dihedrals(es_embedder *emb, const es_embed_opts *o, int max_iter,
+                                 double *alpha, double *e_out, int64_t *iters)
 {
     int64_t n = emb->nvar, it = 0;
     double *x = emb->HA ? emb->HA->x : NULL, *g = emb->grad, lambda = 1e-3, e;
     int have_factor = 0;
     e = closure_eval(emb, alpha, 0, NULL);
-    *iters = 0;
-    if (n == 0 || o->dihedral_max_iter <= 0) {
+    if (n == 0 || max_iter <= 0) {
         *e_out = e;
         return ES_OK;
     }
-    while (it < o->dihedral_max_iter && e > o->dihedral_tol * (double)(emb->nint + 1)) {
+    while (it < max_iter && e > o->dihedral_tol * (double)(emb->nint + 1)) {
         double e_new = 0;
         int accepted = 0;
         closure_eval(emb, alpha, 1, NULL);
@@ -631,8 +627,9 @@ static es_status stage_dihedrals(es_embedder *emb, const es_embed_opts *o, doubl
             }
         }
         it++;
-        es__info(emb->ctx, "embed: dihedrals %lld E %.6g -> %.6g lambda %.3g", (long long)it, e,
-                 e_new, lambda);
+        if (o->verbose)
+            es__info(emb->ctx, "embed: dihedrals %lld E %.6g -> %.6g lambda %.3g", (long long)it,
+                     e, e_new, lambda);
         if (!accepted) break;
         if (e - e_new < o->dihedral_rtol * e) {
             e = e_new;
@@ -640,7 +637,7 @@ static es_status stage_dihedrals(es_embedder *emb, const es_embed_opts *o, doubl
         }
         e = e_new;
     }
-    *iters = it;
+    *iters += it;
     *e_out = e;
     return ES_OK;
 }
@@ -776,8 +773,9 @@ static double length_cost(const es_embedder *emb, const double *xyz, const doubl
 }
 
 static es_status stage_refine(es_embedder *emb, const double *L, double *xyz, int max_iter,
-                              double rtol, double tol, int64_t *iters)
+                              double rtol, double tol, int verbose, int64_t *iters)
 {
+    double hist[4] = {0, 0, 0, 0};
     int64_t nv = emb->nv, n3 = 3 * nv, ne = emb->ne;
     double *x = emb->H3->x, *g = emb->grad, *dg = emb->diag, *step = emb->pcg + 4 * n3;
     double *hd = step + n3, lambda = 1e-4, c, ctol = tol * tol * (double)ne;
@@ -861,10 +859,14 @@ static es_status stage_refine(es_embedder *emb, const double *L, double *xyz, in
             lambda *= 10.0;
         }
         (*iters)++;
-        es__info(emb->ctx, "embed: refine %d cost %.6g -> %.6g lambda %.3g rho %.3g pcg %d", it,
-                 c, c_new, lambda, rho, used);
+        if (verbose)
+            es__info(emb->ctx, "embed: refine %d cost %.6g -> %.6g lambda %.3g rho %.3g pcg %d",
+                     it, c, c_new, lambda, rho, used);
         if (!accepted) break;
-        if (c - c_new < rtol * c) {
+        /* relative stopping rule over a window of 3 iterations (oracle README,
+         * failure D: an absolute rule stops too early or too late) */
+        hist[it % 4] = c_new;
+        if (it >= 3 && hist[(it - 3) % 4] - c_new < 3.0 * rtol * c_new) {
             c = c_new;
             break;
         }
@@ -966,7 +968,7 @@ static es_status run_continuation(es_embedder *emb, const es_embed_opts *o, cons
         double *lp = emb->alpha_try;   /* scratch E */
         for (int64_t e = 0; e < ne; e++) lp[e] = (1 - s) * emb->lpath[e] + s * L[e];
         rc = stage_refine(emb, lp, xyz, step == n ? o->refine_max_iter : 4,
-                          step == n ? o->refine_rtol : 1e-3, o->refine_tol, iters);
+                          step == n ? o->refine_rtol : 1e-3, o->refine_tol, o->verbose, iters);
         if (rc != ES_OK) return rc;
         es__progress(emb->ctx, "embed: continuation", step, n);
     }
@@ -1076,13 +1078,25 @@ es_status es_embed_solve(es_embedder *emb, const double *target, double scale,
             double *keep = emb->xyz_best;
             if (mode == ES_EMBED_DIHEDRAL_AUTO) memcpy(keep, xyz, (size_t)n3 * sizeof *xyz);
             memcpy(emb->alpha_keep, alpha, (size_t)ne * sizeof *alpha);
+            int first = mode == ES_EMBED_DIHEDRAL_AUTO && o->dihedral_max_iter > 5
+                            ? 5 : o->dihedral_max_iter;
             t1 = now_s();
-            if ((rc = stage_dihedrals(emb, o, alpha, &rep.closure_stage1, &rep.dihedral_iters)) !=
-                ES_OK)
+            if ((rc = stage_dihedrals(emb, o, first, alpha, &rep.closure_stage1,
+                                      &rep.dihedral_iters)) != ES_OK)
                 return rc;
             rep.t_dihedral = now_s() - t1;
             if ((rc = linear_stages(emb, alpha, L, xyz, &rep)) != ES_OK) return rc;
             quick_metrics(emb, xyz, L, &rms1, &mx);
+            /* auto: a few iterations decide; finish stage 1 only if it helps */
+            if (first < o->dihedral_max_iter && rms1 < rms0) {
+                t1 = now_s();
+                if ((rc = stage_dihedrals(emb, o, o->dihedral_max_iter - first, alpha,
+                                          &rep.closure_stage1, &rep.dihedral_iters)) != ES_OK)
+                    return rc;
+                rep.t_dihedral += now_s() - t1;
+                if ((rc = linear_stages(emb, alpha, L, xyz, &rep)) != ES_OK) return rc;
+                quick_metrics(emb, xyz, L, &rms1, &mx);
+            }
             if (mode == ES_EMBED_DIHEDRAL_AUTO && !(rms1 < rms0)) {
                 memcpy(xyz, keep, (size_t)n3 * sizeof *xyz);
                 memcpy(alpha, emb->alpha_keep, (size_t)ne * sizeof *alpha);
@@ -1095,7 +1109,7 @@ es_status es_embed_solve(es_embedder *emb, const double *target, double scale,
         t1 = now_s();
         if (o->refine_max_iter > 0 &&
             (rc = stage_refine(emb, L, xyz, o->refine_max_iter, o->refine_rtol, o->refine_tol,
-                               &rep.refine_iters)) != ES_OK)
+                               o->verbose, &rep.refine_iters)) != ES_OK)
             return rc;
         rep.t_refine = now_s() - t1;
         have_dihedral_result = 1;

@@ -354,8 +354,6 @@ es_status es_gpa_align(es_ctx *ctx, int64_t k, int d, es_mat x, const es_gpa_opt
     }
     if (rep.iterations > o.max_iter) rep.iterations = o.max_iter;
     es__progress(ctx, "gpa", o.max_iter, o.max_iter);
-    es__info(ctx, "gpa: %lld iterations, %lld power steps", (long long)rep.iterations,
-             (long long)st.power_steps);
     flush_scales(&st);   /* also recomputes the sum without accumulated rounding */
 
     /* mean, GSS and rho */

@@ -600,13 +600,17 @@ es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
         cairo_destroy(tcr);
         cairo_surface_destroy(tmp);
     }
-    if ((int64_t)W * n + cb_w > 16384) {
-        rc = es__fail(ctx, ES_ERANGE, "render: %lld panels of width %d are too wide",
-                      (long long)n, W);
+    int64_t ncols = spec->ncols > 0 && spec->ncols < n ? spec->ncols : n;
+    int64_t nrows = (n + ncols - 1) / ncols, pitch = H + label_h;
+    if ((int64_t)W * ncols + cb_w > 16384 || title_h + pitch * nrows > 16384) {
+        rc = es__fail(ctx, ES_ERANGE, "render: %lld panels of %d x %d in %lld columns make "
+                      "a picture over 16384 pixels", (long long)n, W, H, (long long)ncols);
         goto done;
     }
-    rep.width = (int)(W * n) + cb_w;
-    rep.height = title_h + H + label_h;
+    rep.width = (int)(W * ncols) + cb_w;
+    rep.height = (int)(title_h + pitch * nrows);
+    rep.ncols = (int)ncols;
+    rep.row_pitch = (double)pitch;
     rep.panel_x0 = 0;
     rep.panel_y0 = title_h;
 
@@ -671,7 +675,8 @@ es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
         downsample(&R, ss, cairo_image_surface_get_data(panel),
                    cairo_image_surface_get_stride(panel), W, H);
         cairo_surface_mark_dirty(panel);
-        cairo_set_source_surface(cr, panel, (double)(W * i), title_h);
+        double px0 = (double)(W * (i % ncols)), py0 = (double)(title_h + pitch * (i / ncols));
+        cairo_set_source_surface(cr, panel, px0, py0);
         cairo_paint(cr);
         if (cv.kind != ES__CANVAS_PNG) {
             /* vector surfaces may keep a reference to the image: give the
@@ -685,17 +690,19 @@ es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
         }
         if (m->label && *m->label) {
             cairo_set_source_rgb(cr, 0, 0, 0);
-            es__text(cr, W * (i + 0.5), title_h + H + 0.4 * fs, m->label, fs, 0.5, 0, 0);
+            es__text(cr, px0 + 0.5 * W, py0 + H + 0.4 * fs, m->label, fs, 0.5, 0, 0);
         }
     }
     es__progress(ctx, "render", n, n);
     if (title_h) {
         cairo_set_source_rgb(cr, 0, 0, 0);
-        es__text(cr, 0.5 * (double)(W * n), 0.6 * fs, spec->title, 1.15 * fs, 0.5, 0, 0);
+        es__text(cr, 0.5 * (double)(W * ncols), 0.6 * fs, spec->title, 1.15 * fs, 0.5, 0, 0);
     }
     if (cbar) {
-        double x = round((double)(W * n) + fs), y = round(title_h + 0.1 * H),
-               w = round(fs), h = round(0.8 * H);
+        /* beside the first row, or centred on all rows */
+        double span = (double)(pitch * (nrows - 1) + H);
+        double x = round((double)(W * ncols) + fs), y = round(title_h + 0.1 * span),
+               w = round(fs), h = round(0.8 * span);
         es__draw_colorbar(cr, x, y, w, h, spec->cmap, rep.vmin, rep.vmax, spec->colorbar_label,
                           fs);
         rep.colorbar[0] = x, rep.colorbar[1] = y, rep.colorbar[2] = w, rep.colorbar[3] = h;

@@ -16,7 +16,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#define BLOCK_BYTES ((int64_t)32 << 20)
+#define BLOCK_BYTES ((int64_t)128 << 20)
 
 /* ---- sources ------------------------------------------------------------ */
 

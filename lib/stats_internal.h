@@ -9,7 +9,7 @@
 /* Check the source's shape and reader. `what` names the caller. */
 es_status es__source_check(es_ctx *ctx, const es_source *src, const char *what);
 
-/* Rows per block: src->block if set, else about 32 MiB of doubles; never
+/* Rows per block: src->block if set, else about 128 MiB of doubles; never
  * more than N, at least 1. */
 int64_t es__source_block(const es_source *src);
 

@@ -494,6 +494,10 @@ static hid_t file_access(void)
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
     /* Readable by HDF5 1.8 and later (h5py, rhdf5, MATLAB all are). */
     if (fapl >= 0) H5Pset_libver_bounds(fapl, H5F_LIBVER_EARLIEST, H5F_LIBVER_V18);
+#if H5_VERSION_GE(1, 10, 7)
+    /* Keep HDF5's flock, but do not fail on file systems without it. */
+    if (fapl >= 0) H5Pset_file_locking(fapl, 1, 1);
+#endif
     return fapl;
 }
 

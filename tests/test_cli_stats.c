@@ -195,6 +195,36 @@ int main(void)
             ES_CHECK(n3 == 1 && sc[0] == g->scales[0]);
         }
         es_group_result_free(g);
+        g = NULL;
+        /* library-level refusals */
+        es_pca *pp = NULL;
+        ES_CHECK_FAILS(ctx, es_analysis_mean(ctx, st, NULL, NULL, "nope", NULL, &g), ES_ENOTFOUND,
+                       "no label column 'nope'");
+        ES_CHECK_FAILS(ctx, es_analysis_mean(ctx, st, NULL, "expression=sad", NULL, NULL, &g),
+                       ES_EINVAL, "no rows match");
+        ES_CHECK_FAILS(ctx, es_analysis_pca(ctx, st, "a/b", NULL, NULL, NULL, &pp, NULL, NULL),
+                       ES_EINVAL, "bad result name");
+        ES_CHECK_FAILS(ctx, es_analysis_pca_load(ctx, st, "missing", &pp, NULL, NULL),
+                       ES_ENOTFOUND, "no PCA named 'missing'");
+        ES_CHECK_FAILS(ctx, es_analysis_pca_load(ctx, st, NULL, &pp, NULL, NULL), ES_ENOTFOUND,
+                       "several PCAs");
+        ES_CHECK_FAILS(ctx, es_analysis_point(ctx, st, NULL, "mean + pc:1", NULL, 0, NULL, NULL,
+                                              NULL), ES_ENOTFOUND, "point: pc:1: pca: several");
+        ES_CHECK_FAILS(ctx, es_analysis_point(ctx, st, NULL, "mean + pc:99", "p", 0, NULL, NULL,
+                                              NULL), ES_ENOTFOUND, "the PCA has 12 components");
+        ES_CHECK_FAILS(ctx, es_analysis_point(ctx, st, NULL, "diff:frown", NULL, 0, NULL, NULL,
+                                              NULL), ES_ENOTFOUND, "no difference named 'frown'");
+        snprintf(path, sizeof path, "%s/other.obj", dir);
+        FILE *o = fopen(path, "w");
+        if (o) {
+            fputs("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", o);
+            fclose(o);
+        }
+        char expr[600];
+        snprintf(expr, sizeof expr, "file:%s", path);
+        ES_CHECK_FAILS(ctx, es_analysis_point(ctx, st, NULL, expr, NULL, 0, NULL, NULL, NULL),
+                       ES_EMISMATCH, "do not match the store's topology");
+        snprintf(path, sizeof path, "%s/study.h5", dir);
         es_free(ctx, pt);
         es_free(ctx, dm);
         es_free(ctx, sc);

@@ -1,9 +1,11 @@
 /* tests/test_cli_store.c — the ingest, info and export commands: --help,
  * exit statuses (0 ok, 1 failure, 2 usage), messages, and what they write. */
+#include "es_internal.h"
 #include "es_test.h"
 #include "es_test_files.h"
 #include "es_test_meshes.h"
 #include "es_test_run.h"
+#include "edgespace/edgespace.h"
 
 int main(void)
 {
@@ -79,6 +81,23 @@ int main(void)
                  strstr(r.out, "60 vertices, 120 faces, 180 edges") &&
                  strstr(r.out, "group            3 distinct: a (2), b (1), \"\" (1)"),
                  "%s", r.out);
+    {
+        /* results show up in info */
+        es_ctx *ctx = NULL;
+        es_store *s = NULL;
+        es_provenance prov = {"test", NULL, -1, NULL};
+        ES_CHECK(es_ctx_new(&ctx) == ES_OK);
+        ES_CHECK_OK(ctx, es_store_open(ctx, store, ES_STORE_WRITE, &s));
+        ES_CHECK_OK(ctx, es_store_result_begin(ctx, s, "pca", "all", &prov));
+        ES_CHECK_OK(ctx, es_store_result_begin(ctx, s, "pca", "by-group", &prov));
+        ES_CHECK_OK(ctx, es_store_result_begin(ctx, s, "mean", "a", &prov));
+        ES_CHECK_OK(ctx, es_store_commit(ctx, s));
+        es_store_close(s);
+        es_ctx_free(ctx);
+        ES_RUN(&r, dir, "info", store);
+        ES_CHECK_MSG(r.status == 0 && strstr(r.out, "  mean             a\n") &&
+                     strstr(r.out, "  pca              all by-group\n"), "%s", r.out);
+    }
     ES_RUN(&r, dir, "info", "--rows", store);
     ES_CHECK(r.status == 0 && strstr(r.out, "\nmesh-1\t") && strstr(r.out, "\tb\n"));
     ES_RUN(&r, dir, "info", m);

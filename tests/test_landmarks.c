@@ -149,6 +149,48 @@ static void test_shared(es_ctx *ctx)
     es_landmarks_free(apes);
 }
 
+typedef struct failing_alloc { int64_t count, fail_at; } failing_alloc;
+static void *fa_malloc(void *ud, size_t n)
+{
+    failing_alloc *fa = ud;
+    return ++fa->count == fa->fail_at ? NULL : malloc(n);
+}
+static void *fa_realloc(void *ud, void *p, size_t n)
+{
+    failing_alloc *fa = ud;
+    return ++fa->count == fa->fail_at ? NULL : realloc(p, n);
+}
+static void fa_free(void *ud, void *p) { (void)ud; free(p); }
+
+/* Every allocation of the readers may fail: ES_ENOMEM, nothing returned,
+ * nothing leaked (checked under ASan). */
+static void test_alloc_sweep(void)
+{
+    es_ctx *ctx = NULL;
+    if (es_ctx_new(&ctx) != ES_OK) return;
+    failing_alloc fa = {0, 0};
+    es_allocator a = {fa_malloc, fa_realloc, fa_free, &fa};
+    es_ctx_set_allocator(ctx, &a);
+    static const char *what[] = {"tps", "csv"};
+    for (int w = 0; w < 2; w++) {
+        es_status rc = ES_ENOMEM;
+        int64_t k;
+        for (k = 1; k < 500 && rc == ES_ENOMEM; k++) {
+            es_landmarks *lm = (es_landmarks *)1;
+            fa.count = 0;
+            fa.fail_at = k;
+            rc = w == 0 ? es_landmarks_read_tps(ctx, DATA "good2d.tps", 1, &lm)
+                        : es_landmarks_read_csv(ctx, DATA "good.csv", DATA "good_specimens.csv", &lm);
+            ES_CHECK_MSG(rc == ES_OK || rc == ES_ENOMEM, "%s, allocation %lld: %s", what[w],
+                         (long long)k, es_ctx_errmsg(ctx));
+            ES_CHECK(rc == ES_OK ? lm != NULL : lm == NULL);
+            if (rc == ES_OK) es_landmarks_free(lm);
+        }
+        ES_CHECK(rc == ES_OK && k > 3);
+    }
+    es_ctx_free(ctx);
+}
+
 int main(void)
 {
     es_ctx *ctx = NULL;
@@ -158,6 +200,7 @@ int main(void)
     test_tps(ctx);
     test_csv(ctx);
     test_shared(ctx);
+    test_alloc_sweep();
     es_ctx_free(ctx);
     ES_TEST_END();
 }

@@ -224,6 +224,33 @@ static void test_validity(es_ctx *ctx)
     es_mesh_free(m);
 }
 
+/* Failing the k-th allocation: parse and evaluate fail cleanly with
+ * ES_ENOMEM until they succeed (leaks show in the ASan build). */
+static int64_t fail_at, nalloc;
+static void *t_malloc(void *ud, size_t n) { (void)ud; return ++nalloc == fail_at ? NULL : malloc(n); }
+static void *t_realloc(void *ud, void *q, size_t n) { (void)ud; return ++nalloc == fail_at ? NULL : realloc(q, n); }
+static void t_free(void *ud, void *q) { (void)ud; free(q); }
+
+static void test_alloc_failures(es_ctx *ctx)
+{
+    es_allocator al = {t_malloc, t_realloc, t_free, NULL};
+    es_ctx_set_allocator(ctx, &al);
+    es_status rc = ES_ENOMEM;
+    for (fail_at = 1; rc == ES_ENOMEM && fail_at < 500; fail_at++) {
+        nalloc = 0;
+        es_point_expr *x = NULL;
+        int calls = 0;
+        double v[E];
+        rc = es_point_parse(ctx, "lerp(mean[g=x,h=y-1], row:a, 2) + 0.5*(pc:1 - diff:d) + "
+                            "row:a + row:a + row:a + row:a + row:a + row:a + row:a + row:a", &x);
+        if (rc == ES_OK) rc = es_point_eval(ctx, x, E, resolve, &calls, NULL, v, NULL);
+        es_point_expr_free(x);
+        ES_CHECK(rc == ES_OK || rc == ES_ENOMEM);
+    }
+    ES_CHECK(rc == ES_OK && fail_at > 10);
+    es_ctx_set_allocator(ctx, NULL);
+}
+
 int main(void)
 {
     ES_TEST_BEGIN();
@@ -232,6 +259,7 @@ int main(void)
     test_eval(ctx);
     test_errors(ctx);
     test_validity(ctx);
+    test_alloc_failures(ctx);
     es_ctx_free(ctx);
     ES_TEST_END();
 }

@@ -410,6 +410,57 @@ static void test_pca(es_ctx *ctx)
     free(t); free(l); free(s); free(l2); free(s2); free(m);
 }
 
+/* ---- allocation failures ------------------------------------------------ */
+
+typedef struct failing_alloc { int64_t count, fail_at; } failing_alloc;
+static void *fa_malloc(void *ud, size_t n)
+{
+    failing_alloc *fa = ud;
+    return ++fa->count == fa->fail_at ? NULL : malloc(n);
+}
+static void *fa_realloc(void *ud, void *p, size_t n)
+{
+    failing_alloc *fa = ud;
+    return ++fa->count == fa->fail_at ? NULL : realloc(p, n);
+}
+static void fa_free(void *ud, void *p) { (void)ud; free(p); }
+
+/* Fail the k-th allocation for k = 1, 2, ... until a call succeeds: each
+ * failure must be ES_ENOMEM (leaks show under -Db_sanitize=address). */
+static void test_alloc_sweep(void)
+{
+    es_ctx *ctx = NULL;
+    if (es_ctx_new(&ctx) != ES_OK) return;
+    failing_alloc fa = {0, 0};
+    es_allocator a = {fa_malloc, fa_realloc, fa_free, &fa};
+    es_ctx_set_allocator(ctx, &a);
+    es__rng rng;
+    es__rng_init(&rng, 2);
+    double *x0 = make_set(&rng, 6, 3, 5, 0.1), x[90], mean[18], tan[90], sd[3], l[54], sc[15];
+    es_status rc = ES_ENOMEM;
+    int64_t k;
+    for (k = 1; k < 200 && rc == ES_ENOMEM; k++) {
+        fa.count = 0;
+        fa.fail_at = k;
+        memcpy(x, x0, sizeof x);
+        es_gpa_out out = {0};
+        out.mean = mean;
+        rc = es_gpa_align(ctx, 6, 3, (es_mat){x, 18, 5, 18}, NULL, &out, NULL);
+        if (rc == ES_OK)
+            rc = es_gpa_tangent(ctx, 6, 3, (es_mat){x, 18, 5, 18}, mean, ES_TANGENT_PARTIAL,
+                                (es_mat){tan, 18, 5, 18});
+        if (rc == ES_OK)
+            rc = es_gpa_pca(ctx, (es_mat){tan, 18, 5, 18}, 3, sd, NULL, (es_mat){l, 18, 3, 18},
+                            (es_mat){sc, 5, 3, 5});
+        if (rc == ES_OK)
+            rc = es_procrustes_opa(ctx, 6, 3, x0, x0 + 18, 1, 0, NULL, NULL, NULL, NULL);
+        ES_CHECK(rc == ES_OK || rc == ES_ENOMEM);
+    }
+    ES_CHECK(rc == ES_OK && k > 3);
+    free(x0);
+    es_ctx_free(ctx);
+}
+
 /* ---- oracle: shapes::procGPA ------------------------------------------- */
 
 /* snprintf into a path buffer; vsnprintf keeps -Wformat-truncation quiet
@@ -606,6 +657,7 @@ int main(void)
     test_fixed_point(ctx);
     test_degenerate(ctx);
     test_pca(ctx);
+    test_alloc_sweep();
 
     char buf[4096];
     const char *data = es_test_shared_data(), *dir = NULL;

@@ -386,6 +386,22 @@ static void test_auto_view(es_ctx *ctx)
         ES_CHECK_MSG(diff < 0.005, "mean difference %g", diff);
         tp_free(&im);
     }
+    /* the same four in a 2 x 2 grid: panel 3 is at column 1, row 1 */
+    spec.ncols = 2;
+    const char *grid = tp_path("render", "grid.png");
+    es_render_report rg;
+    ES_CHECK_OK(ctx, es_render(ctx, &spec, grid, &rg));
+    ES_CHECK(rg.ncols == 2 && rg.width == 2 * 320 && rg.height == (int)(rg.panel_y0 + 2 * rg.row_pitch));
+    ES_CHECK(tp_load(grid, &im) == 0);
+    if (im.s) {
+        for (int i = 0; i < 4; i++) {
+            int x0 = (int)rg.panel_x0 + 320 * (i % 2), y0 = (int)(rg.panel_y0 + rg.row_pitch * (i / 2));
+            int64_t c = count_foreground(&im, x0, y0, x0 + 320, y0 + 320);
+            ES_CHECK_MSG(c > 0.2 * 320 * 320, "grid panel %d: %lld pixels", i, (long long)c);
+        }
+        tp_free(&im);
+    }
+    spec.ncols = 0;
     const char *svg = tp_path("render", "row.svg");
     ES_CHECK_OK(ctx, es_render(ctx, &spec, svg, &rep));
     ES_CHECK(tp_file_has(svg, "<?xml", "<svg") && tp_file_size(svg) > 20000);

@@ -47,6 +47,7 @@ static void usage(FILE *f)
           "      --cull             leave back faces out (default: drawn darker)\n"
           "      --fit-each         each mesh fills its panel (default: one scale)\n"
           "      --same-view        all panels use the first mesh's automatic view\n"
+          "      --columns N        wrap the panels into rows of N\n"
           "  -h, --help             show this help\n", f);
 }
 
@@ -135,7 +136,7 @@ int cmd_render(int argc, char **argv)
         {"width", required_argument, NULL, 'W'}, {"height", required_argument, NULL, 'H'},
         {"ortho", no_argument, NULL, 'O'}, {"fov", required_argument, NULL, 'F'},
         {"cull", no_argument, NULL, 'C'}, {"fit-each", no_argument, NULL, 'E'},
-        {"same-view", no_argument, NULL, 'S'},
+        {"same-view", no_argument, NULL, 'S'}, {"columns", required_argument, NULL, 'N'},
         {"help", no_argument, NULL, 'h'}, {NULL, 0, NULL, 0}};
     es_render_spec spec;
     const char *out = NULL, *scalar_files[MAX_MESHES], *labels[MAX_MESHES];
@@ -197,6 +198,11 @@ int cmd_render(int argc, char **argv)
         case 'C': spec.backface = ES_BACKFACE_CULL; break;
         case 'E': spec.fit_each = 1; break;
         case 'S': spec.same_view = 1; break;
+        case 'N':
+            if (cli_parse_i64(optarg, &v64) || v64 < 1 || v64 > MAX_MESHES)
+                return cli_usage_error(VERB, "--columns wants an integer in 1..%d", MAX_MESHES);
+            spec.ncols = v64;
+            break;
         case 'h': usage(stdout); return CLI_OK;
         default: return cli_usage_error(VERB, "unknown option");
         }

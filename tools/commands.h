@@ -17,7 +17,12 @@ int cmd_project(int argc, char **argv);
 int cmd_point(int argc, char **argv);
 int cmd_plot_pca(int argc, char **argv);
 /* -- procrustes, landmarks, comparison */
+int cmd_gpa(int argc, char **argv);
+int cmd_compare(int argc, char **argv);
+int cmd_ingest_landmarks(int argc, char **argv);
 /* -- embedding, interpolation */
+int cmd_embed(int argc, char **argv);
+int cmd_interp(int argc, char **argv);
 /* -- plotting, rendering */
 int cmd_render(int argc, char **argv);
 int cmd_plot(int argc, char **argv);

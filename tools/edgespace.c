@@ -29,7 +29,12 @@ static const command commands[] = {
     {"point", cmd_point, "evaluate and store a point expression (mean + 2*pc:1, ...)"},
     {"plot-pca", cmd_plot_pca, "PCA score scatter coloured by a label, or scree plot, from a store"},
     /* -- procrustes, landmarks, comparison */
+    {"gpa", cmd_gpa, "generalized Procrustes analysis of a store's positions"},
+    {"compare", cmd_compare, "Procrustes vs edge-length space: distances, Mantel, groups"},
+    {"ingest-landmarks", cmd_ingest_landmarks, "landmarks (TPS, CSV) + triangulation into a store"},
     /* -- embedding, interpolation */
+    {"embed", cmd_embed, "realize a point of edge-length space as a mesh, with a quality report"},
+    {"interp", cmd_interp, "interpolate/extrapolate stored shapes in edge-length space and embed"},
     /* -- plotting, rendering */
     {"render", cmd_render, "draw meshes side by side to PNG/SVG/PDF"},
     {"plot", cmd_plot, "scatter, lines, scree, histogram or heat map of a CSV table"},

@@ -15,7 +15,8 @@ if [ ! -f "$build_dir/build.ninja" ]; then
 else
   meson configure "$build_dir" -Dfuzz=true >/dev/null
 fi
-ninja -C "$build_dir" -j2 tests/fuzz/fuzz_obj tests/fuzz/fuzz_ply tests/fuzz/fuzz_off >&2
+ninja -C "$build_dir" -j2 tests/fuzz/fuzz_obj tests/fuzz/fuzz_ply tests/fuzz/fuzz_off \
+  tests/fuzz/fuzz_num >&2
 # only the fuzz targets are built: the rest of the tree needs no clang build
 # a loaded machine stretches the wall clock: the meson timeout (180 s for
 # 20 s of fuzzing) grows with FUZZ_TIME

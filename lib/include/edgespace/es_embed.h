@@ -35,6 +35,7 @@
 
 #include "es_core.h"
 #include "es_mesh.h"
+#include "es_store.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -57,9 +58,10 @@ typedef struct es_embed_opts {
                                  (defaults 1e-4, 1e-24) */
     double dihedral_tol;
     int refine_max_iter;      /* stage 4 LM iterations per step; 0 skips (default 40) */
-    double refine_rtol;       /* stage 4 stops when the cost drops by less than this
-                                 fraction, or the RMS relative edge error is below
-                                 refine_tol (defaults 1e-6, 1e-13) */
+    double refine_rtol;       /* stage 4 stops when the cost dropped by less than this
+                                 fraction per iteration over the last 3 iterations, or
+                                 the RMS relative edge error is below refine_tol
+                                 (defaults 1e-3, 1e-13) */
     double refine_tol;
     int continuation_steps;   /* > 0 and initial positions given: run stage 4 along the
                                  length path from the initial mesh in this many steps
@@ -71,7 +73,8 @@ typedef struct es_embed_opts {
                                  the initial positions, else to the mesh's reference
                                  positions if it has them (default 1) */
     double bad_face_rtol;     /* triangle-inequality tolerance of the report (1e-12) */
-    double realized_rtol;     /* report.realized = max relative error <= this (1e-3) */
+    double realized_rtol;     /* report.realized = max relative error <= this (1e-2) */
+    int verbose;              /* 1: one note per iteration to the log callback (0) */
 } es_embed_opts;
 
 ES_API void es_embed_opts_init(es_embed_opts *opts);
@@ -80,7 +83,8 @@ typedef struct es_embed_report {
     double closure_before;    /* E(alpha) (eq. 3) at the initial dihedrals */
     double closure_after;     /* E at the output mesh's dihedrals, target corner angles */
     double closure_stage1;    /* E after stage 1 */
-    int64_t dihedral_iters;   /* stage 1 LM iterations */
+    int64_t dihedral_iters;   /* stage 1 LM iterations (AUTO: 5 first, the rest only
+                                 if stage 1 improves the linear reconstruction) */
     int64_t refine_iters;     /* stage 4 LM iterations (all continuation steps) */
     int64_t continuation_steps; /* steps used (0: dihedral path) */
     int used_continuation;    /* 1 if the returned result came from continuation */
@@ -150,6 +154,34 @@ ES_API es_status es_embed_length_error(es_ctx *ctx, const es_mesh *mesh, const d
  * weight 0 (w NULL: all 1) do not count. *rms gets the RMS distance after. */
 ES_API es_status es_kabsch_align(es_ctx *ctx, int64_t nverts, double *xyz, const double *ref,
                                  const double *w, double *rms);
+
+/* ---- with a store (lib/embed_store.c) --------------------------------
+ * One-line and multi-line text of a report (for commands and notebooks):
+ * writes at most n bytes with NUL, returns buf. */
+ES_API const char *es_embed_report_format(const es_embed_report *rep, char *buf, size_t n);
+
+/* The stored row nearest to normalized lengths `target` (E) in Euclidean
+ * edge-length distance: the default initialization. rows/nrows restrict the
+ * search (NULL: all rows). */
+ES_API es_status es_embed_nearest_row(es_ctx *ctx, es_store *store, const double *target,
+                                      const int64_t *rows, int64_t nrows, int64_t *row,
+                                      double *dist);
+
+/* Circular mean of the dihedrals of stored rows (E): the angle of the mean
+ * unit vector per edge (oracle README, failure F). */
+ES_API es_status es_embed_mean_dihedrals(es_ctx *ctx, es_store *store, const es_mesh *mesh,
+                                         const int64_t *rows, int64_t nrows, double *alpha);
+
+/* Store an embedding as /analysis/embed/<name>: datasets positions (V x 3),
+ * target_lengths (E, normalized), vertex_closure and vertex_edge_error
+ * (V, for heat maps, from the embedder's last solve), and the report as
+ * attributes (closure_before, closure_after, rms_ratio, max_rel, p99_rel,
+ * n_bad_faces, realized, iterations, seconds per stage, init). Commit is
+ * the caller's. */
+ES_API es_status es_embed_store_result(es_ctx *ctx, es_store *store, const char *name,
+                                       const es_provenance *prov, const es_embedder *emb,
+                                       const double *target, const double *xyz,
+                                       const es_embed_report *rep, const char *init);
 
 #ifdef __cplusplus
 }

@@ -27,6 +27,7 @@
 #define EDGESPACE_ES_LANDMARKS_H
 
 #include "es_core.h"
+#include "es_store.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -80,6 +81,18 @@ ES_API es_status es_landmarks_truss_lengths(es_ctx *ctx, const es_landmarks *lm,
  * *count. per = 2 or 3. ES_EFORMAT with file:line. */
 ES_API es_status es_landmarks_read_index_list(es_ctx *ctx, const char *path, int per,
                                               int64_t **idx, int64_t *count);
+
+/* Create the store `path` from a landmark set and a triangulation of its
+ * landmarks (ntri triangles, 3 x ntri 0-based indices; it must be an
+ * oriented manifold, es_mesh_new's checks): the triangles' edges are the
+ * store's edges, so edge-length statistics run on the landmarks. 2D
+ * landmarks are stored with z = 0 (es_gpa_store_run analyses such rows in
+ * 2D). Labels become label columns; TPS IMAGE= and SCALE= values are kept
+ * as columns "image" and "tps_scale" when present. The store format needs
+ * faces: a set without a triangulation cannot be stored (ES_EINVAL says so).
+ * ES_EEXIST if path exists. All-or-nothing (es_store_commit). */
+ES_API es_status es_landmarks_to_store(es_ctx *ctx, const es_landmarks *lm, int64_t ntri,
+                                       const int64_t *tri, const char *path);
 
 #ifdef __cplusplus
 }

@@ -1,6 +1,7 @@
 /* lib/include/edgespace/es_render.h — pictures of triangle meshes.
  *
- * es_render draws one or several meshes side by side in a row, each with
+ * es_render draws one or several meshes side by side in a row (or a grid
+ * of `ncols` columns), each with
  * an optional label under it, an optional title above and, when scalars are
  * given, one colour bar for all of them on the right. The output format
  * follows the file extension as in es_plot.h (.png, .svg, .pdf).
@@ -73,9 +74,14 @@ typedef struct es_render_mesh {
 typedef struct es_render_spec {
     int64_t nmeshes;
     const es_render_mesh *meshes;
+    int64_t ncols;             /* panels per row, wrapping into a grid (0: one row) */
     int width, height;         /* of each panel, device units (480 x 480) */
     es_projection projection;  /* ES_PROJ_PERSPECTIVE */
-    double fov_deg;            /* perspective field of view (25) */
+    /* Perspective strength (25): the eye sits where the mesh's bounding
+     * sphere just fills this field of view; the picture is then scaled to
+     * `fill` the panel, so a smaller angle means a flatter, more distant
+     * look, not a smaller mesh. */
+    double fov_deg;
     int has_view, has_up;      /* use view / up below instead of the automatic ones */
     int same_view;             /* 1: every panel uses the automatic view of mesh 0
                                 * (sequences, shapes in one frame); 0: each its own */
@@ -108,9 +114,12 @@ typedef struct es_render_report {
                                 * perspective: at the depth of the bounding box
                                 * centre); with fit_each, the coarsest panel's */
     double view[3], up[3];     /* camera of the first panel, unit vectors */
+    int ncols;                 /* panels per row used */
     double panel_x0;           /* left edge of panel 0; panel i starts at
-                                * panel_x0 + i * panel width */
-    double panel_y0;           /* top edge of the panels */
+                                * panel_x0 + (i % ncols) * width */
+    double panel_y0;           /* top edge of panel 0; panel i at
+                                * panel_y0 + (i / ncols) * row_pitch */
+    double row_pitch;          /* panel height plus the label line */
     double colorbar[4];        /* x, y, w, h of the colour bar's colour area, or zeros */
 } es_render_report;
 

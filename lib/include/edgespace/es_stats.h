@@ -40,7 +40,8 @@ struct es_source {
     int64_t nrows;      /* N */
     es_block_fn read;   /* the reader */
     void *userdata;     /* for the reader */
-    int64_t block;      /* rows per read; 0 chooses (about 32 MiB per block) */
+    int64_t block;      /* rows per read; 0 chooses (128 MiB per block, 256 MiB
+                           per tile in the Gram route) */
     /* Used by es_source_matrix's reader; free for other readers. */
     es_mat mat;
     const int64_t *rows;
@@ -114,11 +115,12 @@ typedef struct es_pca {
  * eigenvalues are mu_k / (N - 1), scores sqrt(mu_k) v_k, and a second pass
  * forms the components (X - mean 1^T) v_k / sqrt(mu_k). Covariance route
  * (N > E): one pass accumulates the E x E covariance the same way, a second
- * the scores. Randomized route: see es_pca_opts; exact to rounding when
- * K + oversample >= rank, otherwise eigenvalue k is within a factor
- * (1 + (sigma_{K+p+1}/sigma_k)^(4q+2) C) of the truth — with the defaults
- * on data whose spectrum decays, 1e-8 relative on the leading components
- * (tests/test_pca.c measures it).
+ * the scores. Randomized route (Halko, Martinsson & Tropp 2011, q + 2
+ * passes): eigenvalues are never overestimated; with the defaults p = 10,
+ * q = 4 the top eigenvalues are exact to rounding when the spectrum has a
+ * gap after K + p, within ~1e-10 relative on a decaying spectrum and a few
+ * 1e-4 on a nearly flat one (table in lib/pca_randomized.c, checked by
+ * tests/test_pca.c).
  *
  * Components whose eigenvalue is below N * eps * (largest eigenvalue) are
  * numerically zero and are not returned, so ncomp may be less than asked.

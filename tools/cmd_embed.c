@@ -1,0 +1,212 @@
+/* tools/cmd_embed.c — edgespace embed: realize a point of edge-length space
+ * (a stored row or a stored point) as a mesh, print and store the quality
+ * report (es_embed_solve, es_embed_store_result). */
+#include "cli.h"
+#include "commands.h"
+
+#include <getopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char usage[] =
+    "usage: edgespace embed STORE --point SPEC -o OUT [options]\n"
+    "\n"
+    "Realize a point of edge-length space as a mesh (dihedral solve, frames and\n"
+    "positions by sparse least squares, Gauss-Newton refinement of the lengths),\n"
+    "print the quality report and store it with per-vertex residuals under\n"
+    "/analysis/embed/NAME.\n"
+    "\n"
+    "  -p, --point SPEC     row:ID (a stored row's lengths) or NAME (a stored point:\n"
+    "                       /analysis/point/NAME/lengths, normalized, and optional\n"
+    "                       /analysis/point/NAME/scale)\n"
+    "  -o, --output OUT     mesh file (.obj, .ply, .off)\n"
+    "  -i, --init HOW       nearest (default: the stored row nearest in edge-length\n"
+    "                       distance), row:ID, or mean[:FILTER] (circular mean of the\n"
+    "                       dihedrals of the selected rows)\n"
+    "  -s, --scale S        sum of edge lengths of the output (default: the point's\n"
+    "                       scale, else the mean scale of the store)\n"
+    "  -n, --name NAME      result name in the store (default: the output's base name)\n"
+    "      --no-store       do not write the report into the store\n"
+    "      --paper          the published method's stages only (stage 1 always, no\n"
+    "                       refinement), for comparison\n"
+    "  -h, --help           show this help\n"
+    "\n"
+    "Exit status: 0 ok, 1 failure, 2 usage error.\n";
+
+static char *base_name(const char *path, char *buf, size_t n)
+{
+    const char *b = strrchr(path, '/');
+    char *dot;
+    snprintf(buf, n, "%s", b ? b + 1 : path);
+    if ((dot = strrchr(buf, '.')) && dot != buf) *dot = 0;
+    return buf;
+}
+
+int cmd_embed(int argc, char **argv)
+{
+    static const struct option longopts[] = {
+        {"point", required_argument, NULL, 'p'}, {"output", required_argument, NULL, 'o'},
+        {"init", required_argument, NULL, 'i'},  {"scale", required_argument, NULL, 's'},
+        {"name", required_argument, NULL, 'n'},  {"no-store", no_argument, NULL, 'N'},
+        {"paper", no_argument, NULL, 'P'},       {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0}};
+    const char *point = NULL, *out = NULL, *init = "nearest", *name = NULL;
+    char namebuf[256], path[512], initdesc[512], text[1024];
+    double scale = 0, *target = NULL, *xyz = NULL, *init_xyz = NULL, *alpha = NULL, *scales = NULL;
+    int c, store_it = 1, paper = 0;
+    es_ctx *ctx;
+    es_store *s = NULL;
+    es_mesh *mesh = NULL;
+    es_embedder *emb = NULL;
+    es_embed_opts opts;
+    es_embed_report rep;
+    es_status rc = ES_OK;
+    int64_t ne, nv, nrows, initrow = -1, *sel = NULL, nsel = 0;
+    optind = 1;
+    while ((c = getopt_long(argc, argv, "p:o:i:s:n:h", longopts, NULL)) != -1) {
+        switch (c) {
+        case 'p': point = optarg; break;
+        case 'o': out = optarg; break;
+        case 'i': init = optarg; break;
+        case 's':
+            if (cli_parse_double(optarg, &scale) || !(scale > 0))
+                return cli_usage_error("embed", "--scale wants a positive number");
+            break;
+        case 'n': name = optarg; break;
+        case 'N': store_it = 0; break;
+        case 'P': paper = 1; break;
+        case 'h': fputs(usage, stdout); return CLI_OK;
+        default: return cli_usage_error("embed", "bad option");
+        }
+    }
+    if (optind != argc - 1) return cli_usage_error("embed", "give exactly one STORE");
+    if (!point || !out) return cli_usage_error("embed", "--point and --output are required");
+    if (!name) name = base_name(out, namebuf, sizeof namebuf);
+    if (!(ctx = cli_ctx_new("embed"))) return CLI_FAIL;
+    if ((rc = es_store_open(ctx, argv[optind], store_it ? ES_STORE_WRITE : ES_STORE_READ, &s)) ||
+        (rc = es_store_mesh(ctx, s, &mesh)))
+        goto fail;
+    ne = es_mesh_nedges(mesh);
+    nv = es_mesh_nverts(mesh);
+    nrows = es_store_nrows(s);
+    target = malloc((size_t)ne * sizeof *target);
+    xyz = malloc(3 * (size_t)nv * sizeof *xyz);
+    init_xyz = malloc(3 * (size_t)nv * sizeof *init_xyz);
+    alpha = malloc((size_t)ne * sizeof *alpha);
+    scales = malloc((size_t)(nrows + 1) * sizeof *scales);
+    if (!target || !xyz || !init_xyz || !alpha || !scales) {
+        rc = ES_ENOMEM;
+        goto fail;
+    }
+    if ((rc = es_store_read_scales(ctx, s, scales))) goto fail;
+    /* the target */
+    if (!strncmp(point, "row:", 4)) {
+        int64_t r = es_store_find_row(s, point + 4);
+        if (r < 0) {
+            fprintf(stderr, "edgespace embed: no row '%s' in the store\n", point + 4);
+            rc = ES_ENOTFOUND;
+            goto done;
+        }
+        if ((rc = es_store_read_lengths(ctx, s, r, 1, (es_mat){target, ne, 1, ne}))) goto fail;
+        if (scale == 0) scale = scales[r];
+    } else {
+        double *v = NULL;
+        int64_t n = 0;
+        snprintf(path, sizeof path, "point/%s/lengths", point);
+        if (!es_store_has(s, path)) {
+            fprintf(stderr, "edgespace embed: no stored point '%s' (looked for "
+                    "/analysis/%s); use row:ID or a stored point\n", point, path);
+            rc = ES_ENOTFOUND;
+            goto done;
+        }
+        if ((rc = es_store_get_vector(ctx, s, path, &v, &n))) goto fail;
+        if (n != ne) {
+            fprintf(stderr, "edgespace embed: point '%s' has %lld lengths, the store's "
+                    "topology %lld edges\n", point, (long long)n, (long long)ne);
+            es_free(ctx, v);
+            rc = ES_EMISMATCH;
+            goto done;
+        }
+        memcpy(target, v, (size_t)ne * sizeof *target);
+        es_free(ctx, v);
+        snprintf(path, sizeof path, "point/%s/scale", point);
+        if (scale == 0 && es_store_has(s, path)) {
+            if ((rc = es_store_get_vector(ctx, s, path, &v, &n))) goto fail;
+            if (n >= 1 && v[0] > 0) scale = v[0];
+            es_free(ctx, v);
+        }
+        if (scale == 0) {
+            for (int64_t i = 0; i < nrows; i++) scale += scales[i] / (double)nrows;
+        }
+    }
+    /* the initialization */
+    if (!strcmp(init, "nearest")) {
+        double d;
+        if ((rc = es_embed_nearest_row(ctx, s, target, NULL, 0, &initrow, &d))) goto fail;
+        snprintf(initdesc, sizeof initdesc, "nearest row %s (edge-length distance %.3g)",
+                 es_store_row_id(s, initrow), d);
+    } else if (!strncmp(init, "row:", 4)) {
+        if ((initrow = es_store_find_row(s, init + 4)) < 0) {
+            fprintf(stderr, "edgespace embed: no row '%s' in the store\n", init + 4);
+            rc = ES_ENOTFOUND;
+            goto done;
+        }
+        snprintf(initdesc, sizeof initdesc, "row %s", init + 4);
+    } else if (!strncmp(init, "mean", 4) && (init[4] == 0 || init[4] == ':')) {
+        if ((rc = es_store_select(ctx, s, init[4] ? init + 5 : NULL, &sel, &nsel))) goto fail;
+        if (nsel == 0) {
+            fprintf(stderr, "edgespace embed: --init %s selects no rows\n", init);
+            rc = ES_ENOTFOUND;
+            goto done;
+        }
+        if ((rc = es_embed_mean_dihedrals(ctx, s, mesh, sel, nsel, alpha))) goto fail;
+        initrow = sel[0];
+        snprintf(initdesc, sizeof initdesc, "circular mean of dihedrals of %lld rows (%s)",
+                 (long long)nsel, init);
+    } else {
+        rc = ES_EINVAL;
+        cli_usage_error("embed", "--init wants nearest, row:ID or mean[:FILTER]");
+        goto done;
+    }
+    if ((rc = es_store_read_positions(ctx, s, initrow, init_xyz))) goto fail;
+    es_embed_opts_init(&opts);
+    if (paper) {
+        opts.dihedral_mode = ES_EMBED_DIHEDRAL_ON;
+        opts.refine_max_iter = 0;
+    }
+    if ((rc = es_embedder_new(ctx, mesh, &emb)) ||
+        (rc = es_embed_solve(emb, target, scale, sel ? alpha : NULL, init_xyz, &opts, xyz, &rep)) ||
+        (rc = es_mesh_write(ctx, out, ES_FORMAT_AUTO, mesh, xyz, NULL)))
+        goto fail;
+    printf("embedded %s (%s) -> %s\ninit: %s\n%s", point, name, out, initdesc,
+           es_embed_report_format(&rep, text, sizeof text));
+    if (store_it) {
+        es_provenance prov = {NULL, initrow >= 0 && !sel ? &initrow : sel,
+                              sel ? nsel : 1, NULL};
+        char cmd[1024] = "edgespace embed", params[256];
+        for (int i = 1; i < argc; i++) {
+            strncat(cmd, " ", sizeof cmd - strlen(cmd) - 1);
+            strncat(cmd, argv[i], sizeof cmd - strlen(cmd) - 1);
+        }
+        snprintf(params, sizeof params, "point=%s; scale=%.17g", point, scale);
+        prov.command = cmd;
+        prov.params = params;
+        if ((rc = es_embed_store_result(ctx, s, name, &prov, emb, target, xyz, &rep, initdesc)) ||
+            (rc = es_store_commit(ctx, s)))
+            goto fail;
+        printf("stored: /analysis/embed/%s\n", name);
+    }
+    goto done;
+fail:
+    cli_fail("embed", ctx, rc);
+done:
+    es_embedder_free(emb);
+    es_mesh_free(mesh);
+    if (rc) es_store_abort(s);
+    else es_store_close(s);
+    es_free(ctx, sel);
+    free(target), free(xyz), free(init_xyz), free(alpha), free(scales);
+    es_ctx_free(ctx);
+    return rc ? CLI_FAIL : CLI_OK;
+}

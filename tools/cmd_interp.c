@@ -1,0 +1,251 @@
+/* tools/cmd_interp.c — edgespace interp: interpolate (or extrapolate)
+ * stored shapes in edge-length space, embed each result, print and store
+ * the quality reports (es_interp_embed). */
+#include "cli.h"
+#include "commands.h"
+
+#include <ctype.h>
+#include <getopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char usage[] =
+    "usage: edgespace interp STORE --from row:A --to row:B [--steps N] -o PATTERN\n"
+    "       edgespace interp STORE --weights \"0.2*row:a + 0.3*row:b + 0.5*row:c\" -o OUT\n"
+    "\n"
+    "Interpolate stored shapes in edge-length space (weighted mean of normalized\n"
+    "lengths at the weighted mean scale; dihedrals averaged on the circle as the\n"
+    "start) and embed each result as a mesh. Weights outside [0, 1] extrapolate.\n"
+    "Sequences are aligned frame to frame. Reports are printed and stored under\n"
+    "/analysis/embed/NAME_<i> (per-vertex residuals included).\n"
+    "\n"
+    "  -f, --from row:A      first shape (t = 0)\n"
+    "  -t, --to row:B        second shape (t = 1)\n"
+    "  -k, --steps N         frames from t0 to t1 inclusive (default 9)\n"
+    "      --t0 T, --t1 T    range of t (default 0 and 1)\n"
+    "  -w, --weights EXPR    w1*row:a + w2*row:b + ... (two or more rows)\n"
+    "  -o, --output PATTERN  mesh file; with several frames a printf pattern with\n"
+    "                        one integer conversion, e.g. 'cat_%02d.obj'\n"
+    "  -n, --name NAME       result name in the store (default: output base name)\n"
+    "      --no-store        do not write reports into the store\n"
+    "  -h, --help            show this help\n"
+    "\n"
+    "Exit status: 0 ok, 1 failure, 2 usage error.\n";
+
+#define MAX_IN 64
+
+/* Parse "w*row:id + w*row:id - row:id ...". Returns the count, -1 on error. */
+static int parse_weights(const char *expr, double *w, char ids[][256])
+{
+    const char *p = expr;
+    int n = 0;
+    while (*p) {
+        double sign = 1, coef = 1;
+        char *end;
+        while (isspace((unsigned char)*p)) p++;
+        if (!*p) break;
+        if (*p == '+' || *p == '-') {
+            sign = *p == '-' ? -1 : 1;
+            p++;
+            while (isspace((unsigned char)*p)) p++;
+        } else if (n > 0) {
+            return -1;
+        }
+        if (strncmp(p, "row:", 4)) {
+            coef = strtod(p, &end);
+            if (end == p) return -1;
+            p = end;
+            while (isspace((unsigned char)*p)) p++;
+            if (*p++ != '*') return -1;
+            while (isspace((unsigned char)*p)) p++;
+        }
+        if (strncmp(p, "row:", 4) || n == MAX_IN) return -1;
+        p += 4;
+        {
+            int k = 0;
+            while (*p && !isspace((unsigned char)*p) && *p != '+' && k < 255) ids[n][k++] = *p++;
+            ids[n][k] = 0;
+            if (!k) return -1;
+        }
+        w[n++] = sign * coef;
+    }
+    return n;
+}
+
+/* Expand a pattern with one %d, %Nd or %0Nd conversion; -1 if malformed. */
+static int expand_pattern(const char *pat, int i, char *out, size_t n)
+{
+    const char *pc = strchr(pat, '%'), *q;
+    int zero = 0, width = 0;
+    char num[32];
+    if (!pc || strchr(pc + 1, '%')) return -1;
+    q = pc + 1;
+    if (*q == '0') zero = 1, q++;
+    while (isdigit((unsigned char)*q)) width = width * 10 + (*q++ - '0');
+    if (*q != 'd' || width > 20) return -1;
+    if (zero) snprintf(num, sizeof num, "%0*d", width, i);
+    else snprintf(num, sizeof num, "%*d", width, i);
+    return snprintf(out, n, "%.*s%s%s", (int)(pc - pat), pat, num, q + 1) < (int)n ? 0 : -1;
+}
+
+static void base_name(const char *path, char *buf, size_t n)
+{
+    const char *b = strrchr(path, '/');
+    char *q;
+    snprintf(buf, n, "%s", b ? b + 1 : path);
+    if ((q = strrchr(buf, '.')) && q != buf) *q = 0;
+    if ((q = strchr(buf, '%'))) {
+        *q = 0;   /* 'cat_%02d' -> 'cat' (frames become cat_00, cat_01, ...) */
+        while (q > buf && (q[-1] == '_' || q[-1] == '-')) *--q = 0;
+    }
+    if (!*buf) snprintf(buf, n, "interp");
+}
+
+int cmd_interp(int argc, char **argv)
+{
+    static const struct option longopts[] = {
+        {"from", required_argument, NULL, 'f'}, {"to", required_argument, NULL, 't'},
+        {"steps", required_argument, NULL, 'k'}, {"t0", required_argument, NULL, '0'},
+        {"t1", required_argument, NULL, '1'},   {"weights", required_argument, NULL, 'w'},
+        {"output", required_argument, NULL, 'o'}, {"name", required_argument, NULL, 'n'},
+        {"no-store", no_argument, NULL, 'N'},   {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0}};
+    const char *from = NULL, *to = NULL, *weights = NULL, *out = NULL, *name = NULL;
+    char ids[MAX_IN][256], namebuf[256], fname[1024], rname[300], text[1024];
+    double w[MAX_IN], t0 = 0, t1 = 1, *xyz[MAX_IN] = {0}, *res = NULL, *len = NULL;
+    int64_t steps = 9, rows[MAX_IN], nin = 0, nv, ne;
+    int c, store_it = 1;
+    es_ctx *ctx;
+    es_store *s = NULL;
+    es_mesh *mesh = NULL;
+    es_embedder *emb = NULL;
+    es_status rc = ES_OK;
+    optind = 1;
+    while ((c = getopt_long(argc, argv, "f:t:k:w:o:n:h", longopts, NULL)) != -1) {
+        switch (c) {
+        case 'f': from = optarg; break;
+        case 't': to = optarg; break;
+        case 'k':
+            if (cli_parse_i64(optarg, &steps) || steps < 1 || steps > 100000)
+                return cli_usage_error("interp", "--steps wants a count >= 1");
+            break;
+        case '0':
+            if (cli_parse_double(optarg, &t0)) return cli_usage_error("interp", "bad --t0");
+            break;
+        case '1':
+            if (cli_parse_double(optarg, &t1)) return cli_usage_error("interp", "bad --t1");
+            break;
+        case 'w': weights = optarg; break;
+        case 'o': out = optarg; break;
+        case 'n': name = optarg; break;
+        case 'N': store_it = 0; break;
+        case 'h': fputs(usage, stdout); return CLI_OK;
+        default: return cli_usage_error("interp", "bad option");
+        }
+    }
+    if (optind != argc - 1) return cli_usage_error("interp", "give exactly one STORE");
+    if (!out) return cli_usage_error("interp", "--output is required");
+    if (weights) {
+        if (from || to) return cli_usage_error("interp", "--weights excludes --from/--to");
+        nin = parse_weights(weights, w, ids);
+        if (nin < 2)
+            return cli_usage_error("interp", "--weights wants 'w1*row:a + w2*row:b ...' with "
+                                   "two or more rows");
+        steps = 1;
+    } else {
+        if (!from || !to || strncmp(from, "row:", 4) || strncmp(to, "row:", 4))
+            return cli_usage_error("interp", "give --from row:A --to row:B, or --weights");
+        snprintf(ids[0], sizeof ids[0], "%s", from + 4);
+        snprintf(ids[1], sizeof ids[1], "%s", to + 4);
+        nin = 2;
+    }
+    if (steps > 1 && expand_pattern(out, 0, fname, sizeof fname))
+        return cli_usage_error("interp", "with several frames, --output must be a pattern "
+                               "with one integer conversion, like 'out_%%02d.obj'");
+    if (!name) {
+        base_name(out, namebuf, sizeof namebuf);
+        name = namebuf;
+    }
+    if (!(ctx = cli_ctx_new("interp"))) return CLI_FAIL;
+    if ((rc = es_store_open(ctx, argv[optind], store_it ? ES_STORE_WRITE : ES_STORE_READ, &s)) ||
+        (rc = es_store_mesh(ctx, s, &mesh)) || (rc = es_embedder_new(ctx, mesh, &emb)))
+        goto fail;
+    nv = es_mesh_nverts(mesh);
+    ne = es_mesh_nedges(mesh);
+    res = malloc(3 * (size_t)nv * sizeof *res);
+    len = malloc((size_t)ne * sizeof *len);
+    if (!res || !len) {
+        rc = ES_ENOMEM;
+        goto fail;
+    }
+    for (int64_t k = 0; k < nin; k++) {
+        if ((rows[k] = es_store_find_row(s, ids[k])) < 0) {
+            fprintf(stderr, "edgespace interp: no row '%s' in the store\n", ids[k]);
+            rc = ES_ENOTFOUND;
+            goto done;
+        }
+        if (!(xyz[k] = malloc(3 * (size_t)nv * sizeof *xyz[k]))) {
+            rc = ES_ENOMEM;
+            goto fail;
+        }
+        if ((rc = es_store_read_positions(ctx, s, rows[k], xyz[k]))) goto fail;
+    }
+    for (int64_t i = 0; i < steps; i++) {
+        double t = steps == 1 ? t0 : t0 + (t1 - t0) * (double)i / (double)(steps - 1);
+        double wi[MAX_IN];
+        es_embed_report rep;
+        es_interp_info info;
+        const double *const *in = (const double *const *)xyz;
+        if (weights) memcpy(wi, w, (size_t)nin * sizeof *wi);
+        else wi[0] = 1 - t, wi[1] = t;
+        /* frames align to the previous frame so that the sequence does not jump */
+        if ((rc = es_interp_embed(emb, nin, in, wi, i ? res : NULL, NULL, res, &rep, &info)))
+            goto fail;
+        if (steps > 1) {
+            expand_pattern(out, (int)i, fname, sizeof fname);
+            snprintf(rname, sizeof rname, "%s_%02d", name, (int)i);
+        } else {
+            snprintf(fname, sizeof fname, "%s", out);
+            snprintf(rname, sizeof rname, "%s", name);
+        }
+        if ((rc = es_mesh_write(ctx, fname, ES_FORMAT_AUTO, mesh, res, NULL))) goto fail;
+        if (weights) printf("%s: weights", fname);
+        else printf("%s: t = %.4g", fname, t);
+        printf(" (%lld dihedrals wrapped, %lld lengths clamped)\n%s",
+               (long long)info.n_wrapped, (long long)info.n_clamped,
+               es_embed_report_format(&rep, text, sizeof text));
+        if (store_it) {
+            char cmd[1024] = "edgespace interp", params[512], initd[64];
+            es_provenance prov = {cmd, rows, nin, params};
+            int off = 0;
+            for (int a = 1; a < argc; a++) {
+                strncat(cmd, " ", sizeof cmd - strlen(cmd) - 1);
+                strncat(cmd, argv[a], sizeof cmd - strlen(cmd) - 1);
+            }
+            for (int64_t k = 0; k < nin && off < (int)sizeof params - 40; k++)
+                off += snprintf(params + off, sizeof params - (size_t)off, "%sw[%s]=%.6g",
+                                k ? "; " : "", ids[k], wi[k]);
+            snprintf(initd, sizeof initd, "circular mean of the inputs' dihedrals");
+            if ((rc = es_interp_targets(ctx, mesh, nin, in, wi, len, NULL, NULL)) ||
+                (rc = es_embed_store_result(ctx, s, rname, &prov, emb, len, res, &rep, initd)))
+                goto fail;
+        }
+    }
+    if (store_it) {
+        if ((rc = es_store_commit(ctx, s))) goto fail;
+        printf("stored: /analysis/embed/%s%s\n", name, steps > 1 ? "_NN" : "");
+    }
+    goto done;
+fail:
+    cli_fail("interp", ctx, rc);
+done:
+    es_embedder_free(emb);
+    es_mesh_free(mesh);
+    if (rc) es_store_abort(s);
+    else es_store_close(s);
+    for (int k = 0; k < MAX_IN; k++) free(xyz[k]);
+    free(res), free(len);
+    es_ctx_free(ctx);
+    return rc ? CLI_FAIL : CLI_OK;
+}
