@@ -84,6 +84,12 @@ static int bad_name(const char *name)
     ES_FAIL(ctx, ES_EINVAL, "analysis: bad result name '%s' (no '/', not empty)", name); \
     } while (0)
 
+/* Length statistics need edges: a landmarks-only store has none. */
+#define NEED_EDGES(ctx, store) do { if (es_store_nedges(store) < 1) \
+    ES_FAIL(ctx, ES_EINVAL, "analysis: store '%s' has no edges: it holds landmarks only; " \
+            "give --edges or --triangles at ingest", es_store_path(store)); \
+    } while (0)
+
 /* ---- means -------------------------------------------------------------------- */
 
 void es_group_result_free(es_group_result *r)
@@ -108,6 +114,7 @@ es_status es_analysis_mean(es_ctx *ctx, es_store *store, const char *name, const
     es_group_result *r = NULL;
     if (out) *out = NULL;
     CHECK_NAME(ctx, name);
+    NEED_EDGES(ctx, store);
     const int64_t E = es_store_nedges(store), col = by ? es_store_find_column(store, by) : -1;
     if (by && col < 0) ES_FAIL(ctx, ES_ENOTFOUND, "mean: no label column '%s'", by);
     if ((rc = es_store_select(ctx, store, filter, &rows, &nrows)) != ES_OK) return rc;
@@ -250,6 +257,7 @@ es_status es_analysis_pca(es_ctx *ctx, es_store *store, const char *name, const 
     if (out) *out = NULL;
     if (rows_out) *rows_out = NULL;
     CHECK_NAME(ctx, name);
+    NEED_EDGES(ctx, store);
     es_status rc = es_store_select(ctx, store, filter, &rows, &nrows);
     if (rc != ES_OK) return rc;
     if ((rc = es_source_store(ctx, store, rows, nrows, &src)) != ES_OK ||
@@ -373,6 +381,7 @@ es_status es_analysis_diff(es_ctx *ctx, es_store *store, const char *name, const
 {
     if (out) *out = NULL;
     CHECK_NAME(ctx, name);
+    NEED_EDGES(ctx, store);
     if (!key || !column || !from || !to)
         ES_FAIL(ctx, ES_EINVAL, "diff: a key column, a role column, 'from' and 'to' are needed");
     if (!strcmp(from, to)) ES_FAIL(ctx, ES_EINVAL, "diff: 'from' and 'to' are both '%s'", from);
@@ -558,13 +567,17 @@ es_status es_analysis_point(es_ctx *ctx, es_store *store, const char *name, cons
     es_analysis_resolver r = {store, NULL, pca_name, NULL, NULL};
     if (vec) *vec = NULL;
     CHECK_NAME(ctx, name);
+    NEED_EDGES(ctx, store);
     const int64_t E = es_store_nedges(store);
     double *v = es__alloc_array(ctx, E, sizeof *v);
     if (!v) return ES_ENOMEM;
     es_status rc;
     if ((rc = es_point_parse(ctx, expr, &x)) != ES_OK ||
-        (rc = es_store_mesh(ctx, store, &mesh)) != ES_OK)
+        (es_store_nfaces(store) > 0 && (rc = es_store_mesh(ctx, store, &mesh)) != ES_OK))
         goto done;
+    /* A truss store has no faces: the point is not checked (in.checked = 0,
+     * recorded as valid = "unchecked"). A store without edges fails in
+     * es_point_eval's reads with the store's message. */
     r.mesh = mesh;
     if ((rc = es_point_eval(ctx, x, E, es_analysis_resolve, &r, mesh, v, &in)) != ES_OK) goto done;
     if (scale > 0) in.scale = scale;
@@ -580,7 +593,8 @@ es_status es_analysis_point(es_ctx *ctx, es_store *store, const char *name, cons
         snprintf(p, sizeof p, "point/%s", name);
         struct { const char *k; char v[64]; } at[6];
         snprintf(at[0].v, 64, "%.17g", in.weight);
-        snprintf(at[1].v, 64, "%d", in.validity.valid);
+        if (in.checked) snprintf(at[1].v, 64, "%d", in.validity.valid);
+        else snprintf(at[1].v, 64, "unchecked (no faces)");
         snprintf(at[2].v, 64, "%lld", (long long)in.validity.n_bad_faces);
         snprintf(at[3].v, 64, "%lld", (long long)in.validity.n_nonpositive);
         snprintf(at[4].v, 64, "%.17g", in.validity.worst_violation);

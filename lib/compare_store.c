@@ -45,8 +45,8 @@ es_status es_compare_store_run(es_ctx *ctx, es_store *store, const char *gpa_nam
     if (res) *res = NULL;
     if (!gpa_name || !*gpa_name || strchr(gpa_name, '/'))
         ES_FAIL(ctx, ES_EINVAL, "compare: bad GPA result name '%s'", gpa_name ? gpa_name : "");
-    if (e < 1) ES_FAIL(ctx, ES_EINVAL, "compare: the store has no edges (a landmark set needs "
-                       "a triangulation for edge-length statistics)");
+    if (e < 1) ES_FAIL(ctx, ES_EINVAL, "compare: store '%s' has no edges: it holds landmarks "
+                       "only; give --edges or --triangles at ingest", es_store_path(store));
     snprintf(path, sizeof path, "gpa/%s", gpa_name);
     if (!es_store_has(store, path))
         ES_FAIL(ctx, ES_ENOTFOUND, "compare: no GPA result '%s' in the store (run 'edgespace gpa "

@@ -42,6 +42,9 @@ es_status es_export_lengths_csv(es_ctx *ctx, es_store *s, const int64_t *rows, i
     FILE *f = NULL;
     if (!s || !path) ES_FAIL(ctx, ES_EINVAL, "export: NULL argument");
     E = es_store_nedges(s);
+    if (E < 1)
+        ES_FAIL(ctx, ES_EINVAL, "export: store '%s' has no edges: it holds landmarks only; give "
+                "--edges or --triangles at ingest", es_store_path(s));
     if ((rc = row_list(ctx, s, rows, nrows, &list, &n, &own))) return rc;
     if (!(len = es__alloc_array(ctx, E, sizeof *len)) ||
         !(edges = es__alloc_array(ctx, 2 * E, sizeof *edges)) ||

@@ -41,7 +41,13 @@
 #include <time.h>
 #include <unistd.h>
 
+/* Version 1: meshes only. Version 2 adds the root attribute topology_kind
+ * ("mesh", "truss", "none"): faces may be empty (truss: an edge list of
+ * landmark pairs), and so may edges (none: landmark configurations only, no
+ * /shapes/lengths or /shapes/scales). Mesh stores are still written as
+ * version 1, byte-compatible with earlier releases; both versions are read. */
 #define FORMAT_VERSION 1
+#define FORMAT_VERSION_KIND 2
 #define CACHE_BYTES (16u << 20)
 
 struct es_store {
@@ -55,6 +61,7 @@ struct es_store {
     struct stat orig;      /* identity of the original when it was copied */
     unsigned tmp_counter;
     int64_t nrows, nverts, nfaces, nedges;
+    es_topology_kind kind;
     char fingerprint[17];
     char **ids, **sources, **hashes; /* nrows each */
     int64_t cap;
@@ -614,9 +621,23 @@ static es_status load(es_store *s)
     if ((rc = read_attr_i64(ctx, s->file, "the root group", "format_version", &version)))
         return es__fail(ctx, ES_EFORMAT, "store: '%s' is not an edgespace store (%s)",
                         s->path, es_ctx_errmsg(ctx));
-    if (version != FORMAT_VERSION)
+    if (version != FORMAT_VERSION && version != FORMAT_VERSION_KIND)
         ES_FAIL(ctx, ES_EFORMAT, "store: '%s' has format version %lld; this edgespace reads "
-                "version %d", s->path, (long long)version, FORMAT_VERSION);
+                "versions %d and %d", s->path, (long long)version, FORMAT_VERSION,
+                FORMAT_VERSION_KIND);
+    s->kind = ES_TOPOLOGY_MESH;
+    if (version == FORMAT_VERSION_KIND) {
+        char kind[16];
+        if ((rc = read_attr_text(ctx, s->file, "topology_kind", kind, sizeof kind)))
+            return es__fail(ctx, ES_EFORMAT, "store: '%s' (format version 2): %s", s->path,
+                            es_ctx_errmsg(ctx));
+        if (!strcmp(kind, "mesh")) s->kind = ES_TOPOLOGY_MESH;
+        else if (!strcmp(kind, "truss")) s->kind = ES_TOPOLOGY_TRUSS;
+        else if (!strcmp(kind, "none")) s->kind = ES_TOPOLOGY_NONE;
+        else
+            ES_FAIL(ctx, ES_EFORMAT, "store: '%s' has topology_kind '%s' (want mesh, truss or "
+                    "none)", s->path, kind);
+    }
     if ((g = H5Gopen2(s->file, "/topology", H5P_DEFAULT)) < 0)
         return h5fail(ctx, ES_EFORMAT, "store: '%s' has no /topology", s->path);
     rc = read_attr_i64(ctx, g, "/topology", "nverts", &s->nverts);
@@ -628,15 +649,26 @@ static es_status load(es_store *s)
         ES_FAIL(ctx, ES_EFORMAT, "store: '%s': /topology/faces is not F x 3", s->path);
     if ((s->nedges = dataset_rows(s->file, "/topology/edges", 2, dims)) < 0 || dims[1] != 2)
         ES_FAIL(ctx, ES_EFORMAT, "store: '%s': /topology/edges is not E x 2", s->path);
-    if ((n = dataset_rows(s->file, "/shapes/lengths", 2, dims)) < 0 ||
-        (int64_t)dims[1] != s->nedges)
+    if ((s->kind == ES_TOPOLOGY_MESH) != (s->nfaces > 0) ||
+        (s->kind == ES_TOPOLOGY_NONE) != (s->nedges == 0))
+        ES_FAIL(ctx, ES_EFORMAT, "store: '%s': topology kind '%s' with %lld faces and %lld "
+                "edges", s->path, es_topology_kind_name(s->kind), (long long)s->nfaces,
+                (long long)s->nedges);
+    if (s->kind == ES_TOPOLOGY_NONE) {
+        n = dataset_rows(s->file, "/shapes/positions", 3, dims);
+        if (n < 0 || (int64_t)dims[1] != s->nverts || dims[2] != 3)
+            ES_FAIL(ctx, ES_EFORMAT, "store: '%s': /shapes/positions is not N x %lld x 3",
+                    s->path, (long long)s->nverts);
+    } else if ((n = dataset_rows(s->file, "/shapes/lengths", 2, dims)) < 0 ||
+               (int64_t)dims[1] != s->nedges) {
         ES_FAIL(ctx, ES_EFORMAT, "store: '%s': /shapes/lengths is not N x %lld", s->path,
                 (long long)s->nedges);
+    }
     if (dataset_rows(s->file, "/shapes/positions", 3, dims) != n ||
         (int64_t)dims[1] != s->nverts || dims[2] != 3)
         ES_FAIL(ctx, ES_EFORMAT, "store: '%s': /shapes/positions is not %lld x %lld x 3",
                 s->path, (long long)n, (long long)s->nverts);
-    if (dataset_rows(s->file, "/shapes/scales", 1, dims) != n)
+    if (s->kind != ES_TOPOLOGY_NONE && dataset_rows(s->file, "/shapes/scales", 1, dims) != n)
         ES_FAIL(ctx, ES_EFORMAT, "store: '%s': /shapes/scales does not have %lld rows",
                 s->path, (long long)n);
     s->nrows = 0;
@@ -721,9 +753,18 @@ static es_status create_impl(es_ctx *ctx, const char *path, int64_t nverts, int6
     struct tm tmv;
     *out = NULL;
     if (!path || !*path) ES_FAIL(ctx, ES_EINVAL, "store: empty path");
-    if (nverts < 1 || nfaces < 1 || nedges < 1 || !faces || !edges)
-        ES_FAIL(ctx, ES_EINVAL, "store: empty topology (%lld vertices, %lld faces, %lld "
+    if (nverts < 1 || nfaces < 0 || nedges < 0 || (nfaces > 0 && (!faces || nedges < 1)) ||
+        (nedges > 0 && !edges))
+        ES_FAIL(ctx, ES_EINVAL, "store: bad topology (%lld vertices, %lld faces, %lld "
                 "edges)", (long long)nverts, (long long)nfaces, (long long)nedges);
+    for (int64_t e = 0; nfaces == 0 && e < nedges; e++) {
+        const int64_t *p = edges + 2 * e;
+        if (p[0] < 0 || p[0] >= p[1] || p[1] >= nverts ||
+            (e > 0 && (p[-2] > p[0] || (p[-2] == p[0] && p[-1] >= p[1]))))
+            ES_FAIL(ctx, ES_EINVAL, "store: edge %lld (%lld, %lld) is not a (min, max) pair of "
+                    "vertices below %lld in sorted order without repeats", (long long)e,
+                    (long long)p[0], (long long)p[1], (long long)nverts);
+    }
     if (access(path, F_OK) == 0)
         ES_FAIL(ctx, ES_EEXIST, "store: '%s' exists already", path);
     if (!(s = es__calloc(ctx, 1, sizeof *s))) return ES_ENOMEM;
@@ -734,6 +775,7 @@ static es_status create_impl(es_ctx *ctx, const char *path, int64_t nverts, int6
     s->nverts = nverts;
     s->nfaces = nfaces;
     s->nedges = nedges;
+    s->kind = nfaces > 0 ? ES_TOPOLOGY_MESH : nedges > 0 ? ES_TOPOLOGY_TRUSS : ES_TOPOLOGY_NONE;
     snprintf(s->fingerprint, sizeof s->fingerprint, "%.16s", fingerprint ? fingerprint : "");
     if (!(s->path = es__strdup(ctx, path)) || !(s->work = temp_name(s))) {
         rc = ES_ENOMEM;
@@ -748,9 +790,13 @@ static es_status create_impl(es_ctx *ctx, const char *path, int64_t nverts, int6
     }
     gmtime_r(&now, &tmv);
     strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", &tmv);
-    if ((rc = write_attr_i64(ctx, s->file, "format_version", FORMAT_VERSION)) ||
+    if ((rc = write_attr_i64(ctx, s->file, "format_version",
+                             s->kind == ES_TOPOLOGY_MESH ? FORMAT_VERSION
+                                                         : FORMAT_VERSION_KIND)) ||
         (rc = write_attr_str(ctx, s->file, "creator", "edgespace " ES_VERSION_STRING)) ||
-        (rc = write_attr_str(ctx, s->file, "created", when)))
+        (rc = write_attr_str(ctx, s->file, "created", when)) ||
+        (s->kind != ES_TOPOLOGY_MESH &&
+         (rc = write_attr_str(ctx, s->file, "topology_kind", es_topology_kind_name(s->kind)))))
         goto fail;
     if ((g = H5Gcreate2(s->file, "/topology", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) < 0) {
         rc = h5fail(ctx, ES_EIO, "store: cannot create /topology");
@@ -764,7 +810,7 @@ static es_status create_impl(es_ctx *ctx, const char *path, int64_t nverts, int6
     if ((sp = H5Screate_simple(2, d, NULL)) < 0 ||
         (ds = H5Dcreate2(g, "faces", H5T_STD_I64LE, sp, H5P_DEFAULT, H5P_DEFAULT,
                          H5P_DEFAULT)) < 0 ||
-        H5Dwrite(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, faces) < 0) {
+        (nfaces > 0 && H5Dwrite(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, faces) < 0)) {
         rc = h5fail(ctx, ES_EIO, "store: cannot write /topology/faces");
         goto fail;
     }
@@ -776,7 +822,7 @@ static es_status create_impl(es_ctx *ctx, const char *path, int64_t nverts, int6
     if ((sp = H5Screate_simple(2, d, NULL)) < 0 ||
         (ds = H5Dcreate2(g, "edges", H5T_STD_I64LE, sp, H5P_DEFAULT, H5P_DEFAULT,
                          H5P_DEFAULT)) < 0 ||
-        H5Dwrite(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, edges) < 0) {
+        (nedges > 0 && H5Dwrite(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, edges) < 0)) {
         rc = h5fail(ctx, ES_EIO, "store: cannot write /topology/edges");
         goto fail;
     }
@@ -787,8 +833,11 @@ static es_status create_impl(es_ctx *ctx, const char *path, int64_t nverts, int6
         rc = h5fail(ctx, ES_EIO, "store: cannot create /shapes");
         goto fail;
     }
-    if ((rc = create_rows(ctx, g, "lengths", H5T_IEEE_F64LE, 2, (hsize_t)nedges, 0, 8)) ||
-        (rc = create_rows(ctx, g, "scales", H5T_IEEE_F64LE, 1, 0, 0, 8)) ||
+    /* HDF5 chunks cannot be 0 wide: a store without edges has no lengths
+     * (and no scales, which are sums of raw edge lengths). */
+    if ((nedges > 0 &&
+         ((rc = create_rows(ctx, g, "lengths", H5T_IEEE_F64LE, 2, (hsize_t)nedges, 0, 8)) ||
+          (rc = create_rows(ctx, g, "scales", H5T_IEEE_F64LE, 1, 0, 0, 8)))) ||
         (rc = create_rows(ctx, g, "positions", H5T_IEEE_F64LE, 3, (hsize_t)nverts, 3, 8)) ||
         (rc = create_rows(ctx, g, "ids", t, 1, 0, 0, 16)) ||
         (rc = create_rows(ctx, g, "source_paths", t, 1, 0, 0, 16)) ||
@@ -971,6 +1020,10 @@ int64_t es_store_nrows(const es_store *s) { return s ? s->nrows : 0; }
 int64_t es_store_nedges(const es_store *s) { return s ? s->nedges : 0; }
 int64_t es_store_nverts(const es_store *s) { return s ? s->nverts : 0; }
 int64_t es_store_nfaces(const es_store *s) { return s ? s->nfaces : 0; }
+es_topology_kind es_store_topology_kind(const es_store *s)
+{
+    return s ? s->kind : ES_TOPOLOGY_MESH;
+}
 const char *es_store_path(const es_store *s) { return s ? s->path : NULL; }
 const char *es_store_fingerprint(const es_store *s) { return s ? s->fingerprint : NULL; }
 
@@ -1038,9 +1091,16 @@ static es_status read_block(es_ctx *ctx, es_store *s, const char *name, int64_t 
     return rc;
 }
 
+static es_status no_edges(es_ctx *ctx, const es_store *s)
+{
+    ES_FAIL(ctx, ES_EINVAL, "store: '%s' has no edges: it holds landmarks only; give --edges "
+            "or --triangles at ingest", s->path);
+}
+
 static es_status check_out(es_ctx *ctx, es_store *s, int64_t n, es_mat out)
 {
     if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    if (s->nedges == 0) return no_edges(ctx, s);
     if (n < 0 || !out.data || out.rows != s->nedges || out.cols != n || out.ld < out.rows)
         ES_FAIL(ctx, ES_EINVAL, "store: output matrix is %lld x %lld (ld %lld), need "
                 "%lld x %lld", (long long)out.rows, (long long)out.cols, (long long)out.ld,
@@ -1110,6 +1170,7 @@ static es_status read_1d(es_ctx *ctx, es_store *s, const char *name, hid_t mtype
 es_status es_store_read_scales(es_ctx *ctx, es_store *s, double *scales)
 {
     es_status rc = ES_OK;
+    if (s && s->nedges == 0) return no_edges(ctx, s);
     if (s && s->nrows == 0) return ES_OK;
     H5E_BEGIN_TRY { rc = read_1d(ctx, s, "/shapes/scales", H5T_NATIVE_DOUBLE, scales); }
     H5E_END_TRY
@@ -1119,6 +1180,7 @@ es_status es_store_read_scales(es_ctx *ctx, es_store *s, double *scales)
 es_status es_store_read_faces(es_ctx *ctx, es_store *s, int64_t *faces)
 {
     es_status rc;
+    if (s && s->nfaces == 0) return ES_OK;
     H5E_BEGIN_TRY { rc = read_1d(ctx, s, "/topology/faces", H5T_NATIVE_INT64, faces); }
     H5E_END_TRY
     return rc;
@@ -1127,6 +1189,7 @@ es_status es_store_read_faces(es_ctx *ctx, es_store *s, int64_t *faces)
 es_status es_store_read_edges(es_ctx *ctx, es_store *s, int64_t *edges)
 {
     es_status rc;
+    if (s && s->nedges == 0) return ES_OK;
     H5E_BEGIN_TRY { rc = read_1d(ctx, s, "/topology/edges", H5T_NATIVE_INT64, edges); }
     H5E_END_TRY
     return rc;
@@ -1169,7 +1232,8 @@ static bool bad_name(const char *name)
 
 static es_status validate_rows(es_ctx *ctx, const es_store *s, const es_store_rows *r)
 {
-    if (r->n < 0 || (r->n > 0 && (!r->ids || !r->lengths || !r->scales || !r->xyz)) ||
+    const bool lens = s->nedges > 0;   /* a store without edges ignores lengths/scales */
+    if (r->n < 0 || (r->n > 0 && (!r->ids || (lens && (!r->lengths || !r->scales)) || !r->xyz)) ||
         r->ncols < 0 || (r->ncols > 0 && (!r->colnames || (r->n > 0 && !r->labels))))
         ES_FAIL(ctx, ES_EINVAL, "store: incomplete rows to append");
     for (int64_t c = 0; c < r->ncols; c++) {
@@ -1189,7 +1253,7 @@ static es_status validate_rows(es_ctx *ctx, const es_store *s, const es_store_ro
         for (int64_t k = 0; k < i; k++)
             if (!strcmp(r->ids[k], id))
                 ES_FAIL(ctx, ES_EEXIST, "store: id '%s' is given twice", id);
-        if (!(r->scales[i] > 0) || !isfinite(r->scales[i]))
+        if (lens && (!(r->scales[i] > 0) || !isfinite(r->scales[i])))
             ES_FAIL(ctx, ES_EINVAL, "store: row '%s' has scale %g (must be finite, > 0)", id,
                     r->scales[i]);
         for (int64_t e = 0; e < s->nedges; e++)
@@ -1249,8 +1313,9 @@ static es_status append_impl(es_ctx *ctx, es_store *s, const es_store_rows *r)
     if ((rc = add_columns(ctx, s, r, g, t))) goto done;
     if ((rc = reserve_rows(s, n0 + n))) goto done;
     if (n == 0) goto done;
-    if ((rc = append_rows(ctx, s->file, "/shapes/lengths", H5T_NATIVE_DOUBLE, n, r->lengths)) ||
-        (rc = append_rows(ctx, s->file, "/shapes/scales", H5T_NATIVE_DOUBLE, n, r->scales)) ||
+    if ((s->nedges > 0 &&
+         ((rc = append_rows(ctx, s->file, "/shapes/lengths", H5T_NATIVE_DOUBLE, n, r->lengths)) ||
+          (rc = append_rows(ctx, s->file, "/shapes/scales", H5T_NATIVE_DOUBLE, n, r->scales)))) ||
         (rc = append_rows(ctx, s->file, "/shapes/positions", H5T_NATIVE_DOUBLE, n, r->xyz)))
         goto done;
     if (!(tmp = es__alloc_array(ctx, n, sizeof *tmp))) { rc = ES_ENOMEM; goto done; }

@@ -18,6 +18,47 @@ es_status es_store_create(es_ctx *ctx, const char *path, const es_mesh *mesh, es
                                 fp, out);
 }
 
+const char *es_topology_kind_name(es_topology_kind kind)
+{
+    switch (kind) {
+    case ES_TOPOLOGY_MESH: return "mesh";
+    case ES_TOPOLOGY_TRUSS: return "truss";
+    case ES_TOPOLOGY_NONE: return "none";
+    }
+    return "?";
+}
+
+/* FNV-1a 64 over little-endian int64 values, as es_faces_fingerprint. */
+static uint64_t fnv_i64(uint64_t h, int64_t x)
+{
+    uint64_t u = (uint64_t)x;
+    for (int i = 0; i < 8; i++) {
+        h ^= (u >> (8 * i)) & 0xffu;
+        h *= UINT64_C(0x100000001b3);
+    }
+    return h;
+}
+
+es_status es_store_create_edges(es_ctx *ctx, const char *path, int64_t nverts, int64_t nedges,
+                                const int64_t *edges, es_store **out)
+{
+    static const char hex[] = "0123456789abcdef";
+    char fp[17];
+    *out = NULL;
+    if (nedges < 0 || (nedges > 0 && !edges))
+        ES_FAIL(ctx, ES_EINVAL, "store: bad edge list (%lld edges)", (long long)nedges);
+    if (nedges == 0) {
+        es_faces_fingerprint(nverts, 0, NULL, fp);
+    } else {
+        uint64_t h = UINT64_C(0xcbf29ce484222325);
+        h = fnv_i64(fnv_i64(h, nverts), nedges);
+        for (int64_t i = 0; i < 2 * nedges; i++) h = fnv_i64(h, edges[i]);
+        for (int i = 0; i < 16; i++) fp[i] = hex[(h >> (60 - 4 * i)) & 0xfu];
+        fp[16] = '\0';
+    }
+    return es__store_create_raw(ctx, path, nverts, 0, NULL, nedges, edges, fp, out);
+}
+
 es_status es_store_mesh(es_ctx *ctx, es_store *store, es_mesh **out)
 {
     int64_t V = es_store_nverts(store), F = es_store_nfaces(store), n3;
@@ -26,6 +67,13 @@ es_status es_store_mesh(es_ctx *ctx, es_store *store, es_mesh **out)
     es_status rc;
     *out = NULL;
     if (!store) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    if (es_store_topology_kind(store) == ES_TOPOLOGY_NONE)
+        ES_FAIL(ctx, ES_EINVAL, "store: '%s' has no edges: it holds landmarks only; give "
+                "--edges or --triangles at ingest", es_store_path(store));
+    if (F == 0)
+        ES_FAIL(ctx, ES_EINVAL, "store: '%s' is a truss store (%lld edges between landmarks, "
+                "no faces): it has no mesh to embed or check; give --triangles at ingest for "
+                "one", es_store_path(store), (long long)es_store_nedges(store));
     if (!es__mul_i64(F, 3, &n3) || !(faces = es__alloc_array(ctx, n3, sizeof *faces)))
         return ES_ENOMEM;
     if ((rc = es_store_read_faces(ctx, store, faces))) goto done;

@@ -76,9 +76,15 @@ int cmd_info(int argc, char **argv)
         return CLI_FAIL;
     }
     printf("store        %s\n", es_store_path(s));
-    printf("topology     %lld vertices, %lld faces, %lld edges, fingerprint %s\n",
-           (long long)es_store_nverts(s), (long long)es_store_nfaces(s),
-           (long long)es_store_nedges(s), es_store_fingerprint(s));
+    printf("topology     %s: %lld vertices, %lld faces, %lld edges, fingerprint %s\n",
+           es_topology_kind_name(es_store_topology_kind(s)), (long long)es_store_nverts(s),
+           (long long)es_store_nfaces(s), (long long)es_store_nedges(s),
+           es_store_fingerprint(s));
+    if (es_store_topology_kind(s) == ES_TOPOLOGY_NONE)
+        printf("             landmarks only: no edge lengths (gpa runs; length statistics "
+               "need --edges or --triangles at ingest)\n");
+    else if (es_store_topology_kind(s) == ES_TOPOLOGY_TRUSS)
+        printf("             truss: lengths of landmark pairs, no faces (no embed)\n");
     printf("rows         %lld", (long long)es_store_nrows(s));
     for (int64_t i = 0; i < es_store_nrows(s) && i < 4; i++)
         printf("%s%s", i ? ", " : ": ", es_store_row_id(s, i));
@@ -101,7 +107,8 @@ int cmd_info(int argc, char **argv)
     }
     if (rows) {
         double *scales = malloc((size_t)(es_store_nrows(s) + 1) * sizeof *scales);
-        if (!scales || (rc = es_store_read_scales(ctx, s, scales))) {
+        if (!scales ||
+            (es_store_nedges(s) > 0 && (rc = es_store_read_scales(ctx, s, scales)))) {
             free(scales);
             if (!scales) rc = ES_ENOMEM;
             goto fail;
@@ -111,7 +118,8 @@ int cmd_info(int argc, char **argv)
             printf("\t%s", es_store_column_name(s, col));
         printf("\n");
         for (int64_t i = 0; i < es_store_nrows(s); i++) {
-            printf("%s\t%.17g", es_store_row_id(s, i), scales[i]);
+            if (es_store_nedges(s) > 0) printf("%s\t%.17g", es_store_row_id(s, i), scales[i]);
+            else printf("%s\t-", es_store_row_id(s, i));
             for (int64_t col = 0; col < es_store_ncolumns(s); col++)
                 printf("\t%s", es_store_label(s, i, col));
             printf("\n");

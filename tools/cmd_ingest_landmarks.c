@@ -1,5 +1,6 @@
 /* tools/cmd_ingest_landmarks.c — edgespace ingest-landmarks: a landmark set
- * (TPS or long CSV) with a triangulation of its landmarks into a new store. */
+ * (TPS or long CSV) into a new store, with a triangulation of its landmarks,
+ * an edge list ("truss") or no topology at all. */
 #include "cli.h"
 #include "commands.h"
 
@@ -9,18 +10,23 @@
 
 static const char usage[] =
     "usage: edgespace ingest-landmarks STORE (--tps FILE | --csv FILE [--specimens FILE])\n"
-    "                                  --triangles FILE\n"
+    "                                  [--triangles FILE | --edges FILE]\n"
     "\n"
-    "Read landmarks, 2D or 3D, and store them in the new HDF5 store STORE with a\n"
-    "triangulation of the landmarks, so that 'edgespace gpa' and the edge-length\n"
-    "tools (compare, ...) run on them. 2D landmarks are stored with z = 0.\n"
+    "Read landmarks, 2D or 3D, into the new HDF5 store STORE. 2D landmarks are\n"
+    "stored with z = 0. What the store can do depends on the topology given:\n"
+    "  --triangles  a mesh over the landmarks: every tool runs (gpa, mean, pca,\n"
+    "               diff, point, compare, embed, export)\n"
+    "  --edges      a \"truss\" of landmark pairs: normalized pair lengths are\n"
+    "               stored, so gpa and the edge-length statistics (mean, pca,\n"
+    "               diff, point, compare) run; no faces, so no embed\n"
+    "  neither      landmark configurations only: gpa, info and export of\n"
+    "               positions; length statistics refuse\n"
     "\n"
     "  -t, --tps FILE        tpsDig file (LM=, LM3=, ID=, IMAGE=, SCALE=; CURVES ignored)\n"
     "  -c, --csv FILE        long CSV: specimen, landmark, x, y[, z]\n"
     "  -s, --specimens FILE  CSV of labels: specimen id, then label columns\n"
     "  -T, --triangles FILE  triangles of 1-based landmark numbers, 3 per line\n"
-    "  -e, --edges FILE      edge list (2 per line): checked, but the store format\n"
-    "                        needs faces; use --triangles to store\n"
+    "  -e, --edges FILE      landmark pairs, 1-based, 2 per line (truss lengths)\n"
     "      --no-tps-scale    keep TPS coordinates unscaled (SCALE= is recorded)\n"
     "  -q, --quiet           print nothing on success\n"
     "  -h, --help            show this help\n"
@@ -66,13 +72,15 @@ int cmd_ingest_landmarks(int argc, char **argv)
     if (rc == ES_OK && (tri || edges))
         rc = es_landmarks_read_index_list(ctx, tri ? tri : edges, tri ? 3 : 2, &idx, &count);
     if (rc == ES_OK)
-        rc = es_landmarks_to_store(ctx, lm, tri ? count : 0, tri ? idx : NULL, argv[optind]);
+        rc = edges ? es_landmarks_to_store_edges(ctx, lm, count, idx, argv[optind])
+                   : es_landmarks_to_store(ctx, lm, count, idx, argv[optind]);
     if (rc != ES_OK) {
         cli_fail("ingest-landmarks", ctx, rc);
     } else if (!quiet) {
-        printf("%s: %lld specimens x %lld landmarks (%dD), %lld triangles, %lld label "
+        printf("%s: %lld specimens x %lld landmarks (%dD), %lld %s, %lld label "
                "columns\n", argv[optind], (long long)lm->n, (long long)lm->k, lm->d,
-               (long long)count, (long long)lm->ncols);
+               (long long)count, tri ? "triangles" : edges ? "edges (truss)" : "edges (landmarks only)",
+               (long long)lm->ncols);
     }
     es_free(ctx, idx);
     es_landmarks_free(lm);

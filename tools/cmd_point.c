@@ -75,7 +75,10 @@ int cmd_point(int argc, char **argv)
     else printf("scale: %.9g%s\n", info.scale, scale > 0 ? " (given)" : "");
     printf("lengths sum to %.12g\n", info.length_sum);
     const es_validity *v = &info.validity;
-    if (v->valid) {
+    if (!info.checked) {
+        printf("validity: not checked (a truss store has no faces for the triangle "
+               "inequality)\n");
+    } else if (v->valid) {
         printf("valid: every length positive, every face satisfies the triangle inequality\n");
     } else {
         printf("INVALID: %lld non-finite, %lld non-positive lengths; %lld faces violate the "

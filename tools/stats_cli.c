@@ -63,17 +63,19 @@ void stats_csv_number(FILE *f, double v)
 
 int64_t *stats_edges(const char *verb, es_ctx *ctx, es_store *store)
 {
-    es_mesh *m = NULL;
-    es_status rc = es_store_mesh(ctx, store, &m);
-    if (rc != ES_OK) {
-        cli_fail(verb, ctx, rc);
+    /* the stored edge list, not es_store_mesh: truss stores have no faces */
+    int64_t E = es_store_nedges(store);
+    int64_t *e = malloc((size_t)(2 * E > 0 ? 2 * E : 1) * sizeof *e);
+    if (!e) {
+        fprintf(stderr, "edgespace %s: out of memory\n", verb);
         return NULL;
     }
-    int64_t E = es_mesh_nedges(m);
-    int64_t *e = malloc((size_t)(2 * E > 0 ? 2 * E : 1) * sizeof *e);
-    if (e) memcpy(e, es_mesh_edges(m), (size_t)(2 * E) * sizeof *e);
-    else fprintf(stderr, "edgespace %s: out of memory\n", verb);
-    es_mesh_free(m);
+    es_status rc = es_store_read_edges(ctx, store, e);
+    if (rc != ES_OK) {
+        cli_fail(verb, ctx, rc);
+        free(e);
+        return NULL;
+    }
     return e;
 }
 

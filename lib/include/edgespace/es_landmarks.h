@@ -85,14 +85,26 @@ ES_API es_status es_landmarks_read_index_list(es_ctx *ctx, const char *path, int
 /* Create the store `path` from a landmark set and a triangulation of its
  * landmarks (ntri triangles, 3 x ntri 0-based indices; it must be an
  * oriented manifold, es_mesh_new's checks): the triangles' edges are the
- * store's edges, so edge-length statistics run on the landmarks. 2D
- * landmarks are stored with z = 0 (es_gpa_store_run analyses such rows in
- * 2D). Labels become label columns; TPS IMAGE= and SCALE= values are kept
- * as columns "image" and "tps_scale" when present. The store format needs
- * faces: a set without a triangulation cannot be stored (ES_EINVAL says so).
- * ES_EEXIST if path exists. All-or-nothing (es_store_commit). */
+ * store's edges, so every tool runs on the landmarks. With ntri = 0 or tri
+ * NULL the store holds no faces and no edges (topology kind "none"):
+ * positions, ids and labels only, for GPA; length operations on it fail.
+ * 2D landmarks are stored with z = 0 in the store's 3 x V positions
+ * (es_gpa_store_run analyses such rows in 2D). Labels become label columns;
+ * TPS IMAGE= and SCALE= values are kept as columns "image" and "tps_scale"
+ * when present. ES_EEXIST if path exists. All-or-nothing (es_store_commit). */
 ES_API es_status es_landmarks_to_store(es_ctx *ctx, const es_landmarks *lm, int64_t ntri,
                                        const int64_t *tri, const char *path);
+
+/* As es_landmarks_to_store, with an edge list of landmark pairs instead of
+ * triangles (a "truss" store: 2 x nedges 0-based indices, any order and
+ * orientation; made (min, max) and sorted, repeats dropped with a warning).
+ * Each row's lengths are the pairs' distances divided by their sum, as for
+ * meshes, so mean, pca, diff and point run on them; there are no faces.
+ * nedges = 0 makes a landmarks-only store. ES_EINVAL on an index out of
+ * range or a pair with equal ends. */
+ES_API es_status es_landmarks_to_store_edges(es_ctx *ctx, const es_landmarks *lm,
+                                             int64_t nedges, const int64_t *edges,
+                                             const char *path);
 
 #ifdef __cplusplus
 }

@@ -30,6 +30,24 @@ extern "C" {
 
 typedef struct es_store es_store;
 
+/* What the store's topology is (format version 2, root attribute
+ * topology_kind; version 1 stores are meshes):
+ *  - MESH:  triangle faces and the edges they make (es_mesh.h);
+ *  - TRUSS: an edge list of vertex (landmark) pairs and no faces: lengths
+ *           and length statistics work, es_store_mesh does not;
+ *  - NONE:  no faces and no edges (landmark configurations only): positions,
+ *           ids and labels; E = 0, and every length operation
+ *           (es_store_read_lengths, _rows, _scales, PCA, ...) fails with
+ *           ES_EINVAL "store has no edges: it holds landmarks only". */
+typedef enum es_topology_kind {
+    ES_TOPOLOGY_MESH = 0,
+    ES_TOPOLOGY_TRUSS = 1,
+    ES_TOPOLOGY_NONE = 2
+} es_topology_kind;
+
+/* "mesh", "truss" or "none" (static string; "?" for other values). */
+ES_API const char *es_topology_kind_name(es_topology_kind kind);
+
 typedef enum es_store_mode {
     ES_STORE_READ = 0,
     ES_STORE_WRITE = 1   /* read and write an existing store */
@@ -45,6 +63,15 @@ ES_API es_status es_store_open(es_ctx *ctx, const char *path, es_store_mode mode
  * Fails with ES_EEXIST if `path` exists. */
 ES_API es_status es_store_create(es_ctx *ctx, const char *path, const es_mesh *mesh,
                                  es_store **out);
+/* Create a new, empty store without faces, open for writing: a "truss"
+ * store over nedges vertex pairs (edges: 2 x nedges, each (min, max) with
+ * min < max < nverts, sorted lexicographically, no repeats; ES_EINVAL
+ * otherwise), or, with nedges = 0 (edges may be NULL), a store of vertex
+ * positions only (ES_TOPOLOGY_NONE). Its fingerprint is FNV-1a 64 over
+ * (nverts, nedges, the 2E indices) for a truss, over nverts alone for none.
+ * Written as format version 2; otherwise as es_store_create. */
+ES_API es_status es_store_create_edges(es_ctx *ctx, const char *path, int64_t nverts,
+                                       int64_t nedges, const int64_t *edges, es_store **out);
 /* Publish what was written so far (atomic rename over the store; no-op if
  * nothing was written). The handle stays usable; later writes start a new
  * working copy. On failure nothing is published and the handle refuses
@@ -59,14 +86,15 @@ ES_API void es_store_abort(es_store *store);
 ES_API int64_t es_store_nrows(const es_store *store);
 ES_API int64_t es_store_nedges(const es_store *store);
 ES_API int64_t es_store_nverts(const es_store *store);
-ES_API int64_t es_store_nfaces(const es_store *store);
+ES_API int64_t es_store_nfaces(const es_store *store);   /* 0 unless a mesh store */
+ES_API es_topology_kind es_store_topology_kind(const es_store *store);
 ES_API const char *es_store_path(const es_store *store);
 /* Topology fingerprint (es_mesh_fingerprint of the stored faces), 16 hex
  * digits. Borrowed, valid until close. */
 ES_API const char *es_store_fingerprint(const es_store *store);
 
 /* The stored face list (3 x F, 0-based) and edge list (2 x E, (min, max),
- * sorted), as es_mesh defines them. */
+ * sorted), as es_mesh defines them. Nothing is read when F (or E) is 0. */
 ES_API es_status es_store_read_faces(es_ctx *ctx, es_store *store, int64_t *faces);
 ES_API es_status es_store_read_edges(es_ctx *ctx, es_store *store, int64_t *edges);
 
@@ -76,8 +104,9 @@ typedef struct es_store_rows {
     const char *const *ids;            /* n unique, non-empty ids */
     const char *const *source_paths;   /* n, or NULL (stored as "") */
     const char *const *content_hashes; /* n, or NULL (stored as "") */
-    const double *lengths;             /* E x n normalized lengths (column = row) */
-    const double *scales;              /* n, finite and > 0 */
+    const double *lengths;             /* E x n normalized lengths (column = row);
+                                          ignored (may be NULL) when E = 0 */
+    const double *scales;              /* n, finite and > 0; ignored when E = 0 */
     const double *xyz;                 /* 3V x n positions as ingested */
     int64_t ncols;                     /* label columns given */
     const char *const *colnames;       /* ncols names (no '/', not '.' or '..') */
@@ -93,7 +122,9 @@ typedef struct es_store_rows {
 ES_API es_status es_store_append(es_ctx *ctx, es_store *store, const es_store_rows *rows);
 
 /* The stored topology (reference positions: those of row 0, or none for an
- * empty store). Caller owns *out. */
+ * empty store). Caller owns *out. A truss or landmarks-only store has no
+ * faces and so no mesh: ES_EINVAL says so (length statistics do not need
+ * it; read the edges with es_store_read_edges). */
 ES_API es_status es_store_mesh(es_ctx *ctx, es_store *store, es_mesh **out);
 
 /* Normalized lengths of rows [row0, row0 + n) into out (E x n, column j =
@@ -103,9 +134,11 @@ ES_API es_status es_store_read_lengths(es_ctx *ctx, es_store *store, int64_t row
 /* Lengths of an arbitrary list of rows (E x nrows). */
 ES_API es_status es_store_read_lengths_rows(es_ctx *ctx, es_store *store, const int64_t *rows,
                                             int64_t nrows, es_mat out);
-/* Scales (sum of raw edge lengths) of all N rows. */
+/* Scales (sum of raw edge lengths) of all N rows. A store without edges
+ * has none: ES_EINVAL. */
 ES_API es_status es_store_read_scales(es_ctx *ctx, es_store *store, double *scales /* N */);
-/* Vertex positions of one row, as ingested (3 x V). */
+/* Vertex positions of one row, as ingested (3 x V; 2D landmarks have
+ * z = 0). */
 ES_API es_status es_store_read_positions(es_ctx *ctx, es_store *store, int64_t row,
                                          double *xyz);
 
