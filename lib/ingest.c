@@ -402,6 +402,12 @@ static es_status ingest(es_ctx *ctx, const char *store_path, int64_t n, const in
     if (exists) {
         int64_t nf3;
         if ((rc = es_store_open(ctx, store_path, ES_STORE_WRITE, &st))) return rc;
+        if (es_store_topology_kind(st) != ES_TOPOLOGY_MESH) {
+            rc = es__fail(ctx, ES_EMISMATCH, "ingest: store '%s' holds landmarks without faces "
+                          "(topology kind '%s'): meshes cannot be added to it", store_path,
+                          es_topology_kind_name(es_store_topology_kind(st)));
+            goto done;
+        }
         r.V = es_store_nverts(st);
         r.F = es_store_nfaces(st);
         if (!es__mul_i64(r.F, 3, &nf3) ||

@@ -66,7 +66,8 @@ int cmd_project(int argc, char **argv)
     es_status rc;
     if ((rc = es_store_open(ctx, argv[optind], ES_STORE_READ, &st)) != ES_OK ||
         (rc = es_analysis_pca_load(ctx, st, pca_name, &p, NULL, NULL)) != ES_OK ||
-        (rc = es_store_mesh(ctx, st, &mesh)) != ES_OK ||
+        /* rows of a truss store project without a mesh; files need its faces */
+        (es_store_nfaces(st) > 0 && (rc = es_store_mesh(ctx, st, &mesh)) != ES_OK) ||
         (where && (rc = es_store_select(ctx, st, where, &rows, &nrows)) != ES_OK)) {
         cli_fail("project", ctx, rc);
         goto done;
@@ -90,7 +91,8 @@ int cmd_project(int argc, char **argv)
         if (i < argc - optind - 1) {
             in = argv[optind + 1 + i];
             if (is_mesh_path(in)) {
-                rc = es_lengths_from_file(ctx, mesh, in, x, &scale);
+                rc = mesh ? es_lengths_from_file(ctx, mesh, in, x, &scale)
+                          : es_store_mesh(ctx, st, &mesh);   /* fails: says why */
             } else {
                 int64_t row = es_store_find_row(st, in);
                 if (row < 0) {
