@@ -527,8 +527,8 @@ es_status es_analysis_resolve(es_ctx *ctx, void *ud, es_point_leaf kind, const c
     }
     case ES_POINT_FILE:
         if (!r->mesh)
-            ES_FAIL(ctx, ES_EINVAL, "file:%s: store '%s' has no faces (a %s store), so mesh "
-                    "files cannot be matched to it", arg, es_store_path(r->store),
+            ES_FAIL(ctx, ES_EINVAL, "store '%s' has no faces (a %s store), so mesh files "
+                    "cannot be matched to it", es_store_path(r->store),
                     es_topology_kind_name(es_store_topology_kind(r->store)));
         return es_lengths_from_file(ctx, r->mesh, arg, vec, scale);
     case ES_POINT_PC:
