@@ -93,9 +93,13 @@ es_status es__fail(es_ctx *ctx, es_status code, const char *fmt, ...)
 {
     va_list ap;
     if (!ctx) return code;
+    /* Format aside: callers may pass es_ctx_errmsg(ctx) itself as an argument
+     * (wrapping an inner message), and vsnprintf's buffers must not overlap. */
+    char buf[sizeof ctx->errmsg];
     va_start(ap, fmt);
-    vsnprintf(ctx->errmsg, sizeof ctx->errmsg, fmt, ap);
+    vsnprintf(buf, sizeof buf, fmt, ap);
     va_end(ap);
+    memcpy(ctx->errmsg, buf, sizeof buf);
     return code;
 }
 

@@ -628,9 +628,9 @@ static es_status load(es_store *s)
     s->kind = ES_TOPOLOGY_MESH;
     if (version == FORMAT_VERSION_KIND) {
         char kind[16];
-        if ((rc = read_attr_text(ctx, s->file, "topology_kind", kind, sizeof kind)))
-            return es__fail(ctx, ES_EFORMAT, "store: '%s' (format version 2): %s", s->path,
-                            es_ctx_errmsg(ctx));
+        if (read_attr_text(ctx, s->file, "topology_kind", kind, sizeof kind))
+            ES_FAIL(ctx, ES_EFORMAT, "store: '%s' has format version 2 but no topology_kind "
+                    "attribute", s->path);
         if (!strcmp(kind, "mesh")) s->kind = ES_TOPOLOGY_MESH;
         else if (!strcmp(kind, "truss")) s->kind = ES_TOPOLOGY_TRUSS;
         else if (!strcmp(kind, "none")) s->kind = ES_TOPOLOGY_NONE;

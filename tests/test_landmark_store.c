@@ -5,13 +5,16 @@
  *  - "truss": an edge list, no faces; stored lengths equal the pair
  *    distances divided by their sum (each row sums to 1), the edge list is
  *    canonical, PCA runs, es_store_mesh refuses;
- *  - a triangulation still makes a version 1 mesh store;
+ *  - a triangulation still makes a version 1 mesh store (no topology_kind);
+ *  - the on-disk layout (HDF5 read directly) and the format checks: version
+ *    2 without or with an unknown topology_kind, or version 3, is refused;
  * on synthetic 2D landmarks and, when ../shared is present, on the apes set
  * of landmarks_rshapes. */
 #include "es_internal.h"
 #include "es_test.h"
 #include "edgespace/edgespace.h"
 
+#include <hdf5.h>   /* the on-disk layout is checked from outside the library */
 #include <math.h>
 #include <stdlib.h>
 #include <sys/stat.h>
@@ -244,6 +247,118 @@ static void check_mesh(es_ctx *ctx, const es_landmarks *lm, const char *path)
     es_store_close(s);
 }
 
+static int64_t attr_i64(hid_t f, const char *name)
+{
+    int64_t v = -1;
+    hid_t a = H5Aopen(f, name, H5P_DEFAULT);
+    if (a >= 0) H5Aread(a, H5T_NATIVE_INT64, &v), H5Aclose(a);
+    return v;
+}
+
+/* Value of a variable-length string attribute of the root, or "" if absent. */
+static void attr_str(hid_t f, const char *name, char *buf, size_t n)
+{
+    char *v = NULL;
+    hid_t a = -1, t = H5Tcopy(H5T_C_S1);
+    buf[0] = 0;
+    H5Tset_size(t, H5T_VARIABLE);
+    H5E_BEGIN_TRY { a = H5Aopen(f, name, H5P_DEFAULT); } H5E_END_TRY
+    if (a >= 0 && H5Aread(a, t, &v) >= 0 && v) {
+        snprintf(buf, n, "%s", v);
+        H5free_memory(v);
+    }
+    if (a >= 0) H5Aclose(a);
+    H5Tclose(t);
+}
+
+static void set_attr_str(hid_t f, const char *name, const char *val)
+{
+    hid_t t = H5Tcopy(H5T_C_S1), sp = H5Screate(H5S_SCALAR), a;
+    H5Tset_size(t, H5T_VARIABLE);
+    H5E_BEGIN_TRY { H5Adelete(f, name); } H5E_END_TRY
+    a = H5Acreate2(f, name, t, sp, H5P_DEFAULT, H5P_DEFAULT);
+    H5Awrite(a, t, &val);
+    H5Aclose(a), H5Sclose(sp), H5Tclose(t);
+}
+
+static int64_t ds_rows(hid_t f, const char *name, hsize_t *d1)
+{
+    hsize_t d[3] = {0, 0, 0};
+    int64_t r = -1;
+    hid_t ds, sp;
+    H5E_BEGIN_TRY { ds = H5Dopen2(f, name, H5P_DEFAULT); } H5E_END_TRY
+    if (ds < 0) return -1;
+    sp = H5Dget_space(ds);
+    if (H5Sget_simple_extent_dims(sp, d, NULL) >= 1) r = (int64_t)d[0];
+    if (d1) *d1 = d[1];
+    H5Sclose(sp), H5Dclose(ds);
+    return r;
+}
+
+static void check_layout(es_ctx *ctx, const char *tag)
+{
+    char p[3][700], kind[32];
+    const char *kinds[3] = {"none", "truss", "mesh"};
+    hsize_t d1 = 0;
+    for (int i = 0; i < 3; i++) {
+        snprintf(p[i], sizeof p[i], "%s/%s-%s.h5", dir, tag, kinds[i]);
+        hid_t f = H5Fopen(p[i], H5F_ACC_RDONLY, H5P_DEFAULT);
+        ES_CHECK(f >= 0);
+        if (f < 0) continue;
+        attr_str(f, "topology_kind", kind, sizeof kind);
+        ES_CHECK_MSG(attr_i64(f, "format_version") == (i < 2 ? 2 : 1), "%s", kinds[i]);
+        ES_CHECK_MSG(!strcmp(kind, i < 2 ? kinds[i] : ""), "%s: kind '%s'", kinds[i], kind);
+        if (i < 2) ES_CHECK(ds_rows(f, "/topology/faces", &d1) == 0 && d1 == 3);
+        ES_CHECK((ds_rows(f, "/topology/edges", &d1) == 0) == (i == 0) && d1 == 2);
+        ES_CHECK((ds_rows(f, "/shapes/lengths", NULL) < 0) == (i == 0));
+        ES_CHECK((ds_rows(f, "/shapes/scales", NULL) < 0) == (i == 0));
+        ES_CHECK(ds_rows(f, "/shapes/positions", NULL) > 0);
+        H5Fclose(f);
+    }
+    /* tampered copies of the truss store: the format checks refuse them */
+    static const char *const bad[3] = {"blob", NULL, "version3"};
+    for (int i = 0; i < 3; i++) {
+        char q[760], cmd[1600];
+        es_store *s = NULL;
+        snprintf(q, sizeof q, "%s/%s-tampered.h5", dir, tag);
+        snprintf(cmd, sizeof cmd, "cp '%s' '%s'", p[1], q);
+        ES_CHECK(system(cmd) == 0);
+        hid_t f = H5Fopen(q, H5F_ACC_RDWR, H5P_DEFAULT);
+        if (f < 0) { ES_CHECK(f >= 0); continue; }
+        if (i == 0) set_attr_str(f, "topology_kind", bad[i]);
+        if (i == 1) H5Adelete(f, "topology_kind");
+        if (i == 2) {
+            int64_t v = 3;
+            hid_t a = H5Aopen(f, "format_version", H5P_DEFAULT);
+            H5Awrite(a, H5T_NATIVE_INT64, &v);
+            H5Aclose(a);
+        }
+        H5Fclose(f);
+        ES_CHECK_FAILS(ctx, es_store_open(ctx, q, ES_STORE_READ, &s), ES_EFORMAT,
+                       i == 0 ? "topology_kind 'blob'" : i == 1 ? "topology_kind" : "version 3");
+        ES_CHECK(s == NULL);
+        unlink(q);
+    }
+    /* a mesh store relabelled "truss" contradicts its faces */
+    {
+        char q[760], cmd[1600];
+        es_store *s = NULL;
+        snprintf(q, sizeof q, "%s/%s-tampered.h5", dir, tag);
+        snprintf(cmd, sizeof cmd, "cp '%s' '%s'", p[2], q);
+        ES_CHECK(system(cmd) == 0);
+        hid_t f = H5Fopen(q, H5F_ACC_RDWR, H5P_DEFAULT);
+        int64_t v = 2;
+        hid_t a = H5Aopen(f, "format_version", H5P_DEFAULT);
+        H5Awrite(a, H5T_NATIVE_INT64, &v);
+        H5Aclose(a);
+        set_attr_str(f, "topology_kind", "truss");
+        H5Fclose(f);
+        ES_CHECK_FAILS(ctx, es_store_open(ctx, q, ES_STORE_READ, &s), ES_EFORMAT,
+                       "topology kind 'truss' with");
+        unlink(q);
+    }
+}
+
 static void run_set(es_ctx *ctx, const char *lmcsv, const char *spec, const char *tag)
 {
     es_landmarks *lm = NULL;
@@ -257,6 +372,7 @@ static void run_set(es_ctx *ctx, const char *lmcsv, const char *spec, const char
     check_truss(ctx, lm, tmp(b));
     check_mesh(ctx, lm, tmp(c));
     check_errors(ctx, lm);
+    check_layout(ctx, tag);
     es_landmarks_free(lm);
 }
 
