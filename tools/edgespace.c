@@ -31,7 +31,7 @@ static const command commands[] = {
     /* -- procrustes, landmarks, comparison */
     {"gpa", cmd_gpa, "generalized Procrustes analysis of a store's positions"},
     {"compare", cmd_compare, "Procrustes vs edge-length space: distances, Mantel, groups"},
-    {"ingest-landmarks", cmd_ingest_landmarks, "landmarks (TPS, CSV) + triangulation into a store"},
+    {"ingest-landmarks", cmd_ingest_landmarks, "landmarks (TPS, CSV) into a store (+ triangles or edges)"},
     /* -- embedding, interpolation */
     {"embed", cmd_embed, "realize a point of edge-length space as a mesh, with a quality report"},
     {"interp", cmd_interp, "interpolate/extrapolate stored shapes in edge-length space and embed"},

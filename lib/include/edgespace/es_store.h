@@ -5,7 +5,8 @@
  * memory as an E x N column-major es_mat with ld = E), scales, vertex
  * positions (N x V x 3) and string labels, plus analysis results under
  * /analysis with provenance. datasets-spec/store-format.md is the exact
- * layout. Rows are named by unique ids.
+ * layout. Rows are named by unique ids. Landmark stores may have no faces
+ * (an edge list, "truss") or no topology at all: es_topology_kind below.
  *
  * A store handle is not thread-safe; use one per thread.
  *
