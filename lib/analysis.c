@@ -461,7 +461,7 @@ done:
 
 /* ---- points ------------------------------------------------------------------------- */
 
-void es_store_resolver_clear(es_ctx *ctx, es_store_resolver *r)
+void es_analysis_resolver_clear(es_ctx *ctx, es_analysis_resolver *r)
 {
     if (!r) return;
     es_pca_free(r->pca);
@@ -470,7 +470,7 @@ void es_store_resolver_clear(es_ctx *ctx, es_store_resolver *r)
     r->scales = NULL;
 }
 
-static es_status load_scales(es_ctx *ctx, es_store_resolver *r)
+static es_status load_scales(es_ctx *ctx, es_analysis_resolver *r)
 {
     if (r->scales) return ES_OK;
     r->scales = es__alloc_array(ctx, es_store_nrows(r->store) > 0 ? es_store_nrows(r->store) : 1,
@@ -484,10 +484,10 @@ static es_status load_scales(es_ctx *ctx, es_store_resolver *r)
     return rc;
 }
 
-es_status es_store_resolve(es_ctx *ctx, void *ud, es_point_leaf kind, const char *arg,
+es_status es_analysis_resolve(es_ctx *ctx, void *ud, es_point_leaf kind, const char *arg,
                            int64_t index, double *vec, double *scale)
 {
-    es_store_resolver *r = ud;
+    es_analysis_resolver *r = ud;
     es_store *st = r->store;
     const int64_t E = es_store_nedges(st);
     es_status rc;
@@ -555,7 +555,7 @@ es_status es_analysis_point(es_ctx *ctx, es_store *store, const char *name, cons
     es_point_expr *x = NULL;
     es_mesh *mesh = NULL;
     es_point_info in;
-    es_store_resolver r = {store, NULL, pca_name, NULL, NULL};
+    es_analysis_resolver r = {store, NULL, pca_name, NULL, NULL};
     if (vec) *vec = NULL;
     CHECK_NAME(ctx, name);
     const int64_t E = es_store_nedges(store);
@@ -566,7 +566,7 @@ es_status es_analysis_point(es_ctx *ctx, es_store *store, const char *name, cons
         (rc = es_store_mesh(ctx, store, &mesh)) != ES_OK)
         goto done;
     r.mesh = mesh;
-    if ((rc = es_point_eval(ctx, x, E, es_store_resolve, &r, mesh, v, &in)) != ES_OK) goto done;
+    if ((rc = es_point_eval(ctx, x, E, es_analysis_resolve, &r, mesh, v, &in)) != ES_OK) goto done;
     if (scale > 0) in.scale = scale;
     if (name) {
         char p[PATH_MAX_LEN], buf[64];
@@ -598,7 +598,7 @@ es_status es_analysis_point(es_ctx *ctx, es_store *store, const char *name, cons
         v = NULL;
     }
 done:
-    es_store_resolver_clear(ctx, &r);
+    es_analysis_resolver_clear(ctx, &r);
     es_point_expr_free(x);
     es_mesh_free(mesh);
     es__free(ctx, v);

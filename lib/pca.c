@@ -172,9 +172,11 @@ static es_status fit_gram(es_ctx *ctx, const es_source *src, int64_t K, es_pca *
     double *ysum = es__calloc(ctx, (size_t)E, sizeof *ysum);
     double *outer = es__alloc_array(ctx, E * BO, sizeof *outer);
     double *inner = es__alloc_array(ctx, E * B, sizeof *inner);
+    /* N < 2^31 (LAPACK's int), so N * N does not overflow; eigenvectors take
+     * only K columns when K is given */
     double *G = es__alloc_array(ctx, N * N, sizeof *G);
     double *w = es__alloc_array(ctx, N, sizeof *w);
-    double *V = es__alloc_array(ctx, N * N, sizeof *V);
+    double *V = es__alloc_array(ctx, N * (K > 0 ? K : N), sizeof *V);
     double *rmean = es__alloc_array(ctx, N, sizeof *rmean);
     es_pca *p = NULL;
     if (!x0 || !ysum || !outer || !inner || !G || !w || !V || !rmean) {
@@ -287,7 +289,7 @@ static es_status fit_covariance(es_ctx *ctx, const es_source *src, int64_t K, es
     double *buf = es__alloc_array(ctx, E * B, sizeof *buf);
     double *C = es__alloc_array(ctx, ee, sizeof *C);
     double *w = es__alloc_array(ctx, E, sizeof *w);
-    double *Z = es__alloc_array(ctx, ee, sizeof *Z);
+    double *Z = es__alloc_array(ctx, E * (K > 0 ? K : E), sizeof *Z);
     es_pca *p = NULL;
     if (!x0 || !ysum || !buf || !C || !w || !Z) {
         rc = ES_ENOMEM;

@@ -16,7 +16,8 @@ static const char usage[] =
     "Mean scale-normalized edge lengths of the rows of STORE: of all rows, of\n"
     "the rows matching FILTER (\"col=value[,col=value...]\", all must hold), or\n"
     "one mean per value of label COLUMN. The means, row counts and mean scales\n"
-    "are stored as /analysis/mean/NAME (default NAME: COLUMN, or \"all\").\n"
+    "are stored as /analysis/mean/NAME (default NAME: COLUMN, FILTER,\n"
+    "COLUMN[FILTER], or \"all\").\n"
     "\n"
     "  -b, --by COLUMN    one mean per value of this label column\n"
     "  -w, --where FILTER only rows matching FILTER\n"
@@ -49,7 +50,13 @@ int cmd_mean(int argc, char **argv)
         }
     }
     if (optind != argc - 1) return cli_usage_error("mean", "give exactly one STORE");
-    if (!name && !nostore) name = by ? by : "all";
+    char defname[512];
+    if (!name && !nostore) {
+        /* by, the filter, both as "by[filter]", or "all" */
+        if (by && where) snprintf(defname, sizeof defname, "%s[%s]", by, where);
+        else snprintf(defname, sizeof defname, "%s", by ? by : where ? where : "all");
+        name = defname;
+    }
     if (nostore) name = NULL;
     es_ctx *ctx = cli_ctx_new("mean");
     if (!ctx) return CLI_FAIL;

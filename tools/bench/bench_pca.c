@@ -140,15 +140,15 @@ int main(int argc, char **argv)
            (long long)N, (long long)E, (double)N * (double)E * 8 / 1048576.0, (long long)R);
     /* time to generate the data once (part of every pass below) */
     double *blk = malloc((size_t)E * 64 * sizeof(double));
-    double t0 = now();
+    double t0 = now(), cg0 = cpu_s();
     for (int64_t r0 = 0; r0 < N; r0 += 64) {
         int64_t n = N - r0 < 64 ? N - r0 : 64;
         gen_read(ctx, &src, r0, n, (es_mat){blk, E, n, E});
     }
-    double tgen = now() - t0;
+    double tgen = now() - t0, cgen = cpu_s() - cg0;
     printf("  load average at start: %s\n", loadavg());
     free(blk);
-    printf("  generating one pass of the data:   %7.2f s\n", tgen);
+    printf("  generating one pass of the data:   %7.2f s wall, %.2f s CPU\n", tgen, cgen);
 
     es_pca_opts o;
     es_pca_opts_init(&o);
@@ -163,9 +163,9 @@ int main(int argc, char **argv)
     double texact = now() - t0, cexact = cpu_s() - c0;
     double rss_exact = peak_rss_mib();
     printf("  exact PCA (Gram route, %lld components): %7.2f s wall, %.2f s CPU  (%.2f passes over "
-           "the data, ~%.2f s of them generating), peak RSS %.0f MiB\n", (long long)exact->ncomp,
-           texact, cexact,
-           (double)g.rows_read / (double)N, tgen * (double)g.rows_read / (double)N, rss_exact);
+           "the data, ~%.2f s CPU of them generating), peak RSS %.0f MiB\n",
+           (long long)exact->ncomp, texact, cexact, (double)g.rows_read / (double)N,
+           cgen * (double)g.rows_read / (double)N, rss_exact);
     double cum = 0;
     for (int64_t k = 0; k < 3 && k < exact->ncomp; k++) cum += exact->explained[k];
     printf("    eigenvalues 1..3: %.6g %.6g %.6g; top 3 explain %.1f%% of the variance\n",
@@ -177,31 +177,33 @@ int main(int argc, char **argv)
         ot.ncomp = 20;
         g.rows_read = 0;
         t0 = now();
+        c0 = cpu_s();
         if (es_pca_fit(ctx, &src, &ot, &top) != ES_OK) {
             fprintf(stderr, "bench_pca: %s\n", es_ctx_errmsg(ctx));
             return 1;
         }
-        printf("  exact PCA (Gram route, top 20):     %7.2f s  (%.2f passes)\n", now() - t0,
-               (double)g.rows_read / (double)N);
+        printf("  exact PCA (Gram route, top 20):     %7.2f s wall, %.2f s CPU  (%.2f passes)\n",
+               now() - t0, cpu_s() - c0, (double)g.rows_read / (double)N);
         es_pca_free(top);
     }
     o.method = ES_PCA_RANDOMIZED;
     o.ncomp = K;
     g.rows_read = 0;
     t0 = now();
+    c0 = cpu_s();
     if (es_pca_fit(ctx, &src, &o, &rnd) != ES_OK) {
         fprintf(stderr, "bench_pca: %s\n", es_ctx_errmsg(ctx));
         return 1;
     }
-    double trnd = now() - t0;
+    double trnd = now() - t0, crnd = cpu_s() - c0;
     double maxrel = 0;
     for (int64_t k = 0; k < K; k++) {
         double rel = fabs(rnd->eigenvalues[k] - exact->eigenvalues[k]) / exact->eigenvalues[k];
         if (rel > maxrel) maxrel = rel;
     }
-    printf("  randomized PCA (top %lld, p=%lld, q=%lld): %7.2f s  (%.2f passes), max relative "
-           "eigenvalue error %.2e\n", (long long)K, (long long)o.oversample,
-           (long long)o.power_iters, trnd, (double)g.rows_read / (double)N, maxrel);
+    printf("  randomized PCA (top %lld, p=%lld, q=%lld): %7.2f s wall, %.2f s CPU  (%.2f passes), "
+           "max relative eigenvalue error %.2e\n", (long long)K, (long long)o.oversample,
+           (long long)o.power_iters, trnd, crnd, (double)g.rows_read / (double)N, maxrel);
 
     if (numpy && have_numpy()) {
         char path[] = "/tmp/bench_pca_XXXXXX";

@@ -1,6 +1,6 @@
 /* lib/include/edgespace/es_analysis.h — the statistics of es_stats.h and
  * the points of es_point.h run on a shape store, with their results kept in
- * the store under /analysis/<kind>/<name> (datasets-spec/store-format.md):
+ * the store under /analysis/<kind>/<name> (datasets-spec/analysis-results.md):
  *
  *   mean/<name>:  means (G x E: row g = mean of group g), counts (G),
  *                 groups (G strings), scales (G: mean scale of the group);
@@ -87,18 +87,18 @@ ES_API es_status es_analysis_diff(es_ctx *ctx, es_store *store, const char *name
 /* ---- points ----------------------------------------------------------------- */
 
 /* Resolver of point leaves on a store (es_point_resolve_fn with userdata =
- * an es_store_resolver). pca_name: the PCA of pc:K (NULL: as
+ * an es_analysis_resolver). pca_name: the PCA of pc:K (NULL: as
  * es_analysis_pca_load). mesh: the store's topology, for file: leaves. */
-typedef struct es_store_resolver {
+typedef struct es_analysis_resolver {
     es_store *store;
     const es_mesh *mesh;
     const char *pca_name;
-    es_pca *pca;        /* loaded on first use; free with es_store_resolver_clear */
+    es_pca *pca;        /* loaded on first use; free with es_analysis_resolver_clear */
     double *scales;     /* all row scales, loaded on first use */
-} es_store_resolver;
-ES_API es_status es_store_resolve(es_ctx *ctx, void *resolver, es_point_leaf kind,
+} es_analysis_resolver;
+ES_API es_status es_analysis_resolve(es_ctx *ctx, void *resolver, es_point_leaf kind,
                                   const char *arg, int64_t index, double *vec, double *scale);
-ES_API void es_store_resolver_clear(es_ctx *ctx, es_store_resolver *r);
+ES_API void es_analysis_resolver_clear(es_ctx *ctx, es_analysis_resolver *r);
 
 /* Evaluate `expr` on the store (validity against the store's topology) and,
  * when name is non-NULL, store it as point/<name>. scale > 0 overrides the

@@ -108,7 +108,9 @@ typedef struct es_pca {
 
 /* Fit a PCA of all rows of src (opts NULL: defaults).
  *
- * Gram route (N <= E): one pass accumulates G = Y^T Y for Y = X - x_0 1^T
+ * Gram route (N <= E): G = Y^T Y for Y = X - x_0 1^T is accumulated in
+ * square tiles of rows (two tiles held, 256 MiB each by default; about
+ * N / (2 x tile rows) + 1 passes over the data)
  * (shifted by the first row, which keeps the entries at the scale of the
  * variation instead of that of the lengths), double-centring gives the
  * Gram matrix of the centred data, LAPACKE_dsyevr its eigenpairs (mu_k, v_k);
@@ -122,7 +124,7 @@ typedef struct es_pca {
  * 1e-4 on a nearly flat one (table in lib/pca_randomized.c, checked by
  * tests/test_pca.c).
  *
- * Components whose eigenvalue is below N * eps * (largest eigenvalue) are
+ * Components whose eigenvalue is below max(N, E) * eps * (largest) are
  * numerically zero and are not returned, so ncomp may be less than asked.
  * Errors: ES_EINVAL (N < 2, E < 1, K > min(N-1, E)), ES_ENOMEM, ES_ENUMERIC
  * (LAPACK failure or non-finite data), ES_ERANGE (sizes beyond LAPACK's
@@ -131,9 +133,9 @@ ES_API es_status es_pca_fit(es_ctx *ctx, const es_source *src, const es_pca_opts
                             es_pca **out);
 ES_API void es_pca_free(es_pca *pca);
 
-/* Wrap arrays read back from a store into an es_pca (copies them; scores
- * may be NULL with nrows 0). eigenvalues may be used to recompute the
- * explained ratios when total_variance > 0. */
+/* Wrap arrays read back from a store into an es_pca (copies them; no
+ * scores: nrows 0). The explained ratios are eigenvalues / total_variance
+ * (NaN unless total_variance > 0). */
 ES_API es_status es_pca_from_arrays(es_ctx *ctx, int64_t nedges, int64_t ncomp,
                                     const double *mean, const double *components,
                                     const double *eigenvalues, double total_variance,
