@@ -495,6 +495,10 @@ static int embed(notebook *nb, study *s)
     if ((rc = es_embedder_new(nb->ctx, s->mesh, &emb)) != ES_OK)
         return nb_fail(nb, rc, "making the embedder");
     es_embed_opts_init(&eo);
+    /* Figures and a quality gate, not an interactive tool: let the final
+     * refinement run longer than the library's speed-minded defaults. */
+    eo.refine_max_iter = 60;
+    eo.refine_rtol = 1e-5;
     s->npts = nb->small ? 3 : NPTS;
     if (nb->small)
         nb_p(nb, "*Small run (the test suite's): only the three expression points are "

@@ -154,13 +154,17 @@ static int lengths_mean(notebook *nb, study *s)
 static int embed_mean(notebook *nb, study *s)
 {
     es_embedder *emb;
+    es_embed_opts eo;
     es_status rc;
     nb_step(nb, "embed: the edge-length mean as a mesh");
+    es_embed_opts_init(&eo);
+    eo.refine_max_iter = 60;     /* accuracy over speed, as in 01_faces */
+    eo.refine_rtol = 1e-5;
     s->emb = malloc(sizeof(double) * (size_t)(3 * s->V));
     if (!s->emb) return nb_fail(nb, ES_ENOMEM, "embedding");
     if ((rc = es_embedder_new(nb->ctx, s->mesh, &emb)) != ES_OK)
         return nb_fail(nb, rc, "embedder");
-    rc = es_embed_solve(emb, s->mean_len, s->mean_scale, NULL, s->xyz, NULL, s->emb, &s->rep);
+    rc = es_embed_solve(emb, s->mean_len, s->mean_scale, NULL, s->xyz, &eo, s->emb, &s->rep);
     es_embedder_free(emb);
     if (rc != ES_OK) return nb_fail(nb, rc, "embedding the mean");
     if ((rc = es_mesh_write(nb->ctx, nb_path(nb, "mean_lengths.obj"), ES_FORMAT_OBJ, s->mesh,
