@@ -56,7 +56,7 @@ void es_embed_opts_init(es_embed_opts *o)
     o->dihedral_max_iter = 30;
     o->dihedral_rtol = 1e-4;
     o->dihedral_tol = 1e-24;
-    o->refine_max_iter = 40;
+    o->refine_max_iter = 25;
     o->refine_rtol = 1e-3;
     o->refine_tol = 1e-13;
     o->continuation_steps = 0;
@@ -775,7 +775,8 @@ static double length_cost(const es_embedder *emb, const double *xyz, const doubl
 static es_status stage_refine(es_embedder *emb, const double *L, double *xyz, int max_iter,
                               double rtol, double tol, int verbose, int64_t *iters)
 {
-    double hist[4] = {0, 0, 0, 0};
+    double hist[4] = {0, 0, 0, 0}, c_prev = 0;
+    const int pcg_max = 12;
     int64_t nv = emb->nv, n3 = 3 * nv, ne = emb->ne;
     double *x = emb->H3->x, *g = emb->grad, *dg = emb->diag, *step = emb->pcg + 4 * n3;
     double *hd = step + n3, lambda = 1e-4, c, ctol = tol * tol * (double)ne;
@@ -814,7 +815,9 @@ static es_status stage_refine(es_embedder *emb, const double *L, double *xyz, in
         }
         mean /= (double)n3;
         for (int tries = 0; tries < 20 && !accepted; tries++) {
-            double eta = fmin(1e-2, fmax(1e-12, sqrt(c / (double)ne)));
+            /* forcing term after Eisenstat and Walker (1996): loose while the
+             * cost crawls, tight when it falls fast (quadratic phase) */
+            double eta = fmin(0.1, fmax(1e-10, c_prev > 0 ? c / c_prev : 0.1));
             for (int64_t i = 0; i < n3; i++) {
                 double v = emb->vweight[i / 3] == 0 ? mean : dg[i];
                 x[pos_diag(emb->H3, 3, emb->nlow, i / 3, (int)(i % 3), (int)(i % 3))] =
@@ -822,7 +825,7 @@ static es_status stage_refine(es_embedder *emb, const double *L, double *xyz, in
                     1e-300;
                 hd[i] = -g[i];
             }
-            used = have_factor ? lagged_pcg(emb, emb->H3, emb->L3, emb->B3, hd, step, eta, 12) : -1;
+            used = have_factor ? lagged_pcg(emb, emb->H3, emb->L3, emb->B3, hd, step, eta, pcg_max) : -1;
             if (used < 0) {
                 memcpy(emb->B3->x, hd, (size_t)n3 * sizeof(double));
                 emb->B3->ncol = 1;
@@ -866,6 +869,7 @@ static es_status stage_refine(es_embedder *emb, const double *L, double *xyz, in
         /* relative stopping rule over a window of 3 iterations (oracle README,
          * failure D: an absolute rule stops too early or too late) */
         hist[it % 4] = c_new;
+        c_prev = c;
         if (it >= 3 && hist[(it - 3) % 4] - c_new < 3.0 * rtol * c_new) {
             c = c_new;
             break;

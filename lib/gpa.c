@@ -59,7 +59,9 @@ typedef struct gpa_state {
 
 /* A = X^T (S - X) for one k x d configuration in a single pass (9 or 4
  * accumulators): the cross product with the mean of the others up to the
- * factor 1/(n-1), which the rotation ignores. */
+ * factor 1/(n-1), which the rotation ignores. (Two BLAS dgemm calls with
+ * a 3 x 3 result were three times slower here: OpenBLAS is not tuned for
+ * that shape.) */
 static void cross_with_others(int64_t k, int d, const double *x, const double *s, double b,
                               double *a)
 {
@@ -288,11 +290,15 @@ es_status es_gpa_align(es_ctx *ctx, int64_t k, int d, es_mat x, const es_gpa_opt
         ES_FAIL(ctx, ES_EINVAL, "gpa: tolerance %g / max_iter %lld invalid", o.tol,
                 (long long)o.max_iter);
     if (!es__mul_i64(n, n, &nn)) ES_FAIL(ctx, ES_ERANGE, "gpa: %lld configurations", (long long)n);
+    if (kd > INT32_MAX) ES_FAIL(ctx, ES_ERANGE, "gpa: %lld coordinates per configuration exceed "
+                                "BLAS's int", (long long)kd);
 
     memset(&st, 0, sizeof st);
     st.ctx = ctx; st.k = k; st.d = d; st.n = n; st.kd = kd; st.x = x;
-    /* one block: sum kd, work max(kd, n*n), norm2, pend, phi, z, scale n each, rot d*d*n */
-    int64_t nwork = kd > nn ? kd : nn, total_len = kd + nwork + 5 * n + (int64_t)d * d * n;
+    /* one block: sum kd, work max(kd, n*n) (n*n only for the explicit Gram
+     * matrix), norm2, pend, phi, z, scale n each, rot d*d*n */
+    int exact = o.scale && (double)n * (double)n * (double)kd <= GRAM_LIMIT;
+    int64_t nwork = exact && nn > kd ? nn : kd, total_len = kd + nwork + 5 * n + (int64_t)d * d * n;
     buf = es__alloc_array(ctx, total_len, sizeof *buf);
     if (!buf) return ES_ENOMEM;
     st.sum = buf;
@@ -339,7 +345,6 @@ es_status es_gpa_align(es_ctx *ctx, int64_t k, int d, es_mat x, const es_gpa_opt
     }
     rep.total_ss = total;
 
-    int exact = (double)n * (double)n * (double)kd <= GRAM_LIMIT;
     for (rep.iterations = 1; rep.iterations <= o.max_iter; rep.iterations++) {
         if ((rc = rotation_sweep(&st, o.allow_reflection, rot_acc, &rep.rot_change)) != ES_OK)
             goto done;

@@ -489,6 +489,9 @@ int main(int argc, char **argv)
          "once; scale-normalized edge lengths compare the parts themselves. Where do the "
          "two distances disagree (the paper's barbells, Figs. 7-8), and how far do they agree "
          "on real faces labelled by expression?");
+    nb_p(&nb, "**Expected.** In Procrustes space the two long barbells are much closer than "
+         "the two short ones; in edge-length space the two distances are comparable. On the "
+         "faces both spaces separate the expressions and broadly agree.");
     if (!barbells(&nb, &ratio_proc, &ratio_len)) labelled(&nb, &p_len);
     nb_step(&nb, "self-check");
     /* The paper's finding, as two bounds: in Procrustes space the long pair

@@ -166,7 +166,7 @@ static int interpolate(notebook *nb, study *s)
     double t0 = nb_now();
 
     nb_step(nb, "interpolate: lengths along t, each frame embedded");
-    s->nt = nb->small ? 5 : 11;
+    s->nt = nb->small ? 3 : 11;
     s->t = malloc(sizeof(double) * (size_t)s->nt);
     s->frames = malloc(sizeof(double) * (size_t)(V3 * s->nt));
     s->rms_emb = malloc(sizeof(double) * (size_t)(4 * s->nt));
@@ -226,7 +226,7 @@ static int report(notebook *nb, study *s)
     es_render_spec rs;
     es_status rc;
     FILE *f;
-    int64_t kmax = 0, nshow = 0;
+    int64_t kmax = 0, kmax_lin = 0, nshow = 0;
 
     nb_step(nb, "report: error curves and frames");
     nb_h(nb, 2, "Interpolation from %s to %s", s->id_a, s->id_b);
@@ -245,16 +245,19 @@ static int report(notebook *nb, study *s)
         nb_row(nb, "%.2f|%.2e|%.2e|%.2e|%.2e", s->t[k], s->rms_emb[k], s->max_emb[k],
                s->rms_lin[k], s->max_lin[k]);
         if (s->max_emb[k] > s->max_emb[kmax]) kmax = k;
+        if (s->max_lin[k] > s->max_lin[kmax_lin]) kmax_lin = k;
     }
     if (nb_csv_close(nb, f)) return 1;
 
     for (int panel = 0; panel < 2; panel++) {
         const char *file = panel ? "max_rel.png" : "rms_ratio.png";
         es_lines_spec_init(&ls);
-        ser[0] = (es_series){"edge-length interpolation, embedded", s->nt, s->t,
-                             panel ? s->max_emb : s->rms_emb};
-        ser[1] = (es_series){"vertex interpolation", s->nt, s->t,
-                             panel ? s->max_lin : s->rms_lin};
+        /* interior frames only: the ends are the inputs themselves (errors at
+         * rounding level, which would only stretch the log axis) */
+        ser[0] = (es_series){"edge-length interpolation, embedded", s->nt - 2, s->t + 1,
+                             (panel ? s->max_emb : s->rms_emb) + 1};
+        ser[1] = (es_series){"vertex interpolation", s->nt - 2, s->t + 1,
+                             (panel ? s->max_lin : s->rms_lin) + 1};
         ls.frame.title = panel ? "Largest relative edge error along t (Fig. 12, right)"
                                : "RMS edge error / mean length along t (Fig. 12, left)";
         ls.frame.xlabel = "t";
@@ -267,11 +270,11 @@ static int report(notebook *nb, study *s)
             return nb_fail(nb, rc, "line plot");
     }
     nb_image(nb, "rms_ratio.png", "RMS edge-length error relative to the mean interpolated "
-             "length, along t (log scale; zero values are not drawn; data: errors.csv)");
+             "length, along t, interior frames (log scale; data: errors.csv, which has the ends too)");
     nb_image(nb, "max_rel.png", "Largest relative edge-length error along t");
     nb_p(nb, "The embedded frames' worst edge is %.2f%% off its interpolated length (at "
-         "t = %.2f); vertex interpolation's worst edge along the way is %.1f%% off.",
-         100 * s->max_emb[kmax], s->t[kmax], 100 * s->max_lin[s->nt / 2]);
+         "t = %.2f); vertex interpolation's worst edge is %.1f%% off (at t = %.2f).",
+         100 * s->max_emb[kmax], s->t[kmax], 100 * s->max_lin[kmax_lin], s->t[kmax_lin]);
 
     for (int64_t k = 0; k < s->nt && nshow < 11; k += (s->nt > 6 ? 2 : 1)) {
         static char labels[11][32];
@@ -311,6 +314,9 @@ int main(int argc, char **argv)
     nb_p(&nb, "**Question.** Interpolating edge lengths between two poses and embedding each "
          "frame should keep the parts rigid. How close do the frames come to their "
          "interpolated lengths along t (Fig. 12), compared with vertex interpolation?");
+    nb_p(&nb, "**Expected.** The embedded frames stay within the paper's Fig. 12 levels "
+         "(RMS ratio below 0.75%%, worst edge below 15%%); vertex interpolation is exact at "
+         "the ends but loses length in the middle, where parts rotate.");
     if (!load(&nb, &s) && !interpolate(&nb, &s) && !report(&nb, &s)) {
         double worst_rms = 0, worst_max = 0, lin_mid = s.max_lin[s.nt / 2];
         for (int64_t k = 0; k < s.nt; k++) {

@@ -378,6 +378,9 @@ int main(int argc, char **argv)
     perms = nb.small ? 199 : 999;
     nb_p(&nb, "**Question.** Do GPA and a permutation test find the groups of a landmark set, "
          "and do the scaled edge lengths of a triangulation of the landmarks agree?");
+    nb_p(&nb, "**Expected.** Both spaces find the groups (p < 0.05) and their distances "
+         "agree closely: a triangulation of a few landmarks is rigid and determines the "
+         "configuration.");
     if (!load(&nb, &s) && !procrustes(&nb, &s, perms) && !edge_lengths(&nb, &s, perms)) {
         verdicts(&nb, &s, perms);
         nb_step(&nb, "self-check");

@@ -484,8 +484,9 @@ static void test_garbage(es_ctx *ctx)
         ES_CHECK(all_finite(out, 3 * s.nv));
         free(len), free(al), free(out);
     }
-    ES_CHECK_FAILS(ctx, es_embedder_new(ctx, NULL, &emb), ES_EINVAL, "mesh");
     es_embedder_free(emb);
+    ES_CHECK_FAILS(ctx, es_embedder_new(ctx, NULL, &emb), ES_EINVAL, "mesh");
+    ES_CHECK(emb == NULL);
     es_embedder_free(NULL);
     es_mesh_free(mesh);
     tm_free(&s);

@@ -410,6 +410,44 @@ static void test_pca(es_ctx *ctx)
     free(t); free(l); free(s); free(l2); free(s2); free(m);
 }
 
+/* Partial (orthogonal projection) tangent coordinates after full GPA: they
+ * are orthogonal to the mean and their length is the full Procrustes
+ * distance sin(rho) (Dryden & Mardia, sec. 4.4). */
+static void test_tangent(es_ctx *ctx)
+{
+    es__rng rng;
+    es__rng_init(&rng, 17);
+    int64_t k = 10, n = 12, d = 3, kd = k * d;
+    double *x = make_set(&rng, k, (int)d, n, 0.15), mean[30], rho[12], *t = malloc(sizeof(double) * 360);
+    es_gpa_opts o;
+    es_gpa_opts_init(&o);
+    o.tol = 1e-13;
+    es_gpa_out out = {0};
+    out.mean = mean;
+    out.rho = rho;
+    ES_CHECK_OK(ctx, es_gpa_align(ctx, k, (int)d, (es_mat){x, kd, n, kd}, &o, &out, NULL));
+    ES_CHECK_OK(ctx, es_gpa_tangent(ctx, k, (int)d, (es_mat){x, kd, n, kd}, mean,
+                                    ES_TANGENT_PARTIAL, (es_mat){t, kd, n, kd}));
+    double gm = 0;
+    for (int64_t v = 0; v < kd; v++) gm += mean[v] * mean[v];
+    gm = sqrt(gm);
+    for (int64_t j = 0; j < n; j++) {
+        double dot = 0, nn = 0;
+        for (int64_t v = 0; v < kd; v++) {
+            dot += t[v + j * kd] * mean[v] / gm;
+            nn += t[v + j * kd] * t[v + j * kd];
+        }
+        ES_CHECK_CLOSE(dot, 0.0, 0, 1e-13);
+        ES_CHECK_CLOSE(sqrt(nn), sin(rho[j]), 1e-9, 1e-13);
+    }
+    double zero[30] = {0};
+    ES_CHECK_FAILS(ctx, es_gpa_tangent(ctx, k, (int)d, (es_mat){x, kd, n, kd}, zero,
+                                       ES_TANGENT_PARTIAL, (es_mat){t, kd, n, kd}),
+                   ES_EINVAL, "zero size");
+    free(x);
+    free(t);
+}
+
 /* ---- allocation failures ------------------------------------------------ */
 
 typedef struct failing_alloc { int64_t count, fail_at; } failing_alloc;
@@ -657,6 +695,7 @@ int main(void)
     test_fixed_point(ctx);
     test_degenerate(ctx);
     test_pca(ctx);
+    test_tangent(ctx);
     test_alloc_sweep();
 
     char buf[4096];

@@ -5,6 +5,7 @@
 #include "commands.h"
 
 #include <getopt.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,9 +18,10 @@ static const char usage[] =
     "print the quality report and store it with per-vertex residuals under\n"
     "/analysis/embed/NAME.\n"
     "\n"
-    "  -p, --point SPEC     row:ID (a stored row's lengths) or NAME (a stored point:\n"
-    "                       /analysis/point/NAME/lengths, normalized, and optional\n"
-    "                       /analysis/point/NAME/scale)\n"
+    "  -p, --point SPEC     row:ID (a stored row's lengths), NAME (a stored point,\n"
+    "                       /analysis/point/NAME), or an expression such as\n"
+    "                       \"mean[expression=neutral] + diff:smile\" (see\n"
+    "                       datasets-spec/point-syntax.md)\n"
     "  -o, --output OUT     mesh file (.obj, .ply, .off)\n"
     "  -i, --init HOW       nearest (default: the stored row nearest in edge-length\n"
     "                       distance), row:ID, or mean[:FILTER] (circular mean of the\n"
@@ -115,10 +117,17 @@ int cmd_embed(int argc, char **argv)
         int64_t n = 0;
         snprintf(path, sizeof path, "point/%s/lengths", point);
         if (!es_store_has(s, path)) {
-            fprintf(stderr, "edgespace embed: no stored point '%s' (looked for "
-                    "/analysis/%s); use row:ID or a stored point\n", point, path);
-            rc = ES_ENOTFOUND;
-            goto done;
+            /* not a stored point: an expression (es_point.h syntax) */
+            es_point_info info;
+            if ((rc = es_analysis_point(ctx, s, NULL, point, NULL, scale, "edgespace embed", &v,
+                                        &info)))
+                goto fail;
+            memcpy(target, v, (size_t)ne * sizeof *target);
+            es_free(ctx, v);
+            if (scale == 0 && isfinite(info.scale) && info.scale > 0) scale = info.scale;
+            if (scale == 0)
+                for (int64_t i = 0; i < nrows; i++) scale += scales[i] / (double)nrows;
+            goto have_target;
         }
         if ((rc = es_store_get_vector(ctx, s, path, &v, &n))) goto fail;
         if (n != ne) {
@@ -140,6 +149,16 @@ int cmd_embed(int argc, char **argv)
             for (int64_t i = 0; i < nrows; i++) scale += scales[i] / (double)nrows;
         }
     }
+have_target:
+    /* the target may leave the positive orthant (extrapolation): the
+     * embedding refuses non-positive lengths, so say which */
+    for (int64_t e = 0; e < ne; e++)
+        if (!(target[e] > 0)) {
+            fprintf(stderr, "edgespace embed: the point has length %g at edge %lld: it is "
+                    "outside edge-length space (not realizable)\n", target[e], (long long)e);
+            rc = ES_EINVAL;
+            goto done;
+        }
     /* the initialization */
     if (!strcmp(init, "nearest")) {
         double d;

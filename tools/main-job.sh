@@ -20,8 +20,9 @@ if [ ! -x "$nb" ]; then
        "(es_stats.h, es_embed.h) are not in this tree yet" >&2
   exit 1
 fi
-if [ -d ../shared/data/face-study ] || [ -n "${EDGESPACE_SHARED:-}" ]; then
-  echo "main-job: face study on ../shared/data/face-study" >&2
+shared=${EDGESPACE_SHARED:-../shared}
+if [ -d "$shared/data/face-study" ]; then
+  echo "main-job: face study on $shared/data/face-study" >&2
 else
   echo "main-job: ../shared/data is absent: running on synthetic faces the project makes itself" >&2
 fi

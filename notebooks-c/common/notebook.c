@@ -90,6 +90,7 @@ int nb_open(notebook *n, const char *name, const char *title, int argc, char **a
 
     memset(n, 0, sizeof *n);
     n->name = name;
+    setvbuf(stdout, NULL, _IOLBF, 0);   /* progress lines show up in logs as they happen */
     n->seed = 0x5eed;
     env = getenv("EDGESPACE_NOTEBOOK_SMALL");
     n->small = env && *env && strcmp(env, "0") != 0;

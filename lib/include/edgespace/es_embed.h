@@ -57,7 +57,7 @@ typedef struct es_embed_opts {
                                  per iteration, or E <= dihedral_tol * #interior verts
                                  (defaults 1e-4, 1e-24) */
     double dihedral_tol;
-    int refine_max_iter;      /* stage 4 LM iterations per step; 0 skips (default 40) */
+    int refine_max_iter;      /* stage 4 LM iterations per step; 0 skips (default 25) */
     double refine_rtol;       /* stage 4 stops when the cost dropped by less than this
                                  fraction per iteration over the last 3 iterations, or
                                  the RMS relative edge error is below refine_tol

@@ -28,9 +28,9 @@
  *    n - 1. Each PC is signed so that its largest-magnitude loading is
  *    positive (procGPA's signs are arbitrary).
  *
- * The mean orientation of a GPA result is arbitrary (here: that of the
- * first configuration after the first sweep); compare results with other
- * software after one global rotation of the means.
+ * The orientation of a GPA result is arbitrary (it follows the inputs; no
+ * normalization is applied); compare results with other software after one
+ * global rotation aligning the means, and PCs up to sign.
  */
 #ifndef EDGESPACE_ES_PROCRUSTES_H
 #define EDGESPACE_ES_PROCRUSTES_H

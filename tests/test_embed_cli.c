@@ -1,0 +1,97 @@
+/* tests/test_embed_cli.c — the embed and interp commands: --help, exit
+ * statuses (0 ok, 1 failure, 2 usage), what they print, write and store. */
+#include "es_test.h"
+#include "es_test_files.h"
+#include "es_test_meshes.h"
+#include "es_test_run.h"
+
+#include <edgespace/edgespace.h>
+
+int main(void)
+{
+    static es_test_out r;
+    char store[4200], p[4400], pat[4400], out[4400];
+    const char *dir;
+    ES_TEST_BEGIN();
+    if (!es_test_edgespace()) ES_TEST_SKIP("EDGESPACE is not set");
+    dir = es_test_tmpdir("cli-embed");
+    snprintf(store, sizeof store, "%s/s.h5", dir);
+    for (int k = 0; k < 3; k++) {
+        snprintf(p, sizeof p, "%s/mesh-%d.obj", dir, k);
+        ES_CHECK(es_test_write_torus(p, 16, 8, k) == 0);
+    }
+    const char *verbs[2] = {"embed", "interp"};
+    for (int k = 0; k < 2; k++) {
+        ES_RUN(&r, dir, verbs[k], "--help");
+        ES_CHECK(r.status == 0 && strstr(r.out, "usage: edgespace ") && strstr(r.out, verbs[k]));
+        ES_RUN(&r, dir, verbs[k], "--bogus");
+        ES_CHECK(r.status == 2);
+        ES_RUN(&r, dir, verbs[k]);
+        ES_CHECK(r.status == 2);
+    }
+    snprintf(p, sizeof p, "%s/mesh-0.obj", dir);
+    snprintf(pat, sizeof pat, "%s/mesh-1.obj", dir);
+    snprintf(out, sizeof out, "%s/mesh-2.obj", dir);
+    ES_RUN(&r, dir, "ingest", "-q", store, p, pat, out);
+    ES_CHECK_MSG(r.status == 0, "ingest: %s", r.err);
+
+    /* interp: a sequence of 3 frames; the pattern expands; reports stored */
+    snprintf(pat, sizeof pat, "%s/seq_%%02d.obj", dir);
+    ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-1", "--steps", "3",
+           "-o", pat);
+    ES_CHECK_MSG(r.status == 0 && strstr(r.out, "t = 0.5") && strstr(r.out, "RMS ratio"),
+                 "interp: %d %s %s", r.status, r.out, r.err);
+    for (int i = 0; i < 3; i++) {
+        snprintf(p, sizeof p, "%s/seq_%02d.obj", dir, i);
+        ES_CHECK_MSG(access(p, F_OK) == 0, "missing %s", p);
+    }
+    ES_RUN(&r, dir, "info", store);
+    ES_CHECK_MSG(strstr(r.out, "seq_00") && strstr(r.out, "seq_02"), "info: %s", r.out);
+    /* weights, extrapolation */
+    snprintf(out, sizeof out, "%s/w.ply", dir);
+    ES_RUN(&r, dir, "interp", store, "--weights", "0.5*row:mesh-0 + 0.7*row:mesh-1 - 0.2*row:mesh-2",
+           "-o", out, "--no-store");
+    ES_CHECK_MSG(r.status == 0 && access(out, F_OK) == 0, "weights: %s", r.err);
+    ES_RUN(&r, dir, "interp", store, "--weights", "0.5*row:mesh-0 +* row:mesh-1", "-o", out);
+    ES_CHECK(r.status == 2);
+    ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:nope", "-o", pat);
+    ES_CHECK(r.status == 1 && strstr(r.err, "nope"));
+    ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-1", "-o", out);
+    ES_CHECK(r.status == 2 && strstr(r.err, "pattern"));
+
+    /* embed a stored row from the nearest other start, and from a given row */
+    snprintf(out, sizeof out, "%s/e.obj", dir);
+    ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out, "--init", "row:mesh-0");
+    ES_CHECK_MSG(r.status == 0 && strstr(r.out, "init: row mesh-0") &&
+                 strstr(r.out, "stored: /analysis/embed/e"), "embed: %d %s %s", r.status, r.out,
+                 r.err);
+    ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out, "--init", "mean");
+    ES_CHECK_MSG(r.status == 0 && strstr(r.out, "circular mean"), "embed mean: %s", r.err);
+    ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out);
+    ES_CHECK_MSG(r.status == 0 && strstr(r.out, "nearest row mesh-2"), "embed nearest: %s", r.out);
+    {
+        es_ctx *ctx;
+        es_store *s = NULL;
+        double *v = NULL;
+        int64_t n = 0;
+        char buf[64];
+        es_ctx_new(&ctx);
+        ES_CHECK_OK(ctx, es_store_open(ctx, store, ES_STORE_READ, &s));
+        if (s) {
+            ES_CHECK_OK(ctx, es_store_get_vector(ctx, s, "embed/e/vertex_closure", &v, &n));
+            ES_CHECK(n == es_store_nverts(s));
+            ES_CHECK_OK(ctx, es_store_get_attr(ctx, s, "embed/e", "rms_ratio", buf, sizeof buf));
+            ES_CHECK(atof(buf) < 1e-6);
+            es_free(ctx, v);
+        }
+        es_store_close(s);
+        es_ctx_free(ctx);
+    }
+    ES_RUN(&r, dir, "embed", store, "--point", "nothing", "-o", out);
+    ES_CHECK_MSG(r.status == 1 && strstr(r.err, "edgespace embed: "), "%s", r.err);
+    ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out, "--init", "sideways");
+    ES_CHECK(r.status != 0);
+    ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out, "--scale", "-1");
+    ES_CHECK(r.status == 2);
+    ES_TEST_END();
+}

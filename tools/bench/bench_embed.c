@@ -1,0 +1,143 @@
+/* tools/bench/bench_embed.c — time per embedding against vertex count (2K to
+ * 60K vertices; larger meshes by midpoint subdivision of real ones, which
+ * keeps them in correspondence) with the edge-length error and closure
+ * energy beside each time. Two cases per mesh: the midpoint t = 0.5 of a
+ * real pair (es_interp_embed: the hard, inconsistent case) and the round
+ * trip of one shape's own lengths and dihedrals (consistent input).
+ * Wall and process CPU time are printed: on a shared machine the wall time
+ * includes waiting for a core.
+ *
+ *   bench_embed [max_vertices]      (default 60000; data from ../shared/data)
+ */
+#include <edgespace/edgespace.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#ifndef ES_SHARED_DIR
+#define ES_SHARED_DIR "../shared"
+#endif
+
+static double cpu_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static double wall_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void run(es_ctx *ctx, const char *dir, const char *a, const char *b, int levels,
+                int64_t vmax)
+{
+    char pa[4096], pb[4096];
+    es_meshdata ma, mb;
+    int64_t nv, nf, *faces;
+    double *xyz;
+    es_mesh *mesh = NULL;
+    es_embedder *emb = NULL;
+    snprintf(pa, sizeof pa, "%s/data/%s/%s.obj", ES_SHARED_DIR, dir, a);
+    snprintf(pb, sizeof pb, "%s/data/%s/%s.obj", ES_SHARED_DIR, dir, b);
+    if (es_meshdata_read(ctx, pa, ES_FORMAT_OBJ, &ma) || es_meshdata_read(ctx, pb, ES_FORMAT_OBJ, &mb)) {
+        fprintf(stderr, "bench_embed: %s\n", es_ctx_errmsg(ctx));
+        return;
+    }
+    nv = ma.nverts;
+    nf = ma.nfaces;
+    faces = malloc(3 * (size_t)nf * sizeof *faces);
+    memcpy(faces, ma.faces, 3 * (size_t)nf * sizeof *faces);
+    xyz = malloc(6 * (size_t)nv * sizeof *xyz);
+    memcpy(xyz, ma.xyz, 3 * (size_t)nv * sizeof *xyz);
+    memcpy(xyz + 3 * nv, mb.xyz, 3 * (size_t)nv * sizeof *xyz);
+    for (int l = 0; l < levels; l++) {
+        int64_t nv2, *f2;
+        double *x2;
+        if (es_mesh_subdivide(ctx, nv, nf, faces, 2, xyz, &nv2, &f2, &x2)) {
+            fprintf(stderr, "bench_embed: %s\n", es_ctx_errmsg(ctx));
+            return;
+        }
+        free(faces);
+        free(xyz);
+        faces = malloc(12 * (size_t)nf * sizeof *faces);
+        memcpy(faces, f2, 12 * (size_t)nf * sizeof *faces);
+        xyz = malloc(6 * (size_t)nv2 * sizeof *xyz);
+        memcpy(xyz, x2, 6 * (size_t)nv2 * sizeof *xyz);
+        es_free(ctx, f2);
+        es_free(ctx, x2);
+        nv = nv2;
+        nf *= 4;
+    }
+    if (nv > vmax) goto done;
+    if (es_mesh_new(ctx, nv, nf, faces, xyz, &mesh)) goto fail;
+    {
+        double w0 = wall_now(), c0 = cpu_now(), tw_new, tc_new;
+        if (es_embedder_new(ctx, mesh, &emb)) goto fail;
+        tw_new = wall_now() - w0;
+        tc_new = cpu_now() - c0;
+        const double *in[2] = {xyz, xyz + 3 * nv};
+        double w[2] = {0.5, 0.5}, *out = malloc(3 * (size_t)nv * sizeof *out);
+        int64_t ne = es_mesh_nedges(mesh);
+        double *len = malloc((size_t)ne * sizeof *len), *al = malloc((size_t)ne * sizeof *al);
+        es_embed_report r;
+        /* midpoint */
+        w0 = wall_now();
+        c0 = cpu_now();
+        if (es_interp_embed(emb, 2, in, w, NULL, NULL, out, &r, NULL)) goto fail;
+        printf("%-22s %-19s %7lld  %6.2f %6.2f  %6.2f %6.2f %6.2f %6.2f  %8.4f%% %7.3f%%  %9.3g %9.3g  %s\n",
+               dir, "midpoint t=0.5", (long long)nv, wall_now() - w0, cpu_now() - c0,
+               r.t_dihedral, r.t_frames + r.t_positions, r.t_refine, tc_new, 100 * r.rms_ratio,
+               100 * r.max_rel, r.closure_before, r.closure_after,
+               r.used_stage1 ? "stage1" : "-");
+        /* round trip of shape a */
+        es_edge_lengths(ctx, mesh, xyz, len);
+        es_dihedral_angles(ctx, mesh, xyz, al);
+        w0 = wall_now();
+        c0 = cpu_now();
+        if (es_embed_solve(emb, len, 0, al, NULL, NULL, out, &r)) goto fail;
+        printf("%-22s %-19s %7lld  %6.2f %6.2f  %6.2f %6.2f %6.2f %6.2f  %8.2g%% %7.2g%%  %9.3g %9.3g  %s\n",
+               dir, "round trip (exact)", (long long)nv, wall_now() - w0, cpu_now() - c0,
+               r.t_dihedral, r.t_frames + r.t_positions, r.t_refine, tw_new, 100 * r.rms_ratio,
+               100 * r.max_rel, r.closure_before, r.closure_after, r.used_stage1 ? "stage1" : "-");
+        fflush(stdout);
+        free(out), free(len), free(al);
+    }
+    goto done;
+fail:
+    fprintf(stderr, "bench_embed: %s\n", es_ctx_errmsg(ctx));
+done:
+    es_embedder_free(emb);
+    es_mesh_free(mesh);
+    free(faces);
+    free(xyz);
+    es_meshdata_clear(ctx, &ma);
+    es_meshdata_clear(ctx, &mb);
+}
+
+int main(int argc, char **argv)
+{
+    es_ctx *ctx;
+    int64_t vmax = argc > 1 ? atoll(argv[1]) : 60000;
+    if (es_ctx_new(&ctx)) return 1;
+    printf("# %-20s %-19s %7s  %6s %6s  %6s %6s %6s %6s  %9s %8s  %9s %9s\n", "mesh", "case", "V",
+           "wall", "cpu", "dih", "lin", "refine", "setup", "rms", "max", "E before", "E after");
+    printf("# times in s; dih/lin/refine: wall per stage; setup: embedder_new (analysis)\n");
+    run(ctx, "facecap_arkit", "anim_000", "anim_100", 0, vmax);
+    run(ctx, "sfm_surrey_face_3448", "mean_neutral", "expr_happiness", 0, vmax);
+    run(ctx, "goast_cactus", "cactus0", "cactus1", 0, vmax);
+    run(ctx, "sumner_cat_poses", "cat-01", "cat-02", 0, vmax);
+    run(ctx, "face-study", "s001_neutral", "s001_happy", 0, vmax);
+    run(ctx, "sfm_surrey_face_3448", "mean_neutral", "expr_happiness", 1, vmax);
+    run(ctx, "goast_cactus", "cactus0", "cactus1", 1, vmax);
+    run(ctx, "facecap_arkit", "anim_000", "anim_100", 3, vmax);
+    run(ctx, "sfm_surrey_face_3448", "mean_neutral", "expr_happiness", 2, vmax);
+    es_ctx_free(ctx);
+    return 0;
+}
