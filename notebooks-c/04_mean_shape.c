@@ -297,11 +297,17 @@ static int report(notebook *nb, study *s)
     sp.nmeshes = nm;
     sp.meshes = rm;
     sp.width = sp.height = 320;
-    sp.same_view = 1;
     sp.title = "Some of the input poses";
-    sp.has_up = s->z_up;
-    sp.up[0] = sp.up[1] = 0;
-    sp.up[2] = 1;
+    /* one camera: the automatic view of the last pose shown (a straight
+     * tube has no preferred view axis); the cactus is stored z-up */
+    if ((rc = es_render_auto_view(nb->ctx, s->V, rm[2].xyz, s->F, es_mesh_faces(s->mesh),
+                                  sp.view, sp.up)) != ES_OK)
+        return nb_fail(nb, rc, "camera");
+    sp.has_view = sp.has_up = 1;
+    if (s->z_up) {
+        sp.up[0] = sp.up[1] = 0;
+        sp.up[2] = 1;
+    }
     if ((rc = es_render(nb->ctx, &sp, nb_path(nb, "inputs.png"), NULL)) != ES_OK)
         return nb_fail(nb, rc, "render");
     nb_image(nb, "inputs.png", "Input poses: first, middle and last");
