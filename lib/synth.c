@@ -32,11 +32,16 @@ const char *es_synth_family_name(es_synth_family f)
 
 es_status es_synth_family_from_name(es_ctx *ctx, const char *name, es_synth_family *out)
 {
-    for (int f = ES_SYNTH_BARBELL; f <= ES_SYNTH_FACE; f++)
-        if (name && strcmp(name, family_names[f]) == 0) {
+    /* Plural forms too: the issue and the paper say "barbells", "faces". */
+    size_t n = name ? strlen(name) : 0;
+    for (int f = ES_SYNTH_BARBELL; f <= ES_SYNTH_FACE; f++) {
+        size_t m = strlen(family_names[f]);
+        if (name && (strcmp(name, family_names[f]) == 0 ||
+                     (n == m + 1 && strncmp(name, family_names[f], m) == 0 && name[m] == 's'))) {
             *out = (es_synth_family)f;
             return ES_OK;
         }
+    }
     ES_FAIL(ctx, ES_ENOTFOUND,
             "synth: unknown family '%s' (known: barbell, tube, tube-closed, face)",
             name ? name : "(null)");

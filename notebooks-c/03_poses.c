@@ -292,10 +292,17 @@ static int report(notebook *nb, study *s)
     rs.meshes = rm;
     rs.width = 260;
     rs.height = 320;
-    rs.same_view = 1;
-    rs.has_up = s->z_up;
-    rs.up[0] = rs.up[1] = 0;
-    rs.up[2] = 1;
+    /* one camera for all frames: the automatic view of the last (most bent)
+     * frame, whose principal axes are well defined (a straight tube's are
+     * not); the cactus is stored z-up */
+    if ((rc = es_render_auto_view(nb->ctx, s->V, s->frames + 3 * s->V * (s->nt - 1), s->F,
+                                  es_mesh_faces(s->mesh), rs.view, rs.up)) != ES_OK)
+        return nb_fail(nb, rc, "camera");
+    rs.has_view = rs.has_up = 1;
+    if (s->z_up) {
+        rs.up[0] = rs.up[1] = 0;
+        rs.up[2] = 1;
+    }
     rs.title = "Embedded frames of the edge-length interpolation";
     if ((rc = es_render(nb->ctx, &rs, nb_path(nb, "frames.png"), NULL)) != ES_OK)
         return nb_fail(nb, rc, "render");

@@ -154,13 +154,17 @@ static int lengths_mean(notebook *nb, study *s)
 static int embed_mean(notebook *nb, study *s)
 {
     es_embedder *emb;
+    es_embed_opts eo;
     es_status rc;
     nb_step(nb, "embed: the edge-length mean as a mesh");
+    es_embed_opts_init(&eo);
+    eo.refine_max_iter = 60;     /* accuracy over speed, as in 01_faces */
+    eo.refine_rtol = 1e-5;
     s->emb = malloc(sizeof(double) * (size_t)(3 * s->V));
     if (!s->emb) return nb_fail(nb, ES_ENOMEM, "embedding");
     if ((rc = es_embedder_new(nb->ctx, s->mesh, &emb)) != ES_OK)
         return nb_fail(nb, rc, "embedder");
-    rc = es_embed_solve(emb, s->mean_len, s->mean_scale, NULL, s->xyz, NULL, s->emb, &s->rep);
+    rc = es_embed_solve(emb, s->mean_len, s->mean_scale, NULL, s->xyz, &eo, s->emb, &s->rep);
     es_embedder_free(emb);
     if (rc != ES_OK) return nb_fail(nb, rc, "embedding the mean");
     if ((rc = es_mesh_write(nb->ctx, nb_path(nb, "mean_lengths.obj"), ES_FORMAT_OBJ, s->mesh,
@@ -297,11 +301,17 @@ static int report(notebook *nb, study *s)
     sp.nmeshes = nm;
     sp.meshes = rm;
     sp.width = sp.height = 320;
-    sp.same_view = 1;
     sp.title = "Some of the input poses";
-    sp.has_up = s->z_up;
-    sp.up[0] = sp.up[1] = 0;
-    sp.up[2] = 1;
+    /* one camera: the automatic view of the last pose shown (a straight
+     * tube has no preferred view axis); the cactus is stored z-up */
+    if ((rc = es_render_auto_view(nb->ctx, s->V, rm[2].xyz, s->F, es_mesh_faces(s->mesh),
+                                  sp.view, sp.up)) != ES_OK)
+        return nb_fail(nb, rc, "camera");
+    sp.has_view = sp.has_up = 1;
+    if (s->z_up) {
+        sp.up[0] = sp.up[1] = 0;
+        sp.up[2] = 1;
+    }
     if ((rc = es_render(nb->ctx, &sp, nb_path(nb, "inputs.png"), NULL)) != ES_OK)
         return nb_fail(nb, rc, "render");
     nb_image(nb, "inputs.png", "Input poses: first, middle and last");

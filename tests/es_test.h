@@ -41,11 +41,17 @@ static int es_test_failures;
     es_test_failures++; fprintf(stderr, "%s:%d: %s failed (%s): %s\n", __FILE__, \
     __LINE__, #call, es_strerror(es_rc_), es_ctx_errmsg(ctx)); } } while (0)
 
+/* 1 if `needle` is NULL or occurs in `s`. */
+static inline int es_test_contains(const char *s, const char *needle)
+{
+    return !needle || strstr(s, needle) != NULL;
+}
+
 /* A library call that must fail with `code` and a message containing
  * `needle` (NULL: any message). */
 #define ES_CHECK_FAILS(ctx, call, code, needle) do { es_status es_rc_ = (call); \
     const char *es_m_ = es_ctx_errmsg(ctx); \
-    if (es_rc_ != (code) || ((needle) && !strstr(es_m_, (needle)))) { \
+    if (es_rc_ != (code) || !es_test_contains(es_m_, (needle))) { \
         es_test_failures++; fprintf(stderr, "%s:%d: %s returned %d (%s), want %d " \
         "with message containing \"%s\"\n", __FILE__, __LINE__, #call, (int)es_rc_, \
         es_m_, (int)(code), (needle) ? (const char *)(needle) : ""); } } while (0)

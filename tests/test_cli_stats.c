@@ -152,6 +152,31 @@ int main(void)
             for (int64_t i = 0; i < 13 * stored->ncomp; i++)
                 ES_CHECK(stored->scores[i] == direct->scores[i]);
         }
+        /* the store source read in blocks of 1 and 7 rows, and a subset */
+        for (int64_t b = 1; b <= 7 && direct; b += 6) {
+            es_pca *pb = NULL;
+            src.block = b;
+            ES_CHECK_OK(ctx, es_pca_fit(ctx, &src, NULL, &pb));
+            for (int64_t k = 0; pb && k < direct->ncomp; k++)
+                ES_CHECK_CLOSE(pb->eigenvalues[k], direct->eigenvalues[k], 1e-12,
+                               1e-13 * direct->eigenvalues[0]);
+            es_pca_free(pb);
+        }
+        const int64_t sub[4] = {12, 0, 5, 3};
+        double msub[4096], want[4096];
+        es_source ss;
+        ES_CHECK_OK(ctx, es_source_store(ctx, st, sub, 4, &ss));
+        int64_t E = es_store_nedges(st);
+        if (E <= 1024) {
+            double *blk = malloc((size_t)(4 * E) * sizeof *blk);
+            ES_CHECK_OK(ctx, es_mean(ctx, &ss, msub));
+            ES_CHECK_OK(ctx, es_store_read_lengths_rows(ctx, st, sub, 4, (es_mat){blk, E, 4, E}));
+            for (int64_t e = 0; e < E; e++) {
+                want[e] = (blk[e] + blk[e + E] + blk[e + 2 * E] + blk[e + 3 * E]) / 4;
+                ES_CHECK_CLOSE(msub[e], want[e], 1e-14, 0);
+            }
+            free(blk);
+        }
         es_pca_free(stored);
         es_pca_free(direct);
         es_pca_free(top);

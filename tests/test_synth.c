@@ -406,6 +406,10 @@ static void test_files(es_ctx *ctx)
     es_synth_opts o;
     ES_CHECK_OK(ctx, es_synth_family_from_name(ctx, "tube-closed", &fam));
     ES_CHECK(fam == ES_SYNTH_TUBE_CLOSED && !strcmp(es_synth_family_name(fam), "tube-closed"));
+    ES_CHECK_OK(ctx, es_synth_family_from_name(ctx, "barbells", &fam));
+    ES_CHECK(fam == ES_SYNTH_BARBELL);
+    ES_CHECK_FAILS(ctx, es_synth_family_from_name(ctx, "barbellss", &fam), ES_ENOTFOUND,
+                   "unknown family");
     ES_CHECK_FAILS(ctx, es_synth_family_from_name(ctx, "bagel", &fam), ES_ENOTFOUND,
                    "unknown family 'bagel' (known: barbell");
     ES_CHECK(es_synth_family_name((es_synth_family)99) == NULL);

@@ -92,6 +92,37 @@ static const char *loadavg(void)
     return buf;
 }
 
+/* Stage timings from the progress callback: wall time from the previous
+ * stage's end to this stage's last report. */
+typedef struct stages {
+    const char *what[8];
+    double end[8];
+    int n;
+    double t0;
+} stages;
+
+static void on_progress(void *ud, const char *what, int64_t done, int64_t total)
+{
+    stages *st = ud;
+    (void)done, (void)total;
+    if (st->n == 0 || strcmp(st->what[st->n - 1], what)) {
+        if (st->n == 8) return;
+        st->what[st->n++] = what;
+    }
+    st->end[st->n - 1] = now();
+}
+
+static void print_stages(const stages *st)
+{
+    double prev = st->t0;
+    printf("    stages:");
+    for (int i = 0; i < st->n; i++) {
+        printf(" %s %.2f s;", st->what[i], st->end[i] - prev);
+        prev = st->end[i];
+    }
+    printf("\n");
+}
+
 static int have_numpy(void)
 {
     return system("python3 -c 'import numpy' >/dev/null 2>&1") == 0;
@@ -153,8 +184,12 @@ int main(int argc, char **argv)
     es_pca_opts o;
     es_pca_opts_init(&o);
     es_pca *exact = NULL, *rnd = NULL;
+    stages stg;
+    memset(&stg, 0, sizeof stg);
+    es_ctx_set_progress(ctx, on_progress, &stg);
     g.rows_read = 0;
     t0 = now();
+    stg.t0 = t0;
     double c0 = cpu_s();
     if (es_pca_fit(ctx, &src, &o, &exact) != ES_OK) {
         fprintf(stderr, "bench_pca: %s\n", es_ctx_errmsg(ctx));
@@ -166,6 +201,7 @@ int main(int argc, char **argv)
            "the data, ~%.2f s CPU of them generating), peak RSS %.0f MiB\n",
            (long long)exact->ncomp, texact, cexact, (double)g.rows_read / (double)N,
            cgen * (double)g.rows_read / (double)N, rss_exact);
+    print_stages(&stg);
     double cum = 0;
     for (int64_t k = 0; k < 3 && k < exact->ncomp; k++) cum += exact->explained[k];
     printf("    eigenvalues 1..3: %.6g %.6g %.6g; top 3 explain %.1f%% of the variance\n",
