@@ -1,20 +1,8 @@
 /* tests/test_ctx.c — the context: messages, allocator hooks, RNG. */
 #include "es_internal.h"
 #include "es_test.h"
+#include "es_test_alloc.h"
 
-typedef struct failing_alloc { int64_t count, fail_at; } failing_alloc;
-
-static void *fa_malloc(void *ud, size_t n)
-{
-    failing_alloc *fa = ud;
-    return ++fa->count == fa->fail_at ? NULL : malloc(n);
-}
-static void *fa_realloc(void *ud, void *p, size_t n)
-{
-    failing_alloc *fa = ud;
-    return ++fa->count == fa->fail_at ? NULL : realloc(p, n);
-}
-static void fa_free(void *ud, void *p) { (void)ud; free(p); }
 
 int main(void)
 {
@@ -35,7 +23,7 @@ int main(void)
     ES_CHECK(es__lapack_int(ctx, (int64_t)1 << 33, &li) == ES_ERANGE);
 
     /* allocator hooks see every allocation and can fail one */
-    failing_alloc fa = {0, 2};
+    failing_alloc fa = {0, 2, 0};
     es_allocator a = {fa_malloc, fa_realloc, fa_free, &fa};
     es_ctx_set_allocator(ctx, &a);
     void *p1 = es__malloc(ctx, 16);

@@ -8,6 +8,7 @@
  * it is present. */
 #include "es_internal.h"
 #include "es_test.h"
+#include "es_test_alloc.h"
 #include "es_test_files.h"
 #include "es_test_meshes.h"
 #include "edgespace/edgespace.h"
@@ -16,18 +17,6 @@
 
 enum { NU = 12, NV = 8 };
 
-typedef struct failing_alloc { int64_t count, fail_at; } failing_alloc;
-static void *fa_malloc(void *ud, size_t n)
-{
-    failing_alloc *fa = ud;
-    return ++fa->count == fa->fail_at ? NULL : malloc(n);
-}
-static void *fa_realloc(void *ud, void *p, size_t n)
-{
-    failing_alloc *fa = ud;
-    return ++fa->count == fa->fail_at ? NULL : realloc(p, n);
-}
-static void fa_free(void *ud, void *p) { (void)ud; free(p); }
 
 /* Two stores hold the same rows, bit for bit. */
 static void check_same_stores(es_ctx *ctx, const char *a, const char *b)
@@ -296,7 +285,7 @@ int main(void)
     /* ---- allocation failures: ES_ENOMEM, no store, no leak (ASan) ---- */
     {
         char s6[4300];
-        failing_alloc fa = {0, 0};
+        failing_alloc fa = {0, 0, 0};
         es_allocator a = {fa_malloc, fa_realloc, fa_free, &fa};
         es_ingest_opts o;
         es_status rc = ES_ENOMEM;

@@ -4,6 +4,7 @@
  * procGPA oracle input it came from. */
 #include "es_internal.h"
 #include "es_test.h"
+#include "es_test_alloc.h"
 #include "edgespace/edgespace.h"
 
 #include <stdarg.h>
@@ -149,18 +150,6 @@ static void test_shared(es_ctx *ctx)
     es_landmarks_free(apes);
 }
 
-typedef struct failing_alloc { int64_t count, fail_at; } failing_alloc;
-static void *fa_malloc(void *ud, size_t n)
-{
-    failing_alloc *fa = ud;
-    return ++fa->count == fa->fail_at ? NULL : malloc(n);
-}
-static void *fa_realloc(void *ud, void *p, size_t n)
-{
-    failing_alloc *fa = ud;
-    return ++fa->count == fa->fail_at ? NULL : realloc(p, n);
-}
-static void fa_free(void *ud, void *p) { (void)ud; free(p); }
 
 /* Every allocation of the readers may fail: ES_ENOMEM, nothing returned,
  * nothing leaked (checked under ASan). */
@@ -168,7 +157,7 @@ static void test_alloc_sweep(void)
 {
     es_ctx *ctx = NULL;
     if (es_ctx_new(&ctx) != ES_OK) return;
-    failing_alloc fa = {0, 0};
+    failing_alloc fa = {0, 0, 0};
     es_allocator a = {fa_malloc, fa_realloc, fa_free, &fa};
     es_ctx_set_allocator(ctx, &a);
     static const char *what[] = {"tps", "csv"};

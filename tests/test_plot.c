@@ -3,6 +3,7 @@
  * cells where the returned es_plot_info says they are, error paths. */
 #include "es_internal.h"
 #include "es_test.h"
+#include "es_test_alloc.h"
 #include "plot_util.h"
 
 #include <edgespace/es_plot.h>
@@ -329,18 +330,6 @@ static void test_histogram(es_ctx *ctx)
     ES_CHECK_FAILS(ctx, es_plot_histogram(ctx, &s, png, NULL), ES_EINVAL, "bins");
 }
 
-typedef struct failing_alloc { int64_t count, fail_at; } failing_alloc;
-static void *fa_malloc(void *ud, size_t n)
-{
-    failing_alloc *fa = ud;
-    return ++fa->count == fa->fail_at ? NULL : malloc(n);
-}
-static void *fa_realloc(void *ud, void *p, size_t n)
-{
-    failing_alloc *fa = ud;
-    return ++fa->count == fa->fail_at ? NULL : realloc(p, n);
-}
-static void fa_free(void *ud, void *p) { (void)ud; free(p); }
 
 /* Fail the k-th allocation of a scatter and a histogram for k = 1, 2, ...
  * until the call succeeds (ASan reports any leak). */
@@ -359,7 +348,7 @@ static void test_alloc_failures(es_ctx *ctx)
         es_status rc = ES_ENOMEM;
         int k;
         for (k = 1; k < 20 && rc == ES_ENOMEM; k++) {
-            failing_alloc fa = {0, k};
+            failing_alloc fa = {0, k, 0};
             es_allocator a = {fa_malloc, fa_realloc, fa_free, &fa};
             es_ctx_set_allocator(ctx, &a);
             rc = which == 0 ? es_plot_scatter(ctx, &s, png, NULL)

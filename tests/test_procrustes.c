@@ -12,6 +12,7 @@
  */
 #include "es_internal.h"
 #include "es_test.h"
+#include "es_test_alloc.h"
 #include "edgespace/edgespace.h"
 
 #include <math.h>
@@ -450,18 +451,6 @@ static void test_tangent(es_ctx *ctx)
 
 /* ---- allocation failures ------------------------------------------------ */
 
-typedef struct failing_alloc { int64_t count, fail_at; } failing_alloc;
-static void *fa_malloc(void *ud, size_t n)
-{
-    failing_alloc *fa = ud;
-    return ++fa->count == fa->fail_at ? NULL : malloc(n);
-}
-static void *fa_realloc(void *ud, void *p, size_t n)
-{
-    failing_alloc *fa = ud;
-    return ++fa->count == fa->fail_at ? NULL : realloc(p, n);
-}
-static void fa_free(void *ud, void *p) { (void)ud; free(p); }
 
 /* Fail the k-th allocation for k = 1, 2, ... until a call succeeds: each
  * failure must be ES_ENOMEM (leaks show under -Db_sanitize=address). */
@@ -469,7 +458,7 @@ static void test_alloc_sweep(void)
 {
     es_ctx *ctx = NULL;
     if (es_ctx_new(&ctx) != ES_OK) return;
-    failing_alloc fa = {0, 0};
+    failing_alloc fa = {0, 0, 0};
     es_allocator a = {fa_malloc, fa_realloc, fa_free, &fa};
     es_ctx_set_allocator(ctx, &a);
     es__rng rng;

@@ -7,6 +7,7 @@
  * build/test-out/render/ to be looked at. */
 #include "es_internal.h"
 #include "es_test.h"
+#include "es_test_alloc.h"
 #include "mesh_gen.h"
 #include "plot_util.h"
 
@@ -635,18 +636,6 @@ static void test_cli(void)
     tm_free(&s);
 }
 
-typedef struct failing_alloc { int64_t count, fail_at; } failing_alloc;
-static void *fa_malloc(void *ud, size_t n)
-{
-    failing_alloc *fa = ud;
-    return ++fa->count == fa->fail_at ? NULL : malloc(n);
-}
-static void *fa_realloc(void *ud, void *p, size_t n)
-{
-    failing_alloc *fa = ud;
-    return ++fa->count == fa->fail_at ? NULL : realloc(p, n);
-}
-static void fa_free(void *ud, void *p) { (void)ud; free(p); }
 
 /* Fail the k-th allocation of a two-panel render with per-edge scalars for
  * k = 1, 2, ... until it succeeds: ES_ENOMEM each time, no leak (ASan). */
@@ -669,7 +658,7 @@ static void test_alloc_failures(es_ctx *ctx)
     es_status rc = ES_ENOMEM;
     int k;
     for (k = 1; k < 40 && rc == ES_ENOMEM; k++) {
-        failing_alloc fa = {0, k};
+        failing_alloc fa = {0, k, 0};
         es_allocator a = {fa_malloc, fa_realloc, fa_free, &fa};
         es_ctx_set_allocator(ctx, &a);
         rc = es_render(ctx, &spec, png, NULL);

@@ -5,6 +5,7 @@
  * allocation-failure sweep over open. */
 #include "es_internal.h"
 #include "es_test.h"
+#include "es_test_alloc.h"
 #include "es_test_files.h"
 #include "store_internal.h"
 
@@ -57,18 +58,6 @@ static es_store_rows rows_of(const batch *b, int64_t ncols, const char *const *c
     return r;
 }
 
-typedef struct failing_alloc { int64_t count, fail_at; } failing_alloc;
-static void *fa_malloc(void *ud, size_t n)
-{
-    failing_alloc *fa = ud;
-    return ++fa->count == fa->fail_at ? NULL : malloc(n);
-}
-static void *fa_realloc(void *ud, void *p, size_t n)
-{
-    failing_alloc *fa = ud;
-    return ++fa->count == fa->fail_at ? NULL : realloc(p, n);
-}
-static void fa_free(void *ud, void *p) { (void)ud; free(p); }
 
 int main(void)
 {
@@ -325,7 +314,7 @@ int main(void)
 
     /* ---- allocation failures in open: ES_ENOMEM, then success ---- */
     {
-        failing_alloc fa = {0, 0};
+        failing_alloc fa = {0, 0, 0};
         es_allocator a = {fa_malloc, fa_realloc, fa_free, &fa};
         es_status rc;
         int64_t k = 1;

@@ -8,6 +8,7 @@
 #include "edgespace/edgespace.h"
 #include "es_internal.h"
 #include "es_test.h"
+#include "es_test_alloc.h"
 
 #include <lapacke.h>
 #include <unistd.h>
@@ -508,27 +509,6 @@ static void test_files(es_ctx *ctx)
 
 /* ---- allocation failures: fail the k-th allocation until success ---- */
 
-typedef struct failing_alloc { int64_t count, fail_at, live; } failing_alloc;
-static void *fa_malloc(void *ud, size_t n)
-{
-    failing_alloc *fa = ud;
-    if (++fa->count == fa->fail_at) return NULL;
-    fa->live++;
-    return malloc(n);
-}
-static void *fa_realloc(void *ud, void *p, size_t n)
-{
-    failing_alloc *fa = ud;
-    if (++fa->count == fa->fail_at) return NULL;
-    if (!p) fa->live++;
-    return realloc(p, n);
-}
-static void fa_free(void *ud, void *p)
-{
-    failing_alloc *fa = ud;
-    if (p) fa->live--;
-    free(p);
-}
 
 static void test_alloc_failures(es_ctx *ctx)
 {
