@@ -543,20 +543,9 @@ static int lagged_pcg(es_embedder *emb, const cholmod_sparse *A, cholmod_factor 
                 r[i] -= a * q[i];
             }
         }
-        {
-            double rel = sqrt(dotn(r, r, n)) / bn;
-            if (rel <= eta) {
-                ret = it + 1;
-                break;
-            }
-            /* a lagged factor that has gone stale shows in the first
-             * iterations: if the mean rate so far would need more than
-             * max_it iterations, stop now and let the caller refactorize
-             * instead of spending max_it solves first */
-            if (it >= 2 && rel < 1 &&
-                (double)(it + 1) * log(eta) / log(rel) > 1.5 * (double)max_it)
-                break;
-            if (it >= 2 && !(rel < 1)) break;
+        if (sqrt(dotn(r, r, n)) <= eta * bn) {
+            ret = it + 1;
+            break;
         }
     }
     B->ncol = ncol;
