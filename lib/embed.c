@@ -24,6 +24,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <time.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 struct es_embedder {
     es_ctx *ctx;
@@ -83,6 +86,8 @@ static es_status cm_check(es_embedder *emb, const char *what)
         ES_FAIL(emb->ctx, ES_ENOMEM, "embed: CHOLMOD out of memory in %s", what);
     ES_FAIL(emb->ctx, ES_ENUMERIC, "embed: CHOLMOD failed in %s (status %d)", what, st);
 }
+
+static int factorize(es_embedder *emb, cholmod_sparse *A, cholmod_factor *L);
 
 /* ---- patterns --------------------------------------------------------- */
 
@@ -378,7 +383,7 @@ es_status es_embedder_new(es_ctx *ctx, const es_mesh *mesh, es_embedder **out)
         for (int64_t v = 0; v < emb->nv; v++)
             if (emb->pinned[v] || emb->off[v + 1] == emb->off[v])
                 x[pos_diag(emb->H1, 1, emb->nlow, v, 0, 0)] = 1.0;
-        if (!cholmod_l_factorize(emb->H1, emb->L1, &emb->cm) ||
+        if (!factorize(emb, emb->H1, emb->L1) ||
             emb->cm.status != CHOLMOD_OK) {
             rc = cm_check(emb, "factorize (positions)");
             if (rc == ES_OK)
@@ -441,11 +446,31 @@ const double *es_embedder_vertex_edge_error(const es_embedder *emb)
 /* Factorize A (pattern of L) and solve A X = B into emb->X. Returns 1 if
  * A is not positive definite (nothing solved), 0 on success, -1 on a
  * CHOLMOD failure (message set). */
+/* Numeric factorization. CHOLMOD 3's supernodal code opens OpenMP regions
+ * with a thread count fixed at its compile time (4), ignoring
+ * OMP_NUM_THREADS; on a machine with fewer free cores the extra threads
+ * spin and wait, which doubled the CPU time of a factorization in
+ * bench_embed. Dynamic adjustment lets the runtime size each region by the
+ * load; the caller's setting is restored. */
+static int factorize(es_embedder *emb, cholmod_sparse *A, cholmod_factor *L)
+{
+    int ok;
+#ifdef _OPENMP
+    int dyn = omp_get_dynamic();
+    omp_set_dynamic(1);
+#endif
+    ok = cholmod_l_factorize(A, L, &emb->cm);
+#ifdef _OPENMP
+    omp_set_dynamic(dyn);
+#endif
+    return ok;
+}
+
 static int factor_solve(es_embedder *emb, cholmod_sparse *A, cholmod_factor *L,
                         cholmod_dense *B)
 {
     emb->cm.status = CHOLMOD_OK;
-    if (!cholmod_l_factorize(A, L, &emb->cm)) return cm_check(emb, "factorize") ? -1 : 1;
+    if (!factorize(emb, A, L)) return cm_check(emb, "factorize") ? -1 : 1;
     if (emb->cm.status == CHOLMOD_NOT_POSDEF) return 1;
     if (!cholmod_l_solve2(CHOLMOD_A, L, B, NULL, &emb->X, NULL, &emb->Y, &emb->Ew, &emb->cm))
         return cm_check(emb, "solve") ? -1 : 1;
