@@ -212,8 +212,8 @@ static es_status parse_mean(parser *p, form *f)
     size_t flen = 0;
     es_status rc = ES_OK;
     for (;;) {
-        const char *w, *v;
-        size_t wl, vl;
+        const char *w = NULL, *v = NULL; /* set by word(); initialized for -O3 */
+        size_t wl = 0, vl = 0;
         skip_ws(p);
         if ((rc = word(p, is_id_char, "a column name", &w, &wl)) != ES_OK) break;
         skip_ws(p);
@@ -323,8 +323,8 @@ static es_status parse_primary(parser *p, form *f)
         if (p->s[p->pos] != ':')
             return perr(p, p->pos, "expected ':' after '%.*s'", (int)n, name);
         p->pos++;
-        const char *w;
-        size_t wl, wat = p->pos;
+        const char *w = NULL;
+        size_t wl = 0, wat = p->pos;
         es_status rc;
         if (IS("row")) {
             if ((rc = word(p, is_id_char, "a row id", &w, &wl)) != ES_OK)
