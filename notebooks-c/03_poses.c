@@ -8,9 +8,11 @@
  * lengths along the way (the Fig. 12 curves), and how does that compare
  * with plain vertex interpolation?
  *
- * Dataset. goast_cactus (../shared/data/goast_cactus; 5,261 vertices,
- * closed): the original cactus and, among the first poses, the one
- * farthest from it in edge-length space. Without ../shared/data: the
+ * Dataset. sumner_cat_poses (../shared/data/sumner_cat_poses; 7,207
+ * vertices, closed, genus 0): the animal poses cat-01 and cat-02 (the pair
+ * the embedding issue measures). If that set is absent but goast_cactus is
+ * there: the original cactus and, among the first poses, the one farthest
+ * from it in edge-length space. Without ../shared/data: the
  * project's closed bent tube (es_synth "tube-closed"), straight to bent by
  * 180 degrees.
  *
@@ -71,16 +73,22 @@ static int load(notebook *nb, study *s)
     const char *dir;
     es_status rc;
     nb_step(nb, "load: two poses");
-    dir = nb_dataset(nb, "goast_cactus");
+    const char *dataset = "sumner_cat_poses";
+    dir = nb_dataset(nb, dataset);
+    if (!dir) dir = nb_dataset(nb, dataset = "goast_cactus");
     if (dir) {
+        /* the cat: its first two poses; the cactus: the farthest of its
+         * first eight from the original */
+        int is_cat = strcmp(dataset, "sumner_cat_poses") == 0;
         char path[4352];
         es_manifest *m = NULL;
         int64_t nmax, best = -1;
         double bestd = -1, *la = NULL, *lb = NULL, sa, sb;
         snprintf(path, sizeof path, "%s/metadata.csv", dir);
         if ((rc = es_manifest_read(nb->ctx, path, &m)) != ES_OK)
-            return nb_fail(nb, rc, "cactus metadata");
+            return nb_fail(nb, rc, path);
         nmax = m->nrows < 8 ? m->nrows : 8;
+        if (is_cat && nmax > 2) nmax = 2;
         snprintf(path, sizeof path, "%s/%s", m->dir, m->cells[m->file_col]);
         if (read_pose(nb, path, s, &s->xa)) goto fail;
         s->E = es_mesh_nedges(s->mesh);
@@ -108,10 +116,16 @@ static int load(notebook *nb, study *s)
         }
         snprintf(s->id_a, sizeof s->id_a, "%s", m->ids[0]);
         snprintf(s->id_b, sizeof s->id_b, "%s", m->ids[best]);
-        nb_p(nb, "**Data:** `goast_cactus` from `%s`: A = `%s` (the original), B = `%s`, the "
-             "farthest of the first %lld poses from A in scaled edge-length distance (%.3g).",
-             dir, s->id_a, s->id_b, (long long)nmax, sqrt(bestd));
-        s->z_up = 1;
+        if (is_cat)
+            nb_p(nb, "**Data:** `sumner_cat_poses` from `%s` (Sumner & Popovic): A = `%s`, "
+                 "B = `%s`; scaled edge-length distance %.3g.", dir, s->id_a, s->id_b,
+                 sqrt(bestd));
+        else
+            nb_p(nb, "**Data:** `goast_cactus` from `%s`: A = `%s` (the original), B = `%s`, "
+                 "the farthest of the first %lld poses from A in scaled edge-length distance "
+                 "(%.3g).", dir, s->id_a, s->id_b, (long long)nmax, sqrt(bestd));
+        nb_input(nb, "dataset", "%s", dataset);
+        s->z_up = !is_cat;
         free(la);
         free(lb);
         es_manifest_free(nb->ctx, m);
