@@ -81,6 +81,22 @@ int cli_usage_error(const char *verb, const char *fmt, ...)
     return CLI_USAGE;
 }
 
+char *cli_command_line(int argc, char **argv)
+{
+    size_t n = strlen("edgespace") + 1;
+    for (int i = 0; i < argc; i++) n += strlen(argv[i]) + 3;
+    char *s = malloc(n);
+    if (!s) return NULL;
+    strcpy(s, "edgespace");
+    for (int i = 0; i < argc; i++) {
+        int quote = strpbrk(argv[i], " \t\"'") != NULL || !*argv[i];
+        strcat(s, quote ? " '" : " ");
+        strcat(s, argv[i]);
+        if (quote) strcat(s, "'");
+    }
+    return s;
+}
+
 int cli_parse_i64(const char *s, int64_t *out)
 {
     char *end;

@@ -20,6 +20,11 @@ int cli_fail(const char *verb, es_ctx *ctx, es_status rc);
 int cli_usage_error(const char *verb, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
 
+/* "edgespace VERB ARG..." with arguments quoted where they hold blanks or
+ * quotes, for the provenance of stored results. malloc'd (free it); NULL if
+ * out of memory. argv[0] is the verb, as subcommands receive it. */
+char *cli_command_line(int argc, char **argv);
+
 /* Parse a whole string as int64 / double; 0 on success, -1 otherwise. */
 int cli_parse_i64(const char *s, int64_t *out);
 int cli_parse_double(const char *s, double *out);

@@ -32,20 +32,6 @@ static const char usage[] =
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
 
-static char *joined(int argc, char **argv)
-{
-    size_t n = 16;
-    for (int i = 0; i < argc; i++) n += strlen(argv[i]) + 1;
-    char *s = malloc(n);
-    if (!s) return NULL;
-    strcpy(s, "edgespace");
-    for (int i = 0; i < argc; i++) {
-        strcat(s, " ");
-        strcat(s, argv[i]);
-    }
-    return s;
-}
-
 int cmd_compare(int argc, char **argv)
 {
     enum { O_NAME = 256, O_TOP, O_NOFIG, O_SEED };
@@ -93,7 +79,7 @@ int cmd_compare(int argc, char **argv)
     if (have_seed) es_ctx_set_seed(ctx, (uint64_t)seed);
     es_store *s = NULL;
     es_compare_result *r = NULL;
-    char *cmd = joined(argc, argv);
+    char *cmd = cli_command_line(argc, argv);
     es_status rc = es_store_open(ctx, argv[optind], ES_STORE_WRITE, &s);
     if (rc == ES_OK)
         rc = es_compare_store_run(ctx, s, gpa, by, &o, name, out, figures, cmd, &r);

@@ -70,7 +70,7 @@ int cmd_diff(int argc, char **argv)
     if (!key || !from || !to) return cli_usage_error("diff", "--pair-by, --from and --to are required");
     es_ctx *ctx = cli_ctx_new("diff");
     if (!ctx) return CLI_FAIL;
-    char *cmdline = stats_command_line(argc, argv), defname[256];
+    char *cmdline = cli_command_line(argc, argv), defname[256];
     es_store *st = NULL;
     es_diff *d = NULL;
     int ret = CLI_FAIL;

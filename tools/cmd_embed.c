@@ -203,16 +203,13 @@ have_target:
     if (store_it) {
         es_provenance prov = {NULL, initrow >= 0 && !sel ? &initrow : sel,
                               sel ? nsel : 1, NULL};
-        char cmd[1024] = "edgespace embed", params[256];
-        for (int i = 1; i < argc; i++) {
-            strncat(cmd, " ", sizeof cmd - strlen(cmd) - 1);
-            strncat(cmd, argv[i], sizeof cmd - strlen(cmd) - 1);
-        }
+        char *cmd = cli_command_line(argc, argv), params[256];
         snprintf(params, sizeof params, "point=%s; scale=%.17g", point, scale);
-        prov.command = cmd;
+        prov.command = cmd ? cmd : "edgespace embed";
         prov.params = params;
-        if ((rc = es_embed_store_result(ctx, s, name, &prov, emb, target, xyz, &rep, initdesc)) ||
-            (rc = es_store_commit(ctx, s)))
+        rc = es_embed_store_result(ctx, s, name, &prov, emb, target, xyz, &rep, initdesc);
+        free(cmd);
+        if (rc || (rc = es_store_commit(ctx, s)))
             goto fail;
         printf("stored: /analysis/embed/%s\n", name);
     }

@@ -29,21 +29,6 @@ static const char usage[] =
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
 
-/* The command line, for the result's provenance. */
-static char *joined(int argc, char **argv)
-{
-    size_t n = 16;
-    for (int i = 0; i < argc; i++) n += strlen(argv[i]) + 1;
-    char *s = malloc(n);
-    if (!s) return NULL;
-    strcpy(s, "edgespace");
-    for (int i = 0; i < argc; i++) {
-        strcat(s, " ");
-        strcat(s, argv[i]);
-    }
-    return s;
-}
-
 int cmd_gpa(int argc, char **argv)
 {
     enum { O_NOSCALE = 256, O_REFLECT, O_TOL, O_MAXIT, O_PCS };
@@ -90,7 +75,7 @@ int cmd_gpa(int argc, char **argv)
     es_store *s = NULL;
     int64_t *rows = NULL, nrows = -1;
     es_gpa_report rep;
-    char *cmd = joined(argc, argv);
+    char *cmd = cli_command_line(argc, argv);
     es_status rc = es_store_open(ctx, argv[optind], ES_STORE_WRITE, &s);
     if (rc == ES_OK && where && *where) rc = es_store_select(ctx, s, where, &rows, &nrows);
     if (rc == ES_OK) rc = es_gpa_store_run(ctx, s, name, rows, nrows, &o, npc, cmd, &rep);

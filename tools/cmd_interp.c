@@ -216,20 +216,17 @@ int cmd_interp(int argc, char **argv)
                (long long)info.n_wrapped, (long long)info.n_clamped,
                es_embed_report_format(&rep, text, sizeof text));
         if (store_it) {
-            char cmd[1024] = "edgespace interp", params[512], initd[64];
-            es_provenance prov = {cmd, rows, nin, params};
+            char *cmd = cli_command_line(argc, argv), params[512], initd[64];
+            es_provenance prov = {cmd ? cmd : "edgespace interp", rows, nin, params};
             int off = 0;
-            for (int a = 1; a < argc; a++) {
-                strncat(cmd, " ", sizeof cmd - strlen(cmd) - 1);
-                strncat(cmd, argv[a], sizeof cmd - strlen(cmd) - 1);
-            }
             for (int64_t k = 0; k < nin && off < (int)sizeof params - 40; k++)
                 off += snprintf(params + off, sizeof params - (size_t)off, "%sw[%s]=%.6g",
                                 k ? "; " : "", ids[k], wi[k]);
             snprintf(initd, sizeof initd, "circular mean of the inputs' dihedrals");
-            if ((rc = es_interp_targets(ctx, mesh, nin, in, wi, len, NULL, NULL)) ||
-                (rc = es_embed_store_result(ctx, s, rname, &prov, emb, len, res, &rep, initd)))
-                goto fail;
+            if (!(rc = es_interp_targets(ctx, mesh, nin, in, wi, len, NULL, NULL)))
+                rc = es_embed_store_result(ctx, s, rname, &prov, emb, len, res, &rep, initd);
+            free(cmd);
+            if (rc) goto fail;
         }
     }
     if (store_it) {

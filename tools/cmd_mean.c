@@ -60,7 +60,7 @@ int cmd_mean(int argc, char **argv)
     if (nostore) name = NULL;
     es_ctx *ctx = cli_ctx_new("mean");
     if (!ctx) return CLI_FAIL;
-    char *cmdline = stats_command_line(argc, argv);
+    char *cmdline = cli_command_line(argc, argv);
     es_store *st = NULL;
     es_group_result *r = NULL;
     int ret = CLI_FAIL;

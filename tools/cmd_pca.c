@@ -152,7 +152,7 @@ int cmd_pca(int argc, char **argv)
     es_ctx *ctx = cli_ctx_new("pca");
     if (!ctx) return CLI_FAIL;
     if (seed >= 0) es_ctx_set_seed(ctx, (uint64_t)seed);
-    char *cmdline = stats_command_line(argc, argv);
+    char *cmdline = cli_command_line(argc, argv);
     es_store *st = NULL;
     es_pca *p = NULL;
     int64_t *rows = NULL, nrows = 0;

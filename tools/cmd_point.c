@@ -57,7 +57,7 @@ int cmd_point(int argc, char **argv)
     if (optind != argc - 2) return cli_usage_error("point", "give a STORE and an EXPRESSION");
     es_ctx *ctx = cli_ctx_new("point");
     if (!ctx) return CLI_FAIL;
-    char *cmdline = stats_command_line(argc, argv);
+    char *cmdline = cli_command_line(argc, argv);
     es_store *st = NULL;
     double *vec = NULL;
     es_point_info info;

@@ -6,23 +6,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-char *stats_command_line(int argc, char **argv)
-{
-    size_t n = strlen("edgespace") + 1;
-    for (int i = 0; i < argc; i++) n += strlen(argv[i]) + 3;
-    char *s = malloc(n);
-    if (!s) return NULL;
-    strcpy(s, "edgespace");
-    for (int i = 0; i < argc; i++) {
-        strcat(s, " ");
-        int quote = strpbrk(argv[i], " \t\"'") != NULL || !*argv[i];
-        if (quote) strcat(s, "'");
-        strcat(s, argv[i]);
-        if (quote) strcat(s, "'");
-    }
-    return s;
-}
-
 FILE *stats_csv_open(const char *verb, const char *path)
 {
     if (!strcmp(path, "-")) return stdout;

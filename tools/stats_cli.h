@@ -10,8 +10,6 @@
 
 #include <stdio.h>
 
-/* "edgespace VERB ARGS..." (malloc'd; NULL if out of memory). */
-char *stats_command_line(int argc, char **argv);
 
 /* Open a CSV file for writing ("-": stdout); prints the error and returns
  * NULL on failure. Close with stats_csv_close (0 ok, -1 write error printed). */
