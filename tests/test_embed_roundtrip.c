@@ -17,18 +17,6 @@
 
 #include <edgespace/edgespace.h>
 
-static double diag_of(int64_t nv, const double *x)
-{
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int64_t v = 0; v < nv; v++)
-        for (int i = 0; i < 3; i++) {
-            lo[i] = fmin(lo[i], x[3 * v + i]);
-            hi[i] = fmax(hi[i], x[3 * v + i]);
-        }
-    return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                (hi[2] - lo[2]) * (hi[2] - lo[2]));
-}
-
 static void trip(es_ctx *ctx, const char *data, const char *file, int closed)
 {
     char p[8400];
@@ -42,7 +30,7 @@ static void trip(es_ctx *ctx, const char *data, const char *file, int closed)
     if (emb) {
         int64_t nv = md.nverts, ne = es_mesh_nedges(mesh);
         double *len = malloc((size_t)ne * sizeof *len), *al = malloc((size_t)ne * sizeof *al);
-        double *out = malloc(3 * (size_t)nv * sizeof *out), diag = diag_of(nv, md.xyz), rms;
+        double *out = malloc(3 * (size_t)nv * sizeof *out), diag = es_test_bbox_diag(nv, md.xyz), rms;
         es_embed_report r;
         es__rng rng;
         ES_CHECK_OK(ctx, es_edge_lengths(ctx, mesh, md.xyz, len));
