@@ -30,6 +30,8 @@ static const char usage[] =
     "                       scale, else the mean scale of the store)\n"
     "  -n, --name NAME      result name in the store (default: the output's base name)\n"
     "      --no-store       do not write the report into the store\n"
+    "      --refine-iters N refinement iterations (default 12; more for accuracy,\n"
+    "                       0 for the linear stages only)\n"
     "      --paper          the published method's stages only (stage 1 always, no\n"
     "                       refinement), for comparison\n"
     "  -h, --help           show this help\n"
@@ -52,11 +54,13 @@ int cmd_embed(int argc, char **argv)
         {"init", required_argument, NULL, 'i'},  {"scale", required_argument, NULL, 's'},
         {"name", required_argument, NULL, 'n'},  {"no-store", no_argument, NULL, 'N'},
         {"paper", no_argument, NULL, 'P'},       {"help", no_argument, NULL, 'h'},
+        {"refine-iters", required_argument, NULL, 'R'},
         {NULL, 0, NULL, 0}};
     const char *point = NULL, *out = NULL, *init = "nearest", *name = NULL;
     char namebuf[256], path[512], initdesc[512], text[1024];
     double scale = 0, *target = NULL, *xyz = NULL, *init_xyz = NULL, *alpha = NULL, *scales = NULL;
     int c, store_it = 1, paper = 0;
+    int64_t refine_iters = -1;
     es_ctx *ctx;
     es_store *s = NULL;
     es_mesh *mesh = NULL;
@@ -78,6 +82,10 @@ int cmd_embed(int argc, char **argv)
         case 'n': name = optarg; break;
         case 'N': store_it = 0; break;
         case 'P': paper = 1; break;
+        case 'R':
+            if (cli_parse_i64(optarg, &refine_iters) || refine_iters < 0 || refine_iters > 100000)
+                return cli_usage_error("embed", "--refine-iters wants a count >= 0");
+            break;
         case 'h': fputs(usage, stdout); return CLI_OK;
         default: return cli_usage_error("embed", "bad option");
         }
@@ -190,6 +198,7 @@ have_target:
     }
     if ((rc = es_store_read_positions(ctx, s, initrow, init_xyz))) goto fail;
     es_embed_opts_init(&opts);
+    if (refine_iters >= 0) opts.refine_max_iter = (int)refine_iters;
     if (paper) {
         opts.dihedral_mode = ES_EMBED_DIHEDRAL_ON;
         opts.refine_max_iter = 0;

@@ -29,6 +29,7 @@ static const char usage[] =
     "                        one integer conversion, e.g. 'cat_%02d.obj'\n"
     "  -n, --name NAME       result name in the store (default: output base name)\n"
     "      --no-store        do not write reports into the store\n"
+    "      --refine-iters N  refinement iterations per frame (default 12)\n"
     "  -h, --help            show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -110,17 +111,21 @@ int cmd_interp(int argc, char **argv)
         {"t1", required_argument, NULL, '1'},   {"weights", required_argument, NULL, 'w'},
         {"output", required_argument, NULL, 'o'}, {"name", required_argument, NULL, 'n'},
         {"no-store", no_argument, NULL, 'N'},   {"help", no_argument, NULL, 'h'},
+        {"refine-iters", required_argument, NULL, 'R'},
         {NULL, 0, NULL, 0}};
     const char *from = NULL, *to = NULL, *weights = NULL, *out = NULL, *name = NULL;
     char ids[MAX_IN][256], namebuf[256], fname[1024], rname[300], text[1024];
     double w[MAX_IN], t0 = 0, t1 = 1, *xyz[MAX_IN] = {0}, *res = NULL, *len = NULL;
     int64_t steps = 9, rows[MAX_IN], nin = 0, nv, ne;
     int c, store_it = 1;
+    int64_t refine_iters = -1;
+    es_embed_opts opts;
     es_ctx *ctx;
     es_store *s = NULL;
     es_mesh *mesh = NULL;
     es_embedder *emb = NULL;
     es_status rc = ES_OK;
+    es_embed_opts_init(&opts);
     optind = 1;
     while ((c = getopt_long(argc, argv, "f:t:k:w:o:n:h", longopts, NULL)) != -1) {
         switch (c) {
@@ -140,10 +145,15 @@ int cmd_interp(int argc, char **argv)
         case 'o': out = optarg; break;
         case 'n': name = optarg; break;
         case 'N': store_it = 0; break;
+        case 'R':
+            if (cli_parse_i64(optarg, &refine_iters) || refine_iters < 0 || refine_iters > 100000)
+                return cli_usage_error("interp", "--refine-iters wants a count >= 0");
+            break;
         case 'h': fputs(usage, stdout); return CLI_OK;
         default: return cli_usage_error("interp", "bad option");
         }
     }
+    if (refine_iters >= 0) opts.refine_max_iter = (int)refine_iters;
     if (optind != argc - 1) return cli_usage_error("interp", "give exactly one STORE");
     if (!out) return cli_usage_error("interp", "--output is required");
     if (weights) {
@@ -200,7 +210,7 @@ int cmd_interp(int argc, char **argv)
         if (weights) memcpy(wi, w, (size_t)nin * sizeof *wi);
         else wi[0] = 1 - t, wi[1] = t;
         /* frames align to the previous frame so that the sequence does not jump */
-        if ((rc = es_interp_embed(emb, nin, in, wi, i ? res : NULL, NULL, res, &rep, &info)))
+        if ((rc = es_interp_embed(emb, nin, in, wi, i ? res : NULL, &opts, res, &rep, &info)))
             goto fail;
         if (steps > 1) {
             expand_pattern(out, (int)i, fname, sizeof fname);
