@@ -87,6 +87,21 @@ int main(void)
         es_store_close(s);
         es_ctx_free(ctx);
     }
+    /* --refine-iters bounds the refinement; 0 leaves the linear stages' result */
+    ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out, "--init", "row:mesh-0",
+           "--refine-iters", "0", "--no-store");
+    ES_CHECK_MSG(r.status == 0 && strstr(r.out, "refinement 0"), "refine-iters 0: %s %s", r.out,
+                 r.err);
+    ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out, "--refine-iters", "many");
+    ES_CHECK(r.status == 2 && strstr(r.err, "--refine-iters"));
+    snprintf(p, sizeof p, "%s/r_%%02d.obj", dir);
+    ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-2", "--steps", "2",
+           "--refine-iters", "2", "--no-store", "-o", p);
+    ES_CHECK_MSG(r.status == 0 && !strstr(r.out, "refinement 3") && strstr(r.out, "RMS ratio"),
+                 "interp --refine-iters: %s %s", r.out, r.err);
+    ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-2",
+           "--refine-iters", "-1", "-o", p);
+    ES_CHECK(r.status == 2);
     ES_RUN(&r, dir, "embed", store, "--point", "nothing", "-o", out);
     ES_CHECK_MSG(r.status == 1 && strstr(r.err, "edgespace embed: "), "%s", r.err);
     ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out, "--init", "sideways");
