@@ -1,9 +1,11 @@
 /* tools/bench/bench_embed.c — time per embedding against vertex count (2K to
  * 60K vertices; larger meshes by midpoint subdivision of real ones, which
  * keeps them in correspondence) with the edge-length error and closure
- * energy beside each time. Two cases per mesh: the midpoint t = 0.5 of a
- * real pair (es_interp_embed: the hard, inconsistent case) and the round
- * trip of one shape's own lengths and dihedrals (consistent input).
+ * energy beside each time. Three cases per mesh: the midpoint t = 0.5 of a
+ * real pair (es_interp_embed: the hard, inconsistent case), the same
+ * midpoint through the published method's stages only (stage 1 always, no
+ * refinement; a comparison in the same run), and the round trip of one
+ * shape's own lengths and dihedrals (consistent input).
  * Wall and process CPU time are printed: on a shared machine the wall time
  * includes waiting for a core.
  *
@@ -96,6 +98,21 @@ static void run(es_ctx *ctx, const char *dir, const char *a, const char *b, int 
                r.t_dihedral, r.t_frames + r.t_positions, r.t_refine, tc_new, 100 * r.rms_ratio,
                100 * r.max_rel, r.closure_before, r.closure_after,
                r.used_stage1 ? "stage1" : "-");
+        /* the published method's stages on the same midpoint, in the same
+         * run: stage 1 always (LM here, not the paper's L-BFGS), no refinement */
+        {
+            es_embed_opts po;
+            es_embed_opts_init(&po);
+            po.dihedral_mode = ES_EMBED_DIHEDRAL_ON;
+            po.refine_max_iter = 0;
+            w0 = wall_now();
+            c0 = cpu_now();
+            if (es_interp_embed(emb, 2, in, w, NULL, &po, out, &r, NULL)) goto fail;
+            printf("%-22s %-19s %7lld  %6.2f %6.2f  %6.2f %6.2f %6.2f %6.2f  %8.4f%% %7.3f%%  %9.3g %9.3g  %s\n",
+                   dir, "paper stages t=0.5", (long long)nv, wall_now() - w0, cpu_now() - c0,
+                   r.t_dihedral, r.t_frames + r.t_positions, r.t_refine, tc_new, 100 * r.rms_ratio,
+                   100 * r.max_rel, r.closure_before, r.closure_after, "stage1");
+        }
         /* round trip of shape a */
         es_edge_lengths(ctx, mesh, xyz, len);
         es_dihedral_angles(ctx, mesh, xyz, al);
