@@ -8,7 +8,8 @@
  * each onto the nearest rotation; stage 3 solves x_u - x_v = G_v u_v over
  * both directed copies of every edge (a graph Laplacian, factorized once per
  * topology); stage 4 is Levenberg-Marquardt on the relative edge-length
- * residuals in position space, which closes what vertex closure leaves
+ * residuals in position space (Gauss-Newton matrix plus the curvature of
+ * the stretched edges' residuals), which closes what vertex closure leaves
  * open (holonomy around holes and handles, failure A of the oracle README;
  * edges between two boundary vertices, failure B). Every sparse matrix has
  * a pattern fixed by the topology: each is analysed once (CHOLMOD
