@@ -17,24 +17,25 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
+
+#include "bench_clock.h"
 
 #ifndef ES_SHARED_DIR
 #define ES_SHARED_DIR "../shared"
 #endif
 
-static double cpu_now(void)
+/* One result line; exact round trips have errors near 1e-12, printed %g. */
+static void print_row(const char *dir, const char *what, int64_t nv, double wall, double cpu,
+                      double setup, const es_embed_report *r, int exact)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static double wall_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+    printf("%-22s %-19s %7lld  %6.2f %6.2f  %6.2f %6.2f %6.2f %6.2f  ", dir, what, (long long)nv,
+           wall, cpu, r->t_dihedral, r->t_frames + r->t_positions, r->t_refine, setup);
+    if (exact)
+        printf("%8.2g%% %7.2g%%", 100 * r->rms_ratio, 100 * r->max_rel);
+    else
+        printf("%8.4f%% %7.3f%%", 100 * r->rms_ratio, 100 * r->max_rel);
+    printf("  %9.3g %9.3g  %s\n", r->closure_before, r->closure_after,
+           r->used_stage1 ? "stage1" : "-");
 }
 
 static void run(es_ctx *ctx, const char *dir, const char *a, const char *b, int levels,
@@ -80,49 +81,39 @@ static void run(es_ctx *ctx, const char *dir, const char *a, const char *b, int 
     if (nv > vmax) goto done;
     if (es_mesh_new(ctx, nv, nf, faces, xyz, &mesh)) goto fail;
     {
-        double w0 = wall_now(), c0 = cpu_now(), tw_new, tc_new;
+        double w0 = bench_wall_s(), c0, tw_new;
         if (es_embedder_new(ctx, mesh, &emb)) goto fail;
-        tw_new = wall_now() - w0;
-        tc_new = cpu_now() - c0;
+        tw_new = bench_wall_s() - w0;
         const double *in[2] = {xyz, xyz + 3 * nv};
         double w[2] = {0.5, 0.5}, *out = malloc(3 * (size_t)nv * sizeof *out);
         int64_t ne = es_mesh_nedges(mesh);
         double *len = malloc((size_t)ne * sizeof *len), *al = malloc((size_t)ne * sizeof *al);
         es_embed_report r;
+        es_embed_opts paper;
         /* midpoint */
-        w0 = wall_now();
-        c0 = cpu_now();
+        w0 = bench_wall_s();
+        c0 = bench_process_cpu_s();
         if (es_interp_embed(emb, 2, in, w, NULL, NULL, out, &r, NULL)) goto fail;
-        printf("%-22s %-19s %7lld  %6.2f %6.2f  %6.2f %6.2f %6.2f %6.2f  %8.4f%% %7.3f%%  %9.3g %9.3g  %s\n",
-               dir, "midpoint t=0.5", (long long)nv, wall_now() - w0, cpu_now() - c0,
-               r.t_dihedral, r.t_frames + r.t_positions, r.t_refine, tc_new, 100 * r.rms_ratio,
-               100 * r.max_rel, r.closure_before, r.closure_after,
-               r.used_stage1 ? "stage1" : "-");
+        print_row(dir, "midpoint t=0.5", nv, bench_wall_s() - w0, bench_process_cpu_s() - c0,
+                  tw_new, &r, 0);
         /* the published method's stages on the same midpoint, in the same
          * run: stage 1 always (LM here, not the paper's L-BFGS), no refinement */
-        {
-            es_embed_opts po;
-            es_embed_opts_init(&po);
-            po.dihedral_mode = ES_EMBED_DIHEDRAL_ON;
-            po.refine_max_iter = 0;
-            w0 = wall_now();
-            c0 = cpu_now();
-            if (es_interp_embed(emb, 2, in, w, NULL, &po, out, &r, NULL)) goto fail;
-            printf("%-22s %-19s %7lld  %6.2f %6.2f  %6.2f %6.2f %6.2f %6.2f  %8.4f%% %7.3f%%  %9.3g %9.3g  %s\n",
-                   dir, "paper stages t=0.5", (long long)nv, wall_now() - w0, cpu_now() - c0,
-                   r.t_dihedral, r.t_frames + r.t_positions, r.t_refine, tc_new, 100 * r.rms_ratio,
-                   100 * r.max_rel, r.closure_before, r.closure_after, "stage1");
-        }
+        es_embed_opts_init(&paper);
+        paper.dihedral_mode = ES_EMBED_DIHEDRAL_ON;
+        paper.refine_max_iter = 0;
+        w0 = bench_wall_s();
+        c0 = bench_process_cpu_s();
+        if (es_interp_embed(emb, 2, in, w, NULL, &paper, out, &r, NULL)) goto fail;
+        print_row(dir, "paper stages t=0.5", nv, bench_wall_s() - w0, bench_process_cpu_s() - c0,
+                  tw_new, &r, 0);
         /* round trip of shape a */
         es_edge_lengths(ctx, mesh, xyz, len);
         es_dihedral_angles(ctx, mesh, xyz, al);
-        w0 = wall_now();
-        c0 = cpu_now();
+        w0 = bench_wall_s();
+        c0 = bench_process_cpu_s();
         if (es_embed_solve(emb, len, 0, al, NULL, NULL, out, &r)) goto fail;
-        printf("%-22s %-19s %7lld  %6.2f %6.2f  %6.2f %6.2f %6.2f %6.2f  %8.2g%% %7.2g%%  %9.3g %9.3g  %s\n",
-               dir, "round trip (exact)", (long long)nv, wall_now() - w0, cpu_now() - c0,
-               r.t_dihedral, r.t_frames + r.t_positions, r.t_refine, tw_new, 100 * r.rms_ratio,
-               100 * r.max_rel, r.closure_before, r.closure_after, r.used_stage1 ? "stage1" : "-");
+        print_row(dir, "round trip (exact)", nv, bench_wall_s() - w0, bench_process_cpu_s() - c0,
+                  tw_new, &r, 1);
         fflush(stdout);
         free(out), free(len), free(al);
     }

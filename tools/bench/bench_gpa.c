@@ -14,15 +14,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
-#include <time.h>
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "bench_clock.h"
 
 /* xorshift-based uniform and normal numbers: the benchmark's own data. */
 static uint64_t state = 0x9e3779b97f4a7c15ULL;
@@ -41,23 +34,6 @@ static void on_log(void *ud, es_log_level level, const char *msg)
 {
     (void)ud; (void)level;
     printf("  [log] %s\n", msg);
-}
-
-/* CPU seconds of this process (user + system): a fairer figure than wall
- * time on a machine shared with other jobs. */
-static double cpu_seconds(void)
-{
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
-    return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
-           (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
-}
-
-static double peak_rss_mib(void)
-{
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
-    return (double)ru.ru_maxrss / 1024.0;
 }
 
 int main(int argc, char **argv)
@@ -92,7 +68,7 @@ int main(int argc, char **argv)
         }
     }
     free(base);
-    double data_mib = (double)(kd * n) * 8 / 1048576.0, rss0 = peak_rss_mib();
+    double data_mib = (double)(kd * n) * 8 / 1048576.0, rss0 = bench_peak_rss_mib();
 
     es_ctx *ctx = NULL;
     if (es_ctx_new(&ctx) != ES_OK) return 1;
@@ -105,19 +81,19 @@ int main(int argc, char **argv)
     es_gpa_out out = {0};
     out.mean = mean;
     out.rho = rho;
-    double t0 = now(), c0 = cpu_seconds();
+    double t0 = bench_wall_s(), c0 = bench_process_cpu_s();
     es_status rc = es_gpa_align(ctx, k, 3, (es_mat){x, kd, n, kd}, &o, &out, &rep);
-    double t1 = now(), c1 = cpu_seconds();
+    double t1 = bench_wall_s(), c1 = bench_process_cpu_s();
     if (rc != ES_OK) { fprintf(stderr, "bench_gpa: %s\n", es_ctx_errmsg(ctx)); return 1; }
-    double rss1 = peak_rss_mib();
+    double rss1 = bench_peak_rss_mib();
     /* tangent coordinates in place, then the first 10 PCs */
     double sd[10], pc[10];
     rc = es_gpa_tangent(ctx, k, 3, (es_mat){x, kd, n, kd}, mean, ES_TANGENT_RESIDUAL,
                         (es_mat){x, kd, n, kd});
-    double t2 = now();
+    double t2 = bench_wall_s();
     if (rc == ES_OK)
         rc = es_gpa_pca(ctx, (es_mat){x, kd, n, kd}, 10, sd, pc, (es_mat){0}, (es_mat){0});
-    double t3 = now();
+    double t3 = bench_wall_s();
     if (rc != ES_OK) { fprintf(stderr, "bench_gpa: %s\n", es_ctx_errmsg(ctx)); return 1; }
     printf("GPA %s, n = %lld configurations x k = %lld vertices (3D)\n",
            scale ? "full (scale)" : "partial (no scale)", (long long)n, (long long)k);

@@ -19,28 +19,13 @@
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
+
+#include "bench_clock.h"
 
 #ifndef ES_SHARED_DIR
 #define ES_SHARED_DIR "../shared"
 #endif
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* CPU time of this thread: the phase figures stay meaningful on a loaded
- * machine, where wall time mostly measures the other processes. */
-static double cpu_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static double tv(struct timeval t) { return (double)t.tv_sec + 1e-6 * (double)t.tv_usec; }
 
@@ -120,7 +105,7 @@ int main(int argc, char **argv)
         double t0;
         pid_t pid;
         unlink(store);
-        t0 = now();
+        t0 = bench_wall_s();
         if ((pid = fork()) == 0) {
             es_ingest_report rep;
             es_ingest_opts o;
@@ -135,7 +120,7 @@ int main(int argc, char **argv)
             fprintf(stderr, "bench_ingest: ingest failed\n");
             return 1;
         }
-        wall[k] = now() - t0;
+        wall[k] = bench_wall_s() - t0;
         cpu[k] = tv(ru.ru_utime) + tv(ru.ru_stime);
         if ((double)ru.ru_maxrss > maxrss) maxrss = (double)ru.ru_maxrss;
     }
@@ -168,15 +153,15 @@ int main(int argc, char **argv)
             char *buf;
             es_meshdata md;
             snprintf(p, sizeof p, "%s/%s", m->dir, m->cells[r * m->ncols + m->file_col]);
-            t = cpu_now();
+            t = bench_thread_cpu_s();
             buf = slurp(p, &n);
             es_content_hash(buf, n, hash);
-            t_read += cpu_now() - t;
-            t = cpu_now();
+            t_read += bench_thread_cpu_s() - t;
+            t = bench_thread_cpu_s();
             if ((rc = es_meshdata_parse(ctx, p, buf, n, ES_FORMAT_AUTO, &md))) die(ctx, rc, p);
-            t_parse += cpu_now() - t;
+            t_parse += bench_thread_cpu_s() - t;
             free(buf);
-            t = cpu_now();
+            t = bench_thread_cpu_s();
             if (!mesh) {
                 if ((rc = es_mesh_new(ctx, md.nverts, md.nfaces, md.faces, NULL, &mesh)))
                     die(ctx, rc, "mesh");
@@ -189,7 +174,7 @@ int main(int argc, char **argv)
                 (rc = es_lengths_normalize(ctx, E, len + r * E, len + r * E, &scale[r])))
                 die(ctx, rc, "lengths");
             memcpy(xyz + r * 3 * V, md.xyz, (size_t)(3 * V) * sizeof *xyz);
-            t_len += cpu_now() - t;
+            t_len += bench_thread_cpu_s() - t;
             es_meshdata_clear(ctx, &md);
         }
         {
@@ -198,12 +183,12 @@ int main(int argc, char **argv)
             for (int64_t r = 0; r < N; r++) ids[r] = m->ids[r];
             rows.ids = ids;
             unlink(store);
-            t = cpu_now();
+            t = bench_thread_cpu_s();
             if ((rc = es_store_create(ctx, store, mesh, &s)) ||
                 (rc = es_store_append(ctx, s, &rows)) || (rc = es_store_commit(ctx, s)))
                 die(ctx, rc, "store");
             es_store_close(s);
-            t_write = cpu_now() - t;
+            t_write = bench_thread_cpu_s() - t;
             free(ids);
         }
         printf("phases CPU read+hash %.3f s, parse %.3f s (%.1f MB/s), lengths %.3f s, "
@@ -212,18 +197,18 @@ int main(int argc, char **argv)
         {
             /* reading back: all rows in one block, and row by row */
             es_mat out = {len, E, N, E};
-            t = cpu_now();
+            t = bench_thread_cpu_s();
             if (es_store_open(ctx, store, ES_STORE_READ, &s)) die(ctx, ES_EIO, "open");
-            printf("read CPU   open %.3f s; ", cpu_now() - t);
-            t = cpu_now();
+            printf("read CPU   open %.3f s; ", bench_thread_cpu_s() - t);
+            t = bench_thread_cpu_s();
             if (es_store_read_lengths(ctx, s, 0, N, out)) die(ctx, ES_EIO, "read back");
-            printf("all %lld rows of lengths in one block: %.3f s", (long long)N, cpu_now() - t);
-            t = cpu_now();
+            printf("all %lld rows of lengths in one block: %.3f s", (long long)N, bench_thread_cpu_s() - t);
+            t = bench_thread_cpu_s();
             for (int64_t r = 0; r < N; r++) {
                 es_mat one = {len + r * E, E, 1, E};
                 if (es_store_read_lengths(ctx, s, r, 1, one)) die(ctx, ES_EIO, "read row");
             }
-            printf("; row by row: %.3f s\n", cpu_now() - t);
+            printf("; row by row: %.3f s\n", bench_thread_cpu_s() - t);
             es_store_close(s);
         }
         es_mesh_free(mesh);

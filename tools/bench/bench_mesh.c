@@ -9,14 +9,8 @@
 
 #include <stdio.h>
 #include <stdlib.h>
-#include <time.h>
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "bench_clock.h"
 
 static int fail(es_ctx *ctx, const char *what)
 {
@@ -46,31 +40,31 @@ int main(int argc, char **argv)
             es_mesh *m = NULL;
             double *len = NULL, *ang = NULL, *al = NULL;
             for (int r = 0; r < reps; r++) {
-                double t0 = now();
+                double t0 = bench_process_cpu_s();
                 es_mesh_free(m);
                 m = NULL;
                 if (es_mesh_new(ctx, s.nverts, s.nfaces, s.faces, NULL, &m) != ES_OK)
                     return fail(ctx, "mesh_new");
-                double t1 = now();
+                double t1 = bench_process_cpu_s();
                 int64_t ne = es_mesh_nedges(m);
                 if (!len) {
                     len = malloc((size_t)ne * sizeof *len);
                     al = malloc((size_t)ne * sizeof *al);
                     ang = malloc((size_t)s.nfaces * 3 * sizeof *ang);
                 }
-                double t2 = now();
+                double t2 = bench_process_cpu_s();
                 es_edge_lengths(ctx, m, s.xyz, len);
-                double t3 = now();
+                double t3 = bench_process_cpu_s();
                 es_corner_angles(ctx, m, len, ang);
-                double t4 = now();
+                double t4 = bench_process_cpu_s();
                 if (es_dihedral_angles(ctx, m, s.xyz, al) != ES_OK) return fail(ctx, "dihedral");
-                double t5 = now();
+                double t5 = bench_process_cpu_s();
                 int64_t nv2, *f2;
                 double *x2;
                 if (es_mesh_subdivide(ctx, s.nverts, s.nfaces, s.faces, 1, s.xyz, &nv2, &f2,
                                       &x2) != ES_OK)
                     return fail(ctx, "subdivide");
-                double t6 = now();
+                double t6 = bench_process_cpu_s();
                 es_free(ctx, f2);
                 es_free(ctx, x2);
                 double d[5] = {t1 - t0, t3 - t2, t4 - t3, t5 - t4, t6 - t5};

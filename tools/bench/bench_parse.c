@@ -17,26 +17,11 @@
 #include <string.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
 
+#include "bench_clock.h"
+
 typedef struct file { char *path, *buf; size_t len; } file;
-
-/* CPU time of this process: on a shared, loaded machine it measures the
- * work done, where wall time would mostly measure the wait for a core. */
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static double wall(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static int add_file(file **fs, int *n, const char *path)
 {
@@ -158,7 +143,7 @@ int main(int argc, char **argv)
     if (es_ctx_new(&ctx) != ES_OK) return 1;
 
     for (int pass = 0; pass < passes; pass++) {
-        double w0 = wall(), t0 = now();
+        double w0 = bench_wall_s(), t0 = bench_process_cpu_s();
         for (int i = 0; i < n; i++) {
             es_meshdata md;
             if (es_meshdata_parse(ctx, fs[i].path, fs[i].buf, fs[i].len, ES_FORMAT_OBJ, &md)) {
@@ -168,15 +153,15 @@ int main(int argc, char **argv)
             if (pass == 0) verts += md.nverts;
             es_meshdata_clear(ctx, &md);
         }
-        double t1 = now();
-        if (wall() - w0 < best_fast_wall) best_fast_wall = wall() - w0;
+        double t1 = bench_process_cpu_s();
+        if (bench_wall_s() - w0 < best_fast_wall) best_fast_wall = bench_wall_s() - w0;
         for (int i = 0; i < n; i++) {
             es_meshdata md;
             naive_parse(fs[i].buf, fs[i].len, &md);
             free(md.xyz);
             free(md.faces);
         }
-        double t2 = now();
+        double t2 = bench_process_cpu_s();
         if (fs[0].path[0] != 'g' || strcmp(fs[0].path, "generated.obj")) {
             for (int i = 0; i < n; i++) {
                 es_meshdata md;
@@ -184,7 +169,7 @@ int main(int argc, char **argv)
                 es_meshdata_clear(ctx, &md);
             }
         }
-        double t3 = now();
+        double t3 = bench_process_cpu_s();
         if (t1 - t0 < best_fast) best_fast = t1 - t0;
         if (t2 - t1 < best_naive) best_naive = t2 - t1;
         if (t3 - t2 < best_read) best_read = t3 - t2;
@@ -227,14 +212,14 @@ int main(int argc, char **argv)
             remove(tmp);
             double best = 1e30;
             for (int pass = 0; pass < passes; pass++) {
-                double t0 = now();
+                double t0 = bench_process_cpu_s();
                 for (int r = 0; r < reps; r++) {
                     es_meshdata m2;
                     if (es_meshdata_parse(ctx, tmp, x->buf, x->len, ES_FORMAT_AUTO, &m2))
                         return 1;
                     es_meshdata_clear(ctx, &m2);
                 }
-                if (now() - t0 < best) best = now() - t0;
+                if (bench_process_cpu_s() - t0 < best) best = bench_process_cpu_s() - t0;
             }
             other_mbs[k] = reps * (double)x->len / 1e6 / best;
             other_ms[k] = reps / best;

@@ -21,9 +21,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
 #include <time.h>
 #include <unistd.h>
+
+#include "bench_clock.h"
 
 typedef struct gen {
     int64_t E, N, R;
@@ -58,28 +59,6 @@ static es_status gen_read(es_ctx *ctx, const es_source *src, int64_t row0, int64
     return ES_OK;
 }
 
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static double cpu_s(void)
-{
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
-    return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
-           (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
-}
-
-static double peak_rss_mib(void)
-{
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
-    return (double)ru.ru_maxrss / 1024.0;
-}
-
 static const char *loadavg(void)
 {
     static char buf[64] = "?";
@@ -109,7 +88,7 @@ static void on_progress(void *ud, const char *what, int64_t done, int64_t total)
         if (st->n == 8) return;
         st->what[st->n++] = what;
     }
-    st->end[st->n - 1] = now();
+    st->end[st->n - 1] = bench_wall_s();
 }
 
 static void print_stages(const stages *st)
@@ -171,12 +150,12 @@ int main(int argc, char **argv)
            (long long)N, (long long)E, (double)N * (double)E * 8 / 1048576.0, (long long)R);
     /* time to generate the data once (part of every pass below) */
     double *blk = malloc((size_t)E * 64 * sizeof(double));
-    double t0 = now(), cg0 = cpu_s();
+    double t0 = bench_wall_s(), cg0 = bench_process_cpu_s();
     for (int64_t r0 = 0; r0 < N; r0 += 64) {
         int64_t n = N - r0 < 64 ? N - r0 : 64;
         gen_read(ctx, &src, r0, n, (es_mat){blk, E, n, E});
     }
-    double tgen = now() - t0, cgen = cpu_s() - cg0;
+    double tgen = bench_wall_s() - t0, cgen = bench_process_cpu_s() - cg0;
     printf("  load average at start: %s\n", loadavg());
     free(blk);
     printf("  generating one pass of the data:   %7.2f s wall, %.2f s CPU\n", tgen, cgen);
@@ -188,15 +167,15 @@ int main(int argc, char **argv)
     memset(&stg, 0, sizeof stg);
     es_ctx_set_progress(ctx, on_progress, &stg);
     g.rows_read = 0;
-    t0 = now();
+    t0 = bench_wall_s();
     stg.t0 = t0;
-    double c0 = cpu_s();
+    double c0 = bench_process_cpu_s();
     if (es_pca_fit(ctx, &src, &o, &exact) != ES_OK) {
         fprintf(stderr, "bench_pca: %s\n", es_ctx_errmsg(ctx));
         return 1;
     }
-    double texact = now() - t0, cexact = cpu_s() - c0;
-    double rss_exact = peak_rss_mib();
+    double texact = bench_wall_s() - t0, cexact = bench_process_cpu_s() - c0;
+    double rss_exact = bench_peak_rss_mib();
     printf("  exact PCA (Gram route, %lld components): %7.2f s wall, %.2f s CPU  (%.2f passes over "
            "the data, ~%.2f s CPU of them generating), peak RSS %.0f MiB\n",
            (long long)exact->ncomp, texact, cexact, (double)g.rows_read / (double)N,
@@ -212,26 +191,26 @@ int main(int argc, char **argv)
         es_pca_opts ot = o;
         ot.ncomp = 20;
         g.rows_read = 0;
-        t0 = now();
-        c0 = cpu_s();
+        t0 = bench_wall_s();
+        c0 = bench_process_cpu_s();
         if (es_pca_fit(ctx, &src, &ot, &top) != ES_OK) {
             fprintf(stderr, "bench_pca: %s\n", es_ctx_errmsg(ctx));
             return 1;
         }
         printf("  exact PCA (Gram route, top 20):     %7.2f s wall, %.2f s CPU  (%.2f passes)\n",
-               now() - t0, cpu_s() - c0, (double)g.rows_read / (double)N);
+               bench_wall_s() - t0, bench_process_cpu_s() - c0, (double)g.rows_read / (double)N);
         es_pca_free(top);
     }
     o.method = ES_PCA_RANDOMIZED;
     o.ncomp = K;
     g.rows_read = 0;
-    t0 = now();
-    c0 = cpu_s();
+    t0 = bench_wall_s();
+    c0 = bench_process_cpu_s();
     if (es_pca_fit(ctx, &src, &o, &rnd) != ES_OK) {
         fprintf(stderr, "bench_pca: %s\n", es_ctx_errmsg(ctx));
         return 1;
     }
-    double trnd = now() - t0, crnd = cpu_s() - c0;
+    double trnd = bench_wall_s() - t0, crnd = bench_process_cpu_s() - c0;
     double maxrel = 0;
     for (int64_t k = 0; k < K; k++) {
         double rel = fabs(rnd->eigenvalues[k] - exact->eigenvalues[k]) / exact->eigenvalues[k];

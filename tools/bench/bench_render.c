@@ -9,30 +9,22 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
+
+#include "bench_clock.h"
 
 #include "../../tests/mesh_gen.h"
-
-/* CPU time of the process: the build machine is shared, so wall time
- * under load says little; this counts only our own work. */
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* Best of `reps` CPU times of one render. */
 static double time_render(es_ctx *ctx, const es_render_spec *spec, const char *out, int reps)
 {
     double best = 1e30;
     for (int r = 0; r < reps; r++) {
-        double t0 = now();
+        double t0 = bench_process_cpu_s();
         if (es_render(ctx, spec, out, NULL) != ES_OK) {
             fprintf(stderr, "bench_render: %s\n", es_ctx_errmsg(ctx));
             exit(1);
         }
-        double t = now() - t0;
+        double t = bench_process_cpu_s() - t0;
         if (t < best) best = t;
     }
     return best;
@@ -105,9 +97,9 @@ int main(void)
     for (int k = 0; k < 2; k++) {
         double best = 1e30;
         for (int r = 0; r < 3; r++) {
-            double t0 = now();
+            double t0 = bench_process_cpu_s();
             if (es_plot_scatter(ctx, &sc, outs[k], NULL) != ES_OK) return 1;
-            double t = now() - t0;
+            double t = bench_process_cpu_s() - t0;
             best = t < best ? t : best;
         }
         printf("scatter %d points -> %-14s %10.1f cpu ms\n", N, k ? "SVG" : "PNG", 1e3 * best);
