@@ -873,10 +873,11 @@ static es_status stage_refine(es_embedder *emb, const double *L, double *xyz, in
              * failed twice in a row (the damping has fallen so far that the
              * near-flexes dominate), every try would pay for a failed PCG run
              * and a factorization, so factorize directly from then on */
-            used = have_factor && pcg_fail < pcg_give_up
-                       ? lagged_pcg(emb, emb->H3, emb->L3, emb->B3, hd, step, eta, pcg_max)
-                       : -1;
-            if (have_factor && pcg_fail < pcg_give_up) pcg_fail = used < 0 ? pcg_fail + 1 : 0;
+            used = -1;
+            if (have_factor && pcg_fail < pcg_give_up) {
+                used = lagged_pcg(emb, emb->H3, emb->L3, emb->B3, hd, step, eta, pcg_max);
+                pcg_fail = used < 0 ? pcg_fail + 1 : 0;
+            }
             if (used < 0) {
                 memcpy(emb->B3->x, hd, (size_t)n3 * sizeof(double));
                 emb->B3->ncol = 1;

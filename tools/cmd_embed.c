@@ -60,7 +60,7 @@ int cmd_embed(int argc, char **argv)
     char namebuf[256], path[512], initdesc[512], text[1024];
     double scale = 0, *target = NULL, *xyz = NULL, *init_xyz = NULL, *alpha = NULL, *scales = NULL;
     int c, store_it = 1, paper = 0;
-    int64_t refine_iters = -1;
+    int64_t refine_iters;
     es_ctx *ctx;
     es_store *s = NULL;
     es_mesh *mesh = NULL;
@@ -69,6 +69,7 @@ int cmd_embed(int argc, char **argv)
     es_embed_report rep;
     es_status rc = ES_OK;
     int64_t ne, nv, nrows, initrow = -1, *sel = NULL, nsel = 0;
+    es_embed_opts_init(&opts);
     optind = 1;
     while ((c = getopt_long(argc, argv, "p:o:i:s:n:h", longopts, NULL)) != -1) {
         switch (c) {
@@ -85,6 +86,7 @@ int cmd_embed(int argc, char **argv)
         case 'R':
             if (cli_parse_i64(optarg, &refine_iters) || refine_iters < 0 || refine_iters > 100000)
                 return cli_usage_error("embed", "--refine-iters wants a count >= 0");
+            opts.refine_max_iter = (int)refine_iters;
             break;
         case 'h': fputs(usage, stdout); return CLI_OK;
         default: return cli_usage_error("embed", "bad option");
@@ -197,8 +199,6 @@ have_target:
         goto done;
     }
     if ((rc = es_store_read_positions(ctx, s, initrow, init_xyz))) goto fail;
-    es_embed_opts_init(&opts);
-    if (refine_iters >= 0) opts.refine_max_iter = (int)refine_iters;
     if (paper) {
         opts.dihedral_mode = ES_EMBED_DIHEDRAL_ON;
         opts.refine_max_iter = 0;

@@ -118,7 +118,7 @@ int cmd_interp(int argc, char **argv)
     double w[MAX_IN], t0 = 0, t1 = 1, *xyz[MAX_IN] = {0}, *res = NULL, *len = NULL;
     int64_t steps = 9, rows[MAX_IN], nin = 0, nv, ne;
     int c, store_it = 1;
-    int64_t refine_iters = -1;
+    int64_t refine_iters;
     es_embed_opts opts;
     es_ctx *ctx;
     es_store *s = NULL;
@@ -148,12 +148,12 @@ int cmd_interp(int argc, char **argv)
         case 'R':
             if (cli_parse_i64(optarg, &refine_iters) || refine_iters < 0 || refine_iters > 100000)
                 return cli_usage_error("interp", "--refine-iters wants a count >= 0");
+            opts.refine_max_iter = (int)refine_iters;
             break;
         case 'h': fputs(usage, stdout); return CLI_OK;
         default: return cli_usage_error("interp", "bad option");
         }
     }
-    if (refine_iters >= 0) opts.refine_max_iter = (int)refine_iters;
     if (optind != argc - 1) return cli_usage_error("interp", "give exactly one STORE");
     if (!out) return cli_usage_error("interp", "--output is required");
     if (weights) {
