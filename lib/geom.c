@@ -120,6 +120,21 @@ static void face_normal(const es_mesh *m, const double *xyz, int64_t f, double *
     if (s > 0) { n[0] /= s; n[1] /= s; n[2] /= s; }
 }
 
+double es_bbox_diagonal(int64_t nverts, const double *xyz)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    if (nverts <= 0 || !xyz) return 0.0;
+    for (int64_t v = 0; v < nverts; v++)
+        for (int i = 0; i < 3; i++) {
+            double c = xyz[3 * v + i];
+            if (!isfinite(c)) return NAN;
+            lo[i] = fmin(lo[i], c);
+            hi[i] = fmax(hi[i], c);
+        }
+    return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                (hi[2] - lo[2]) * (hi[2] - lo[2]));
+}
+
 es_status es_dihedral_angles(es_ctx *ctx, const es_mesh *mesh, const double *xyz,
                              double *alpha)
 {

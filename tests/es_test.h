@@ -57,20 +57,6 @@ static inline int es_test_contains(const char *s, const char *needle)
         "with message containing \"%s\"\n", __FILE__, __LINE__, #call, (int)es_rc_, \
         es_m_, (int)(code), (needle) ? (const char *)(needle) : ""); } } while (0)
 
-/* Length of the diagonal of the bounding box of nv points (3 x nv): the
- * scale that geometric tolerances are relative to. */
-static inline double es_test_bbox_diag(int64_t nv, const double *x)
-{
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int64_t v = 0; v < nv; v++)
-        for (int i = 0; i < 3; i++) {
-            lo[i] = fmin(lo[i], x[3 * v + i]);
-            hi[i] = fmax(hi[i], x[3 * v + i]);
-        }
-    return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                (hi[2] - lo[2]) * (hi[2] - lo[2]));
-}
-
 /* Directory of ../shared/data beside the source tree, or NULL if absent
  * (ES_SHARED_DIR is set by tests/meson.build; the environment variable
  * EDGESPACE_SHARED overrides it). */

@@ -137,7 +137,7 @@ static void oracle_case(es_ctx *ctx, const char *dir)
     if (emb) {
         es_embed_opts o;
         es_embed_report r;
-        double md_ = 0, diag = es_test_bbox_diag(nv, etrue ? md.xyz : md.xyz);
+        double md_ = 0, diag = es_bbox_diagonal(nv, etrue ? md.xyz : md.xyz);
         es_embed_opts_init(&o);
         o.dihedral_mode = ES_EMBED_DIHEDRAL_OFF;
         o.refine_max_iter = 0;
@@ -253,7 +253,7 @@ static void roundtrip(es_ctx *ctx, const char *name, tm_mesh tm, int closed)
     }
     int64_t ne = es_mesh_nedges(mesh), nv = tm.nv;
     double *len = malloc((size_t)ne * sizeof *len), *al = malloc((size_t)ne * sizeof *al);
-    double *out = malloc(3 * (size_t)nv * sizeof *out), diag = es_test_bbox_diag(nv, tm.xyz), rms;
+    double *out = malloc(3 * (size_t)nv * sizeof *out), diag = es_bbox_diagonal(nv, tm.xyz), rms;
     es_embed_report r;
     ES_CHECK_OK(ctx, es_edge_lengths(ctx, mesh, tm.xyz, len));
     ES_CHECK_OK(ctx, es_dihedral_angles(ctx, mesh, tm.xyz, al));
@@ -391,7 +391,7 @@ static void test_interp(es_ctx *ctx)
         ES_CHECK_CLOSE(len[5], (0.5 * la[5] / sa + 0.5 * lb[5] / sb) * 0.5 * (sa + sb), 1e-12, 0);
         /* endpoints come back; extrapolation stays finite */
         ES_CHECK_OK(ctx, es_interp_sequence(emb, t.xyz, b, 0.0, 1.2, 3, NULL, out, rs));
-        ES_CHECK(aligned_rms(ctx, t.nv, out, t.xyz) <= 1e-8 * es_test_bbox_diag(t.nv, t.xyz));
+        ES_CHECK(aligned_rms(ctx, t.nv, out, t.xyz) <= 1e-8 * es_bbox_diagonal(t.nv, t.xyz));
         ES_CHECK(rs[0].max_rel < 1e-8);
         ES_CHECK(all_finite(out, 9 * t.nv));
         fprintf(stderr, "torus sequence t = 0, 0.6, 1.2: rms %g %g %g max %g %g %g\n",

@@ -33,7 +33,7 @@ static void trip(es_ctx *ctx, const char *data, const char *file, int closed)
     if (emb) {
         int64_t nv = md.nverts, ne = es_mesh_nedges(mesh);
         double *len = malloc((size_t)ne * sizeof *len), *al = malloc((size_t)ne * sizeof *al);
-        double *out = malloc(3 * (size_t)nv * sizeof *out), diag = es_test_bbox_diag(nv, md.xyz), rms;
+        double *out = malloc(3 * (size_t)nv * sizeof *out), diag = es_bbox_diagonal(nv, md.xyz), rms;
         es_embed_report r;
         es__rng rng;
         ES_CHECK_OK(ctx, es_edge_lengths(ctx, mesh, md.xyz, len));

@@ -366,6 +366,18 @@ static void *null_realloc(void *ud, void *p, size_t n) { (void)ud; (void)p; (voi
 static void plain_free(void *ud, void *p) { (void)ud; free(p); }
 
 /* The only allocation of the module (face normals) fails cleanly. */
+/* The bounding-box diagonal: a box 1 x 2 x 2 has diagonal 3 wherever it
+ * lies; no points give 0, a non-finite coordinate NaN. */
+static void test_bbox_diagonal(void)
+{
+    double box[12] = {5, -1, 2, 6, -1, 2, 5, 1, 4, 5.5, 0, 3};
+    double bad[6] = {0, 0, 0, 1, NAN, 1};
+    ES_CHECK_CLOSE(es_bbox_diagonal(4, box), 3.0, 1e-15, 0);
+    ES_CHECK_CLOSE(es_bbox_diagonal(1, box), 0.0, 0, 0);
+    ES_CHECK(es_bbox_diagonal(0, box) == 0.0);
+    ES_CHECK(isnan(es_bbox_diagonal(2, bad)));
+}
+
 static void test_alloc_failure(es_ctx *ctx)
 {
     es_mesh *m = NULL;
@@ -389,6 +401,7 @@ int main(void)
     test_cube(ctx);
     test_needles(ctx);
     test_oracle(ctx);
+    test_bbox_diagonal();
     test_alloc_failure(ctx);
     es_ctx_free(ctx);
     ES_TEST_END();

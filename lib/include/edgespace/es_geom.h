@@ -36,6 +36,11 @@ ES_API es_status es_lengths_normalize(es_ctx *ctx, int64_t nedges, const double 
 ES_API es_status es_corner_angles(es_ctx *ctx, const es_mesh *mesh, const double *len,
                                   double *angles /* 3 x F */);
 
+/* Length of the diagonal of the axis-aligned bounding box of nverts points
+ * (3 x nverts): the scale geometric tolerances are relative to ("vertex RMS
+ * <= 1e-9 x diagonal"). 0 for no points; not finite if a coordinate is not. */
+ES_API double es_bbox_diagonal(int64_t nverts, const double *xyz);
+
 /* Signed bending angles (convention above) of all edges at positions xyz. */
 ES_API es_status es_dihedral_angles(es_ctx *ctx, const es_mesh *mesh, const double *xyz,
                                     double *alpha /* E */);
