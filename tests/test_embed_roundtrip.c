@@ -2,18 +2,23 @@
  * ../shared/data (skipped when absent): exact lengths and own dihedrals
  * give the mesh back (vertex RMS <= 1e-9 x bounding-box diagonal); with
  * dihedral noise of 0.005 rad the lengths are realized (RMS ratio <= 1e-6)
- * and closed meshes come back (<= 1e-6 x diagonal). At 0.05 rad the issue
- * asks for RMS ratio <= 1e-6: with this seed all three meshes reach 1.5e-7
- * to 8.6e-7 in the default 12 refinement iterations, but other seeds give
- * 5e-7 to 2.8e-6 on five real meshes (a stationary point with a non-zero
- * residual reached from the noisy dihedrals: the full Newton matrix stalls
- * at the same cost, so it is not a slow approach to zero), so 1e-5 is
- * asserted here and the values are printed;
- * the vertex distance is printed too: at 0.05 rad closed meshes come back
- * 3e-5 to 1e-4 x diagonal away, a smooth nearly flexible deformation that
- * keeps every length to 1e-5 (on cactus0 the dihedrals differ by ~0.03 rad
- * over a quarter of the edges; reflecting single vertices through the plane
- * of their neighbours lowers no vertex's share of the cost). Suite slow.
+ * and closed meshes come back (<= 1e-6 x diagonal). With noise of 0.05 rad
+ * the auto rule must finish stage 1 (the trial iteration removes >99 % of
+ * the closure energy), and the RMS ratio is asserted <= 1e-5 and printed:
+ * the issue asks for 1e-6, reached on four of these meshes with this seed
+ * (1.5e-7 to 8.6e-7) but 1.4e-6 on the spacetime face, and 1.6e-7 to
+ * 3.4e-6 over three seeds on six meshes (bench_noisy_roundtrip). The
+ * refinement ends at stationary points with a non-zero residual there: a
+ * dense eigen-decomposition of the full Hessian at the finger's end point
+ * has no negative eigenvalue, so it is a local minimum, not a saddle.
+ * The vertex distance of closed meshes at 0.05 rad (2.6e-5 to 1.3e-4 x
+ * diagonal) is printed, not asserted against the issue's 1e-6: the lengths
+ * do not fix these meshes that well. tools/bench/bench_noisy_roundtrip
+ * finds other realizations of the same lengths (max relative error below
+ * 3e-12) 2.3e-6 x diagonal from cat-01 and 2.8e-6 to 5.5e-6 from cactus0,
+ * reached from 0.005 rad dihedral noise or from the mesh moved by 2e-6 to
+ * 1e-5 x diagonal; even the 0.005 rad bound below holds for this seed, not
+ * for every seed (cactus0 with seed 3 of that program: 1.04e-6). Suite slow.
  */
 #include "es_test.h"
 #include "es_internal.h"
@@ -55,6 +60,10 @@ static void trip(es_ctx *ctx, const char *data, const char *file, int closed)
                     (long long)r.dihedral_iters, (long long)r.refine_iters, r.t_total);
             ES_CHECK_MSG(r.rms_ratio <= (level ? 1e-5 : 1e-6), "%s: noise %g: rms ratio %g", file,
                          sigma, r.rms_ratio);
+            /* incoherent dihedrals: the auto rule must finish stage 1 (one
+             * LM iteration removes >99 % of the closure energy here) */
+            ES_CHECK_MSG(r.dihedral_iters > 1, "%s: noise %g: stage 1 stopped after the trial",
+                         file, sigma);
             if (closed && !level)
                 ES_CHECK_MSG(rms <= 1e-6 * diag, "%s: noise %g: vertex rms %g x diag", file, sigma,
                              rms / diag);
@@ -76,6 +85,7 @@ int main(void)
     trip(ctx, data, "goast_finger/finger0.obj", 1);
     trip(ctx, data, "goast_cactus/cactus0.obj", 1);
     trip(ctx, data, "facecap_arkit/neutral.obj", 0);
+    trip(ctx, data, "goast_spacetime_faces/disgust.obj", 0);
     es_ctx_free(ctx);
     ES_TEST_END();
 }

@@ -56,7 +56,9 @@ typedef enum es_embed_dihedral_mode {
 typedef struct es_embed_opts {
     es_embed_dihedral_mode dihedral_mode;   /* default AUTO: one stage-1 iteration is
                                                tried; stage 1 goes on only if that
-                                               halved the linear stages' edge error */
+                                               halved the linear stages' edge error
+                                               or removed 99 % of the closure energy
+                                               (incoherent, e.g. noisy, dihedrals) */
     int dihedral_max_iter;    /* stage 1 LM iterations; 0 skips stage 1 (default 30) */
     double dihedral_rtol;     /* stage 1 stops when E drops by less than this fraction
                                  per iteration, or E <= dihedral_tol * #interior verts
