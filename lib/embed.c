@@ -1211,9 +1211,12 @@ es_status es_embed_solve(es_embedder *emb, const double *target, double scale,
     ref = init_xyz ? init_xyz : es_mesh_xyz(emb->mesh);
     if (o->align && ref) {
         double r;
-        if ((rc = es_kabsch_align(ctx, nv, xyz, ref, emb->vweight, &r)) != ES_OK) return rc;
+        if ((rc = es_kabsch_align_parts(ctx, nv, xyz, ref, emb->vweight,
+                                        es_mesh_vertex_component(emb->mesh), &r)) != ES_OK)
+            return rc;
         for (int64_t v = 0; v < nv; v++)
-            if (emb->vweight[v] == 0) xyz[3 * v] = xyz[3 * v + 1] = xyz[3 * v + 2] = 0;
+            if (emb->vweight[v] == 0)
+                for (int i = 0; i < 3; i++) xyz[3 * v + i] = ref[3 * v + i];
     }
 
     /* report */

@@ -388,40 +388,74 @@ es_status es_embed_length_error(es_ctx *ctx, const es_mesh *mesh, const double *
 es_status es_kabsch_align(es_ctx *ctx, int64_t nverts, double *xyz, const double *ref,
                           const double *w, double *rms)
 {
-    double ca[3] = {0, 0, 0}, cb[3] = {0, 0, 0}, sw = 0, h[9] = {0}, r[9], ss = 0;
+    return es_kabsch_align_parts(ctx, nverts, xyz, ref, w, NULL, rms);
+}
+
+/* One pass gathers every part's weighted centroids and cross-covariance,
+ * one 3 x 3 SVD per part gives its rotation, one pass moves the vertices:
+ * O(V + parts), so a mesh split into many pieces (seams cut open) costs no
+ * more than one piece. */
+es_status es_kabsch_align_parts(es_ctx *ctx, int64_t nverts, double *xyz, const double *ref,
+                                const double *w, const int64_t *part, double *rms)
+{
+    int64_t np = 1;
+    double *acc, ss = 0;   /* per part: sum w, centroid of xyz (3), of ref (3), h (9), r (9) */
+    enum { SW = 0, CA = 1, CB = 4, H = 7, R = 16, STRIDE = 25 };
     if (nverts <= 0 || !xyz || !ref) ES_FAIL(ctx, ES_EINVAL, "kabsch: empty input");
+    if (part)
+        for (int64_t v = 0; v < nverts; v++)
+            if (part[v] + 1 > np) np = part[v] + 1;
+    acc = es__calloc(ctx, (size_t)np * STRIDE, sizeof *acc);
+    if (!acc) return ES_ENOMEM;
     for (int64_t v = 0; v < nverts; v++) {
-        double wv = w ? w[v] : 1.0;
+        double wv = w ? w[v] : 1.0, *a;
+        if (part && part[v] < 0) continue;
+        a = acc + STRIDE * (part ? part[v] : 0);
+        a[SW] += wv;
         for (int i = 0; i < 3; i++) {
-            ca[i] += wv * xyz[3 * v + i];
-            cb[i] += wv * ref[3 * v + i];
+            a[CA + i] += wv * xyz[3 * v + i];
+            a[CB + i] += wv * ref[3 * v + i];
         }
-        sw += wv;
     }
-    if (!(sw > 0)) ES_FAIL(ctx, ES_EINVAL, "kabsch: weights sum to %g", sw);
-    for (int i = 0; i < 3; i++) {
-        ca[i] /= sw;
-        cb[i] /= sw;
+    if (!part && !(acc[SW] > 0)) {
+        es__free(ctx, acc);
+        ES_FAIL(ctx, ES_EINVAL, "kabsch: weights sum to %g", acc[SW]);
     }
-    /* h = sum w (ref - cb)(xyz - ca)^T; rotation R maximizing tr(R^T h)
+    for (int64_t p = 0; p < np; p++)
+        for (int i = 0; i < 6; i++)
+            if (acc[STRIDE * p + SW] > 0) acc[STRIDE * p + CA + i] /= acc[STRIDE * p + SW];
+    /* h = sum w (ref - cb)(xyz - ca)^T; the rotation R maximizing tr(R^T h)
      * is the polar factor of h (Kabsch 1976). */
     for (int64_t v = 0; v < nverts; v++) {
-        double wv = w ? w[v] : 1.0;
+        double wv = w ? w[v] : 1.0, *a;
+        if (part && part[v] < 0) continue;
+        a = acc + STRIDE * (part ? part[v] : 0);
         for (int i = 0; i < 3; i++)
             for (int j = 0; j < 3; j++)
-                h[3 * i + j] += wv * (ref[3 * v + i] - cb[i]) * (xyz[3 * v + j] - ca[j]);
+                a[H + 3 * i + j] += wv * (ref[3 * v + i] - a[CB + i]) * (xyz[3 * v + j] - a[CA + j]);
     }
-    for (int i = 0; i < 9; i++) r[i] = h[i];
-    if (nearest_rotation_svd(r) != 0) set_identity(r);
+    for (int64_t p = 0; p < np; p++) {
+        double *a = acc + STRIDE * p;
+        for (int i = 0; i < 9; i++) a[R + i] = a[H + i];
+        /* a part with no weight keeps its place (identity, no shift) */
+        if (!(a[SW] > 0) || nearest_rotation_svd(a + R) != 0) set_identity(a + R);
+        if (!(a[SW] > 0))
+            for (int i = 0; i < 3; i++) a[CA + i] = a[CB + i] = 0;
+    }
     for (int64_t v = 0; v < nverts; v++) {
         double p[3], q[3];
-        for (int i = 0; i < 3; i++) p[i] = xyz[3 * v + i] - ca[i];
+        const double *a, *r;
+        if (part && part[v] < 0) continue;
+        a = acc + STRIDE * (part ? part[v] : 0);
+        r = a + R;
+        for (int i = 0; i < 3; i++) p[i] = xyz[3 * v + i] - a[CA + i];
         for (int i = 0; i < 3; i++) {
-            q[i] = r[3 * i] * p[0] + r[3 * i + 1] * p[1] + r[3 * i + 2] * p[2] + cb[i];
+            q[i] = r[3 * i] * p[0] + r[3 * i + 1] * p[1] + r[3 * i + 2] * p[2] + a[CB + i];
             xyz[3 * v + i] = q[i];
             if (!w || w[v] > 0) ss += (q[i] - ref[3 * v + i]) * (q[i] - ref[3 * v + i]);
         }
     }
+    es__free(ctx, acc);
     if (rms) *rms = sqrt(ss / (double)nverts);
     return ES_OK;
 }

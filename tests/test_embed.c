@@ -3,7 +3,8 @@
  * absent) and on meshes made here: closure energy, gradient and per-vertex
  * energies at given dihedrals, the frames-and-positions stages from exact
  * dihedrals, round trips on closed (sphere, torus: genus 1) and open (disc)
- * meshes, interpolation and extrapolation, garbage in.
+ * meshes, a mesh of several pieces, interpolation and extrapolation,
+ * garbage in.
  */
 #include "es_test.h"
 #include "mesh_gen.h"
@@ -343,6 +344,90 @@ static void test_roundtrips(es_ctx *ctx)
     tm_free(&s), tm_free(&t), tm_free(&d);
 }
 
+/* Pieces in one mesh: a bumpy sphere, a torus moved away and turned, and a
+ * vertex in no face. Lengths fix each piece but not where the pieces lie
+ * relative to each other, so the output is aligned piece by piece: the
+ * exact round trip must come back in place without any further alignment,
+ * and the unused vertex where the reference has it. */
+static void test_components(es_ctx *ctx)
+{
+    tm_mesh a = icosphere(2), b = tm_torus(1.0, 0.35, 16, 8);
+    int64_t nv = a.nv + b.nv + 1, nf = a.nf + b.nf;
+    double *xyz = malloc(3 * (size_t)nv * sizeof *xyz), c = cos(0.7), s = sin(0.7);
+    int64_t *faces = malloc(3 * (size_t)nf * sizeof *faces);
+    es_mesh *mesh = NULL;
+    es_embedder *emb = NULL;
+    memcpy(xyz, a.xyz, 3 * (size_t)a.nv * sizeof *xyz);
+    for (int64_t v = 0; v < b.nv; v++) {
+        const double *p = b.xyz + 3 * v;
+        double *q = xyz + 3 * (a.nv + v);
+        q[0] = c * p[0] - s * p[2] + 4.0;
+        q[1] = p[1] - 1.0;
+        q[2] = s * p[0] + c * p[2] + 0.5;
+    }
+    xyz[3 * (nv - 1)] = 7, xyz[3 * (nv - 1) + 1] = -8, xyz[3 * (nv - 1) + 2] = 9;
+    memcpy(faces, a.faces, 3 * (size_t)a.nf * sizeof *faces);
+    for (int64_t i = 0; i < 3 * b.nf; i++) faces[3 * a.nf + i] = b.faces[i] + a.nv;
+    ES_CHECK_OK(ctx, es_mesh_new(ctx, nv, nf, faces, xyz, &mesh));
+    if (mesh) ES_CHECK_OK(ctx, es_embedder_new(ctx, mesh, &emb));
+    if (emb) {
+        int64_t ne = es_mesh_nedges(mesh);
+        double *len = malloc((size_t)ne * sizeof *len), *al = malloc((size_t)ne * sizeof *al);
+        double *out = malloc(3 * (size_t)nv * sizeof *out), d = 0;
+        double diag = es_bbox_diagonal(nv - 1, xyz);
+        es_embed_report r;
+        ES_CHECK_OK(ctx, es_edge_lengths(ctx, mesh, xyz, len));
+        ES_CHECK_OK(ctx, es_dihedral_angles(ctx, mesh, xyz, al));
+        ES_CHECK_OK(ctx, es_embed_solve(emb, len, 0, al, NULL, NULL, out, &r));
+        for (int64_t i = 0; i < 3 * nv; i++) d += (out[i] - xyz[i]) * (out[i] - xyz[i]);
+        ES_CHECK_MSG(sqrt(d / (double)nv) <= 1e-9 * diag, "two pieces: %g x diag off",
+                     sqrt(d / (double)nv) / diag);
+        ES_CHECK(out[3 * (nv - 1)] == 7 && out[3 * (nv - 1) + 1] == -8 &&
+                 out[3 * (nv - 1) + 2] == 9);
+        free(len), free(al), free(out);
+    }
+    es_embedder_free(emb);
+    es_mesh_free(mesh);
+    free(xyz), free(faces);
+    tm_free(&a), tm_free(&b);
+}
+
+/* es_kabsch_align_parts: two parts moved by different rigid motions come
+ * back each onto its reference; a vertex of part -1 stays where it is. */
+static void test_kabsch_parts(es_ctx *ctx)
+{
+    double ref[18] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 5, 5, 5, 6, 5, 5, 5, 7, 6};
+    double x[18], rms, c = cos(1.1), s = sin(1.1);
+    int64_t part[6] = {0, 0, 0, 1, 1, -1};
+    for (int v = 0; v < 6; v++) {
+        const double *p = ref + 3 * v;
+        if (v < 3) {   /* part 0: turned about z, shifted */
+            x[3 * v] = c * p[0] - s * p[1] + 2, x[3 * v + 1] = s * p[0] + c * p[1] - 1;
+            x[3 * v + 2] = p[2] + 3;
+        } else {       /* part 1 and the free vertex: turned about x */
+            x[3 * v] = p[0] - 9, x[3 * v + 1] = c * p[1] - s * p[2];
+            x[3 * v + 2] = s * p[1] + c * p[2];
+        }
+    }
+    {
+        double keep[3] = {x[15], x[16], x[17]};
+        part[5] = 1;   /* first: the free vertex as part of part 1 (3 points fix it) */
+        ES_CHECK_OK(ctx, es_kabsch_align_parts(ctx, 6, x, ref, NULL, part, &rms));
+        ES_CHECK(rms < 1e-14);
+        for (int i = 0; i < 18; i++) ES_CHECK_CLOSE(x[i], ref[i], 0, 1e-14);
+        /* again from the moved positions with vertex 5 in no part */
+        x[15] = keep[0], x[16] = keep[1], x[17] = keep[2];
+        part[5] = -1;
+        for (int v = 0; v < 5; v++)
+            for (int i = 0; i < 3; i++) x[3 * v + i] += 0.5;
+        ES_CHECK_OK(ctx, es_kabsch_align_parts(ctx, 6, x, ref, NULL, part, NULL));
+        for (int i = 0; i < 15; i++) ES_CHECK_CLOSE(x[i], ref[i], 0, 1e-14);
+        ES_CHECK(x[15] == keep[0] && x[16] == keep[1] && x[17] == keep[2]);
+    }
+    ES_CHECK_FAILS(ctx, es_kabsch_align_parts(ctx, 0, x, ref, NULL, part, NULL), ES_EINVAL,
+                   "empty");
+}
+
 /* ---- interpolation ------------------------------------------------------ */
 
 /* Bend a torus-like tube: rotate points about the y axis by an angle that
@@ -494,6 +579,8 @@ int main(void)
     if (getenv("ES_TEST_VERBOSE")) es_ctx_set_log(ctx, log_stderr, NULL);
     test_oracle(ctx);
     test_roundtrips(ctx);
+    test_components(ctx);
+    test_kabsch_parts(ctx);
     test_interp(ctx);
     test_garbage(ctx);
     es_ctx_free(ctx);

@@ -80,7 +80,11 @@ typedef struct es_embed_opts {
                                  result by max relative edge error (default 0) */
     int align;                /* 1: rigidly align (Kabsch, proper rotation) the output to
                                  the initial positions, else to the mesh's reference
-                                 positions if it has them (default 1) */
+                                 positions if it has them (default 1); each connected
+                                 component separately (lengths do not fix where the
+                                 components lie relative to each other), and vertices in
+                                 no face are put where the reference has them. Not
+                                 aligned: those vertices are at the origin */
     double bad_face_rtol;     /* triangle-inequality tolerance of the report (1e-12) */
     double realized_rtol;     /* report.realized = max relative error <= this (1e-2) */
     int verbose;              /* 1: one note per iteration to the log callback (0) */
@@ -163,6 +167,15 @@ ES_API es_status es_embed_length_error(es_ctx *ctx, const es_mesh *mesh, const d
  * weight 0 (w NULL: all 1) do not count. *rms gets the RMS distance after. */
 ES_API es_status es_kabsch_align(es_ctx *ctx, int64_t nverts, double *xyz, const double *ref,
                                  const double *w, double *rms);
+
+/* The same for each part separately: part[v] (0-based; < 0: vertex left
+ * where it is) names the rigid piece vertex v belongs to, e.g. the
+ * connected components of es_mesh_vertex_component, whose relative
+ * placement edge lengths do not fix. part NULL: one piece. A part whose
+ * weights sum to 0 is left where it is. */
+ES_API es_status es_kabsch_align_parts(es_ctx *ctx, int64_t nverts, double *xyz,
+                                       const double *ref, const double *w, const int64_t *part,
+                                       double *rms);
 
 /* ---- with a store (lib/embed_store.c) --------------------------------
  * One-line and multi-line text of a report (for commands and notebooks):
