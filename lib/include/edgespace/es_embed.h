@@ -47,18 +47,15 @@ extern "C" {
 typedef struct es_embedder es_embedder;
 
 typedef enum es_embed_dihedral_mode {
-    ES_EMBED_DIHEDRAL_AUTO = 0, /* stages 2-3 from the initial and from the stage-1
-                                   dihedrals; refine the one with smaller edge error */
+    ES_EMBED_DIHEDRAL_AUTO = 0, /* one stage-1 iteration decides: stage 1 goes on if it
+                                   removed 99 % of the closure energy (incoherent, e.g.
+                                   noisy, dihedrals), else its dihedrals are dropped */
     ES_EMBED_DIHEDRAL_ON,       /* always stage 1 (the paper) */
     ES_EMBED_DIHEDRAL_OFF       /* skip stage 1: stages 2-3 from the initial dihedrals */
 } es_embed_dihedral_mode;
 
 typedef struct es_embed_opts {
-    es_embed_dihedral_mode dihedral_mode;   /* default AUTO: one stage-1 iteration is
-                                               tried; stage 1 goes on only if that
-                                               halved the linear stages' edge error
-                                               or removed 99 % of the closure energy
-                                               (incoherent, e.g. noisy, dihedrals) */
+    es_embed_dihedral_mode dihedral_mode;   /* default AUTO (see above) */
     int dihedral_max_iter;    /* stage 1 LM iterations; 0 skips stage 1 (default 30) */
     double dihedral_rtol;     /* stage 1 stops when E drops by less than this fraction
                                  per iteration, or E <= dihedral_tol * #interior verts
@@ -97,7 +94,7 @@ typedef struct es_embed_report {
     double closure_after;     /* E at the output mesh's dihedrals, target corner angles */
     double closure_stage1;    /* E after stage 1 */
     int64_t dihedral_iters;   /* stage 1 LM iterations (AUTO: 1 first, the rest only
-                                 if stage 1 improves the linear reconstruction) */
+                                 if that one removed 99 % of the closure energy) */
     int64_t refine_iters;     /* stage 4 LM iterations (all continuation steps) */
     int64_t continuation_steps; /* steps used (0: dihedral path) */
     int used_continuation;    /* 1 if the returned result came from continuation */
