@@ -10,6 +10,10 @@
  * includes waiting for a core.
  *
  *   bench_embed [max_vertices]      (default 60000; data from ../shared/data)
+ *   bench_embed sweep               time and error of the face-study midpoint
+ *                                   and the 54K face against the number of
+ *                                   refinement iterations (the trade-off
+ *                                   behind --refine-iters)
  */
 #include <edgespace/edgespace.h>
 
@@ -36,6 +40,28 @@ static void print_row(const char *dir, const char *what, int64_t nv, double wall
         printf("%8.4f%% %7.3f%%", 100 * r->rms_ratio, 100 * r->max_rel);
     printf("  %9.3g %9.3g  %s\n", r->closure_before, r->closure_after,
            r->used_stage1 ? "stage1" : "-");
+}
+
+static int sweep_mode;
+
+/* The midpoint at 0, 1, 2, ... refinement iterations (sweep mode). */
+static void sweep(es_embedder *emb, int64_t nv, const double *const *in, double *out,
+                  const char *dir, double setup)
+{
+    static const int iters[] = {0, 1, 2, 3, 4, 6, 8, 12, 20, 40};
+    double w[2] = {0.5, 0.5};
+    for (size_t i = 0; i < sizeof iters / sizeof iters[0]; i++) {
+        es_embed_opts o;
+        es_embed_report r;
+        char what[32];
+        double w0 = bench_wall_s(), c0 = bench_process_cpu_s();
+        es_embed_opts_init(&o);
+        o.refine_max_iter = iters[i];
+        if (es_interp_embed(emb, 2, in, w, NULL, &o, out, &r, NULL)) return;
+        snprintf(what, sizeof what, "refine %d", iters[i]);
+        print_row(dir, what, nv, bench_wall_s() - w0, bench_process_cpu_s() - c0, setup, &r, 0);
+        fflush(stdout);
+    }
 }
 
 static void run(es_ctx *ctx, const char *dir, const char *a, const char *b, int levels,
@@ -90,6 +116,11 @@ static void run(es_ctx *ctx, const char *dir, const char *a, const char *b, int 
         double *len = malloc((size_t)ne * sizeof *len), *al = malloc((size_t)ne * sizeof *al);
         es_embed_report r;
         es_embed_opts paper;
+        if (sweep_mode) {
+            sweep(emb, nv, in, out, dir, tw_new);
+            free(out), free(len), free(al);
+            goto done;
+        }
         /* midpoint */
         w0 = bench_wall_s();
         c0 = bench_process_cpu_s();
@@ -133,10 +164,18 @@ int main(int argc, char **argv)
 {
     es_ctx *ctx;
     int64_t vmax = argc > 1 ? atoll(argv[1]) : 60000;
+    sweep_mode = argc > 1 && strcmp(argv[1], "sweep") == 0;
+    if (sweep_mode) vmax = 60000;
     if (es_ctx_new(&ctx)) return 1;
     printf("# %-20s %-19s %7s  %6s %6s  %6s %6s %6s %6s  %9s %8s  %9s %9s\n", "mesh", "case", "V",
            "wall", "cpu", "dih", "lin", "refine", "setup", "rms", "max", "E before", "E after");
     printf("# times in s; dih/lin/refine: wall per stage; setup: embedder_new (analysis)\n");
+    if (sweep_mode) {
+        run(ctx, "face-study", "s001_neutral", "s001_happy", 0, vmax);
+        run(ctx, "sfm_surrey_face_3448", "mean_neutral", "expr_happiness", 2, vmax);
+        es_ctx_free(ctx);
+        return 0;
+    }
     run(ctx, "facecap_arkit", "anim_000", "anim_100", 0, vmax);
     run(ctx, "sfm_surrey_face_3448", "mean_neutral", "expr_happiness", 0, vmax);
     run(ctx, "goast_cactus", "cactus0", "cactus1", 0, vmax);
