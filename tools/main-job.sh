@@ -30,4 +30,5 @@ fi
 # shellcheck disable=SC2086
 OPENBLAS_NUM_THREADS=${OPENBLAS_NUM_THREADS:-1} "$nb" --out "$out" ${NOTEBOOK_ARGS:-}
 echo
-echo "Report: $here/$out/report.md (figures and CSV files beside it, run.json for the run)"
+case "$out" in /*) report="$out/report.md" ;; *) report="$here/$out/report.md" ;; esac
+echo "Report: $report (figures and CSV files beside it, run.json for the run)"
