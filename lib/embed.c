@@ -69,6 +69,7 @@ void es_embed_opts_init(es_embed_opts *o)
     o->bad_face_rtol = 1e-12;
     o->realized_rtol = 1e-2;
     o->verbose = 0;
+    o->blas_threads = 1;
 }
 
 static double now_s(void)
@@ -1071,9 +1072,9 @@ static es_status linear_stages(es_embedder *emb, const double *alpha, const doub
     return ES_OK;
 }
 
-es_status es_embed_solve(es_embedder *emb, const double *target, double scale,
-                         const double *init_alpha, const double *init_xyz,
-                         const es_embed_opts *opts, double *xyz, es_embed_report *report)
+static es_status embed_solve(es_embedder *emb, const double *target, double scale,
+                             const double *init_alpha, const double *init_xyz,
+                             const es_embed_opts *opts, double *xyz, es_embed_report *report)
 {
     es_ctx *ctx;
     es_embed_opts dflt;
@@ -1252,4 +1253,39 @@ es_status es_embed_solve(es_embedder *emb, const double *target, double scale,
     rep.t_total = now_s() - t0;
     if (report) *report = rep;
     return ES_OK;
+}
+
+/* The BLAS work of an embedding is many small dense blocks (the supernodes
+ * of a surface mesh's factor). Threaded OpenBLAS made whole midpoint
+ * embeddings 25-33 % slower with 2 threads than with 1 on this project's
+ * 2-core machine (9.4K, 13.6K and 54K vertices; OMP_NUM_THREADS=1 too), so
+ * the solve runs with opts->blas_threads threads and restores the caller's
+ * setting. OpenBLAS's setter is a weak symbol: with another BLAS the
+ * setting is left alone. */
+#if defined(__GNUC__)
+extern void openblas_set_num_threads(int n) __attribute__((weak));
+extern int openblas_get_num_threads(void) __attribute__((weak));
+#define ES_HAVE_BLAS_THREADS 1
+#endif
+
+es_status es_embed_solve(es_embedder *emb, const double *target, double scale,
+                         const double *init_alpha, const double *init_xyz,
+                         const es_embed_opts *opts, double *xyz, es_embed_report *report)
+{
+    es_status rc;
+    int want = opts ? opts->blas_threads : 1, had = 0;
+#ifdef ES_HAVE_BLAS_THREADS
+    if (want > 0 && openblas_set_num_threads && openblas_get_num_threads) {
+        had = openblas_get_num_threads();
+        if (had != want) openblas_set_num_threads(want);
+        else had = 0;
+    }
+#endif
+    rc = embed_solve(emb, target, scale, init_alpha, init_xyz, opts, xyz, report);
+#ifdef ES_HAVE_BLAS_THREADS
+    if (had > 0) openblas_set_num_threads(had);
+#endif
+    (void)want;
+    (void)had;
+    return rc;
 }

@@ -428,6 +428,47 @@ static void test_kabsch_parts(es_ctx *ctx)
                    "empty");
 }
 
+/* The solve runs with opts.blas_threads OpenBLAS threads and gives the
+ * caller's setting back (weak symbols: skipped with another BLAS). */
+#if defined(__GNUC__)
+extern void openblas_set_num_threads(int n) __attribute__((weak));
+extern int openblas_get_num_threads(void) __attribute__((weak));
+#endif
+static void test_blas_threads(es_ctx *ctx)
+{
+#if defined(__GNUC__)
+    tm_mesh s = icosphere(1);
+    es_mesh *mesh = NULL;
+    es_embedder *emb = NULL;
+    if (!openblas_set_num_threads || !openblas_get_num_threads) {
+        tm_free(&s);
+        return;
+    }
+    ES_CHECK_OK(ctx, es_mesh_new(ctx, s.nv, s.nf, s.faces, s.xyz, &mesh));
+    if (mesh) ES_CHECK_OK(ctx, es_embedder_new(ctx, mesh, &emb));
+    if (emb) {
+        int64_t ne = es_mesh_nedges(mesh);
+        double *len = malloc((size_t)ne * sizeof *len), *al = malloc((size_t)ne * sizeof *al);
+        double *out = malloc(3 * (size_t)s.nv * sizeof *out);
+        int before = openblas_get_num_threads();
+        ES_CHECK_OK(ctx, es_edge_lengths(ctx, mesh, s.xyz, len));
+        ES_CHECK_OK(ctx, es_dihedral_angles(ctx, mesh, s.xyz, al));
+        int set;
+        openblas_set_num_threads(2);
+        set = openblas_get_num_threads();   /* 1 where OpenBLAS caps it on one core */
+        ES_CHECK_OK(ctx, es_embed_solve(emb, len, 0, al, NULL, NULL, out, NULL));
+        ES_CHECK(openblas_get_num_threads() == set);
+        openblas_set_num_threads(before);
+        free(len), free(al), free(out);
+    }
+    es_embedder_free(emb);
+    es_mesh_free(mesh);
+    tm_free(&s);
+#else
+    (void)ctx;
+#endif
+}
+
 /* ---- interpolation ------------------------------------------------------ */
 
 /* Bend a torus-like tube: rotate points about the y axis by an angle that
@@ -581,6 +622,7 @@ int main(void)
     test_roundtrips(ctx);
     test_components(ctx);
     test_kabsch_parts(ctx);
+    test_blas_threads(ctx);
     test_interp(ctx);
     test_garbage(ctx);
     es_ctx_free(ctx);
