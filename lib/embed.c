@@ -1162,15 +1162,14 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
                 return rc;
             rep.used_stage1 = 1;
             if (mode == ES_EMBED_DIHEDRAL_AUTO) {
-                if (first < o->dihedral_max_iter &&
-                    rep.closure_stage1 < 0.01 * rep.closure_before) {
-                    if ((rc = stage_dihedrals(emb, o, o->dihedral_max_iter - first, alpha,
-                                              &rep.closure_stage1, &rep.dihedral_iters,
-                                              &lambda1)) != ES_OK)
-                        return rc;
-                } else {
+                if (!(rep.closure_stage1 < 0.01 * rep.closure_before)) {
                     memcpy(alpha, emb->alpha_keep, (size_t)ne * sizeof *alpha);
                     rep.used_stage1 = 0;
+                } else if (first < o->dihedral_max_iter &&
+                           (rc = stage_dihedrals(emb, o, o->dihedral_max_iter - first, alpha,
+                                                 &rep.closure_stage1, &rep.dihedral_iters,
+                                                 &lambda1)) != ES_OK) {
+                    return rc;
                 }
             }
             rep.t_dihedral = now_s() - t1;

@@ -289,6 +289,17 @@ static void roundtrip(es_ctx *ctx, const char *name, tm_mesh tm, int closed)
                      r.rms_ratio, r.max_rel);
         ES_CHECK(r.closure_before > r.closure_after);
         ES_CHECK(all_finite(out, 3 * nv));
+        /* incoherent dihedrals: auto mode keeps stage 1, also when it may
+         * take only the one iteration that decides */
+        ES_CHECK_MSG(r.used_stage1 && r.dihedral_iters > 1, "%s: stage 1 dropped on noise", name);
+        {
+            es_embed_opts one;
+            es_embed_opts_init(&one);
+            one.dihedral_max_iter = 1;
+            ES_CHECK_OK(ctx, es_embed_solve(emb, len, 0, al, NULL, &one, out, &r));
+            ES_CHECK_MSG(r.used_stage1 && r.dihedral_iters == 1, "%s: max 1 iteration: used %d, "
+                         "%lld iterations", name, r.used_stage1, (long long)r.dihedral_iters);
+        }
     }
     /* scale: embedding at scale s gives edge lengths summing to s */
     ES_CHECK_OK(ctx, es_embed_solve(emb, len, 3.5, NULL, tm.xyz, NULL, out, &r));
