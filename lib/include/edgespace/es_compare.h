@@ -131,7 +131,7 @@ ES_API es_status es_compare_write(es_ctx *ctx, const es_compare_result *res,
  * /analysis/compare/<name> (name NULL: gpa_name) with provenance: datasets
  * d_lengths, d_procrustes (n x n), group_means_lengths/_procrustes and
  * p_lengths/_procrustes (g x g), group_names, attributes spearman_rho,
- * mantel_p, nn_agreement, permutations, by, gpa. out_dir (or NULL) gets
+ * mantel_p, nn_agreement, by, gpa (permutations in @params). out_dir (or NULL) gets
  * es_compare_write's files (figures if `figures`). ES_ENOTFOUND if the GPA
  * result or the column is missing; ES_EINVAL for a store without edges. The
  * store must be open for writing if name is not "" (name "": nothing is
