@@ -357,7 +357,22 @@ es_status es_embedder_new(es_ctx *ctx, const es_mesh *mesh, es_embedder **out)
         if (rc == ES_OK) rc = ES_ENOMEM;
         goto fail;
     }
-    emb->L3 = cholmod_l_analyze(emb->H3, &emb->cm);
+    /* The position matrix H3 is factorized once per refinement iteration.
+     * On larger meshes, with the supernodes above, CHOLMOD's nested
+     * dissection (NESDIS) orders it better than AMD: 11-22 % faster
+     * embeddings at 14K-54K vertices, for 0.1-0.35 s more analysis (once
+     * per topology); below 10K vertices the analysis costs more than a
+     * single embedding gains. H1 and HA keep the default ordering. */
+    {
+        int nmethods = emb->cm.nmethods, ordering = emb->cm.method[0].ordering;
+        if (emb->nv >= 10000) {
+            emb->cm.nmethods = 1;
+            emb->cm.method[0].ordering = CHOLMOD_NESDIS;
+        }
+        emb->L3 = cholmod_l_analyze(emb->H3, &emb->cm);
+        emb->cm.nmethods = nmethods;
+        emb->cm.method[0].ordering = ordering;
+    }
     emb->L1 = cholmod_l_analyze(emb->H1, &emb->cm);
     if (!emb->L3 || !emb->L1) {
         rc = cm_check(emb, "analyze");
