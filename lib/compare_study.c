@@ -12,6 +12,7 @@
  */
 #include "es_internal.h"
 #include "edgespace/es_compare.h"
+#include "edgespace/es_io.h"
 #include "edgespace/es_plot.h"
 
 #include <errno.h>
@@ -142,21 +143,6 @@ static es_status out_close(es_ctx *ctx, outfile *o)
     return ES_OK;
 }
 
-/* A CSV field: quoted when it holds a comma, quote or newline. */
-static void put_field(FILE *f, const char *s)
-{
-    if (!strpbrk(s, ",\"\n\r")) {
-        fputs(s, f);
-        return;
-    }
-    fputc('"', f);
-    for (; *s; s++) {
-        if (*s == '"') fputc('"', f);
-        fputc(*s, f);
-    }
-    fputc('"', f);
-}
-
 typedef struct names {
     const char *const *s;
     char buf[32];
@@ -207,11 +193,11 @@ static es_status write_matrix(es_ctx *ctx, const char *dir, const char *file, in
     fputs("id", o.f);
     for (int64_t j = 0; j < n; j++) {
         fputc(',', o.f);
-        put_field(o.f, name_of(&nm, j));
+        es_csv_write_field(o.f, name_of(&nm, j));
     }
     fputc('\n', o.f);
     for (int64_t i = 0; i < n; i++) {
-        put_field(o.f, name_of(&nm, i));
+        es_csv_write_field(o.f, name_of(&nm, i));
         for (int64_t j = 0; j < n; j++) fprintf(o.f, ",%.17g", d[i + j * n]);
         fputc('\n', o.f);
     }
@@ -320,9 +306,9 @@ es_status es_compare_write(es_ctx *ctx, const es_compare_result *r, const char *
     for (int64_t j = 1; j < n; j++)
         for (int64_t i = 0; i < j; i++) {
             fprintf(o.f, "%lld,%lld,", (long long)i + 1, (long long)j + 1);
-            put_field(o.f, name_of(&a, i));
+            es_csv_write_field(o.f, name_of(&a, i));
             fputc(',', o.f);
-            put_field(o.f, name_of(&b, j));
+            es_csv_write_field(o.f, name_of(&b, j));
             int64_t t = j * (j - 1) / 2 + i;
             fprintf(o.f, ",%.17g,%.17g,%lld,%lld", r->d_len[i + j * n], r->d_proc[i + j * n],
                     (long long)rank[t], (long long)rank[m + t]);
@@ -334,7 +320,7 @@ es_status es_compare_write(es_ctx *ctx, const es_compare_result *r, const char *
                 const char *y = name_of(&gb, group[j]);
                 char *pl = pair_label(ctx, xa, y);
                 if (!pl) { fclose(o.f); es__free(ctx, rank); return ES_ENOMEM; }
-                put_field(o.f, pl);
+                es_csv_write_field(o.f, pl);
                 es__free(ctx, pl);
             }
             fputc('\n', o.f);
@@ -357,11 +343,11 @@ es_status es_compare_write(es_ctx *ctx, const es_compare_result *r, const char *
     if ((rc = out_open(ctx, &o, dir, "nearest.csv")) != ES_OK) return rc;
     fputs("id,nearest_lengths,nearest_procrustes,agree\n", o.f);
     for (int64_t i = 0; i < n; i++) {
-        put_field(o.f, name_of(&a, i));
+        es_csv_write_field(o.f, name_of(&a, i));
         fputc(',', o.f);
-        put_field(o.f, name_of(&a, r->nn_len[i]));
+        es_csv_write_field(o.f, name_of(&a, r->nn_len[i]));
         fputc(',', o.f);
-        put_field(o.f, name_of(&a, r->nn_proc[i]));
+        es_csv_write_field(o.f, name_of(&a, r->nn_proc[i]));
         fprintf(o.f, ",%d\n", r->nn_len[i] == r->nn_proc[i]);
     }
     if ((rc = out_close(ctx, &o)) != ES_OK) return rc;
@@ -370,9 +356,9 @@ es_status es_compare_write(es_ctx *ctx, const es_compare_result *r, const char *
     fputs("id_i,id_j,d_lengths,d_procrustes,rank_difference\n", o.f);
     for (int64_t q = 0; q < r->ntop; q++) {
         int64_t i = r->top_pairs[2 * q], j = r->top_pairs[2 * q + 1];
-        put_field(o.f, name_of(&a, i));
+        es_csv_write_field(o.f, name_of(&a, i));
         fputc(',', o.f);
-        put_field(o.f, name_of(&a, j));
+        es_csv_write_field(o.f, name_of(&a, j));
         fprintf(o.f, ",%.17g,%.17g,%.17g\n", r->d_len[i + j * n], r->d_proc[i + j * n],
                 r->top_diff[q]);
     }
@@ -388,9 +374,9 @@ es_status es_compare_write(es_ctx *ctx, const es_compare_result *r, const char *
                     const double *md = q ? r->mean_proc : r->mean_len;
                     const double *pv = q ? r->p_proc : r->p_len;
                     fputs(q ? "procrustes," : "lengths,", o.f);
-                    put_field(o.f, name_of(&ga, x));
+                    es_csv_write_field(o.f, name_of(&ga, x));
                     fputc(',', o.f);
-                    put_field(o.f, name_of(&gb, c));
+                    es_csv_write_field(o.f, name_of(&gb, c));
                     fprintf(o.f, ",%.17g,%.17g\n", md[x + c * g], pv[x + c * g]);
                 }
         if ((rc = out_close(ctx, &o)) != ES_OK) return rc;

@@ -12,6 +12,21 @@
 #include <stdlib.h>
 #include <sys/stat.h>
 
+void es_csv_write_field(FILE *f, const char *s)
+{
+    if (!s) s = "";
+    if (!strpbrk(s, ",\"\r\n")) {
+        fputs(s, f);
+        return;
+    }
+    fputc('"', f);
+    for (; *s; s++) {
+        if (*s == '"') fputc('"', f);
+        fputc(*s, f);
+    }
+    fputc('"', f);
+}
+
 /* rows/nrows as given, or all rows (allocated into *own). */
 static es_status row_list(es_ctx *ctx, es_store *s, const int64_t *rows, int64_t nrows,
                           const int64_t **out, int64_t *n, int64_t **own)
@@ -69,17 +84,7 @@ es_status es_export_lengths_csv(es_ctx *ctx, es_store *s, const int64_t *rows, i
         double sc = scales[list[j]];
         es__progress(ctx, "exporting lengths", j, n);
         if ((rc = es_store_read_lengths(ctx, s, list[j], 1, m))) goto done;
-        /* ids are free text: quote them the RFC 4180 way when needed */
-        if (strpbrk(id, ",\"\r\n")) {
-            fputc('"', f);
-            for (const char *p = id; *p; p++) {
-                if (*p == '"') fputc('"', f);
-                fputc(*p, f);
-            }
-            fputc('"', f);
-        } else {
-            fputs(id, f);
-        }
+        es_csv_write_field(f, id);
         fprintf(f, ",%.17g", sc);
         for (int64_t e = 0; e < E; e++) fprintf(f, ",%.17g", raw ? sc * len[e] : len[e]);
         fputc('\n', f);

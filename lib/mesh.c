@@ -317,14 +317,20 @@ static uint64_t fnv_i64(uint64_t h, int64_t x)
     return h;
 }
 
-void es_faces_fingerprint(int64_t nverts, int64_t nfaces, const int64_t *faces, char out[17])
+void es__fingerprint_i64(const int64_t *head, int nhead, const int64_t *vals, int64_t nvals,
+                         char out[17])
 {
     static const char hex[] = "0123456789abcdef";
     uint64_t h = UINT64_C(0xcbf29ce484222325);
-    h = fnv_i64(h, nverts);
-    for (int64_t i = 0; i < 3 * nfaces; i++) h = fnv_i64(h, faces[i]);
+    for (int i = 0; i < nhead; i++) h = fnv_i64(h, head[i]);
+    for (int64_t i = 0; i < nvals; i++) h = fnv_i64(h, vals[i]);
     for (int i = 0; i < 16; i++) out[i] = hex[(h >> (60 - 4 * i)) & 0xfu];
     out[16] = '\0';
+}
+
+void es_faces_fingerprint(int64_t nverts, int64_t nfaces, const int64_t *faces, char out[17])
+{
+    es__fingerprint_i64(&nverts, 1, faces, 3 * nfaces, out);
 }
 
 void es_mesh_fingerprint(const es_mesh *m, char out[17])

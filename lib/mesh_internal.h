@@ -35,6 +35,12 @@ struct es_mesh {
  * check. Needs faces, edges, face_edges, edge_faces and the boundary flags. */
 es_status es__mesh_build_stars(es_ctx *ctx, es_mesh *m);
 
+/* FNV-1a 64 over the little-endian bytes of head[0..nhead) then
+ * vals[0..nvals), as 16 lowercase hex digits plus NUL: the fingerprint of
+ * face lists (es_faces_fingerprint) and of edge-only stores. */
+void es__fingerprint_i64(const int64_t *head, int nhead, const int64_t *vals, int64_t nvals,
+                         char out[17]);
+
 /* Stage 3 (mesh_boundary.c): boundary loops, components, Euler
  * characteristic and genus. Needs the stars. */
 es_status es__mesh_build_boundary(es_ctx *ctx, es_mesh *m);

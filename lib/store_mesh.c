@@ -5,6 +5,7 @@
  * only. */
 #include "es_internal.h"
 #include "edgespace/es_mesh.h"
+#include "mesh_internal.h"
 #include "store_internal.h"
 
 es_status es_store_create(es_ctx *ctx, const char *path, const es_mesh *mesh, es_store **out)
@@ -28,21 +29,9 @@ const char *es_topology_kind_name(es_topology_kind kind)
     return "?";
 }
 
-/* FNV-1a 64 over little-endian int64 values, as es_faces_fingerprint. */
-static uint64_t fnv_i64(uint64_t h, int64_t x)
-{
-    uint64_t u = (uint64_t)x;
-    for (int i = 0; i < 8; i++) {
-        h ^= (u >> (8 * i)) & 0xffu;
-        h *= UINT64_C(0x100000001b3);
-    }
-    return h;
-}
-
 es_status es_store_create_edges(es_ctx *ctx, const char *path, int64_t nverts, int64_t nedges,
                                 const int64_t *edges, es_store **out)
 {
-    static const char hex[] = "0123456789abcdef";
     char fp[17];
     *out = NULL;
     if (nedges < 0 || (nedges > 0 && !edges))
@@ -50,11 +39,8 @@ es_status es_store_create_edges(es_ctx *ctx, const char *path, int64_t nverts, i
     if (nedges == 0) {
         es_faces_fingerprint(nverts, 0, NULL, fp);
     } else {
-        uint64_t h = UINT64_C(0xcbf29ce484222325);
-        h = fnv_i64(fnv_i64(h, nverts), nedges);
-        for (int64_t i = 0; i < 2 * nedges; i++) h = fnv_i64(h, edges[i]);
-        for (int i = 0; i < 16; i++) fp[i] = hex[(h >> (60 - 4 * i)) & 0xfu];
-        fp[16] = '\0';
+        const int64_t head[2] = {nverts, nedges};
+        es__fingerprint_i64(head, 2, edges, 2 * nedges, fp);
     }
     return es__store_create_raw(ctx, path, nverts, 0, NULL, nedges, edges, fp, out);
 }

@@ -9,6 +9,7 @@
  * is built just to write files.
  */
 #include "synth_internal.h"
+#include "edgespace/es_io.h"
 #include "edgespace/es_mesh.h"
 #include "mesh_io_internal.h"
 
@@ -214,21 +215,6 @@ es_status es_synth_subdivide(es_ctx *ctx, es_synth_set *s, int levels)
 
 /* ---- output ---- */
 
-/* A CSV field, quoted when it holds a comma, quote or newline (RFC 4180). */
-static void csv_field(FILE *fp, const char *s)
-{
-    if (!strpbrk(s, ",\"\n\r")) {
-        fputs(s, fp);
-        return;
-    }
-    fputc('"', fp);
-    for (; *s; s++) {
-        if (*s == '"') fputc('"', fp);
-        fputc(*s, fp);
-    }
-    fputc('"', fp);
-}
-
 /* mkdir -p: create each missing component of dir. */
 static es_status make_dirs(es_ctx *ctx, const char *dir)
 {
@@ -272,14 +258,14 @@ es_status es_synth_write(es_ctx *ctx, const es_synth_set *s, const char *dir)
     fputs("file", fp);
     for (int64_t j = 0; j < s->nlabels; j++) {
         fputc(',', fp);
-        csv_field(fp, s->label_names[j]);
+        es_csv_write_field(fp, s->label_names[j]);
     }
     fputc('\n', fp);
     for (int64_t i = 0; i < s->nmembers; i++) {
         fprintf(fp, "%s.obj", s->names[i]);
         for (int64_t j = 0; j < s->nlabels; j++) {
             fputc(',', fp);
-            csv_field(fp, s->labels[i * s->nlabels + j]);
+            es_csv_write_field(fp, s->labels[i * s->nlabels + j]);
         }
         fputc('\n', fp);
     }

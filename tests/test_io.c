@@ -711,6 +711,26 @@ static void test_shared(es_ctx *ctx)
     for (int i = 0; i < n; i++) free(names[i]);
 }
 
+/* CSV fields: plain text as is, quoted (quotes doubled) when it holds a
+ * comma, quote or line break, NULL as empty. */
+static void test_csv_field(void)
+{
+    static const char *in[] = {"s01", "a,b", "say \"hi\"", "two\nlines", "", NULL};
+    static const char *want = "s01|\"a,b\"|\"say \"\"hi\"\"\"|\"two\nlines\"||";
+    char buf[128] = {0};
+    FILE *f = tmpfile();
+    ES_CHECK(f != NULL);
+    if (!f) return;
+    for (size_t i = 0; i < sizeof in / sizeof in[0]; i++) {
+        if (i) fputc('|', f);
+        es_csv_write_field(f, in[i]);
+    }
+    rewind(f);
+    ES_CHECK(fread(buf, 1, sizeof buf - 1, f) == strlen(want));
+    ES_CHECK_MSG(strcmp(buf, want) == 0, "csv fields: got [%s]", buf);
+    fclose(f);
+}
+
 int main(void)
 {
     es_ctx *ctx;
@@ -718,6 +738,7 @@ int main(void)
     if (es_ctx_new(&ctx) != ES_OK) return 1;
     es_ctx_set_log(ctx, count_log, NULL);
     test_numbers();
+    test_csv_field();
     test_syntax(ctx);
     test_round_trips(ctx);
     test_malformed(ctx);

@@ -26,17 +26,7 @@ int stats_csv_close(const char *verb, FILE *f, const char *path)
 void stats_csv_field(FILE *f, const char *s, int first)
 {
     if (!first) fputc(',', f);
-    if (!s) s = "";
-    if (!strpbrk(s, ",\"\r\n")) {
-        fputs(s, f);
-        return;
-    }
-    fputc('"', f);
-    for (; *s; s++) {
-        if (*s == '"') fputc('"', f);
-        fputc(*s, f);
-    }
-    fputc('"', f);
+    es_csv_write_field(f, s);
 }
 
 void stats_csv_number(FILE *f, double v)

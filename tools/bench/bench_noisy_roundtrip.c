@@ -18,6 +18,8 @@
  */
 #include <edgespace/edgespace.h>
 
+#include "es_internal.h"   /* es__rng: the seeded generator the tests use */
+
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -29,22 +31,6 @@
 #ifndef ES_SHARED_DIR
 #define ES_SHARED_DIR "../shared"
 #endif
-
-/* splitmix64 and Box-Muller: the same noise on every machine */
-static uint64_t rng_next(uint64_t *s)
-{
-    uint64_t z = (*s += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-}
-
-static double rng_normal(uint64_t *s)
-{
-    double u1 = ((double)(rng_next(s) >> 11) + 1.0) / 9007199254740993.0;
-    double u2 = (double)(rng_next(s) >> 11) / 9007199254740992.0;
-    return sqrt(-2.0 * log(u1)) * cos(6.283185307179586 * u2);
-}
 
 static void run(es_ctx *ctx, const char *file, int closed)
 {
@@ -72,9 +58,10 @@ static void run(es_ctx *ctx, const char *file, int closed)
         for (int level = 0; level < 2; level++)
             for (uint64_t seed = 1; seed <= 3; seed++) {
                 double sigma = level ? 0.05 : 0.005, w0;
-                uint64_t s = seed;
+                es__rng rng;
+                es__rng_init(&rng, seed);
                 es_dihedral_angles(ctx, mesh, md.xyz, al);
-                for (int64_t e = 0; e < ne; e++) al[e] += sigma * rng_normal(&s);
+                for (int64_t e = 0; e < ne; e++) al[e] += sigma * es__rng_normal(&rng);
                 w0 = bench_wall_s();
                 if (es_embed_solve(emb, len, 0, al, NULL, NULL, out, &r)) goto fail;
                 w0 = bench_wall_s() - w0;
@@ -94,9 +81,10 @@ static void run(es_ctx *ctx, const char *file, int closed)
             o.refine_rtol = 1e-15;
             o.refine_tol = 0;
             for (int m = 0; m < 3; m++) {
-                uint64_t s = 99;
+                es__rng rng;
+                es__rng_init(&rng, 99);
                 for (int64_t i = 0; i < 3 * nv; i++)
-                    x0[i] = md.xyz[i] + moves[m] * diag * rng_normal(&s);
+                    x0[i] = md.xyz[i] + moves[m] * diag * es__rng_normal(&rng);
                 if (es_embed_solve(emb, len, 0, NULL, x0, &o, out, &r)) goto fail;
                 es_kabsch_align(ctx, nv, out, md.xyz, NULL, &rms);
                 printf("%-34s %6lld  moved %.0e x diag          %9.2e %9.2e  %9.2e  %3s %3lld\n",
