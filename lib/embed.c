@@ -49,6 +49,7 @@ struct es_embedder {
     cholmod_dense *X, *Y, *Ew, *B3, *B1, *BA;
     /* work, sized once */
     double *ang, *theta, *C, *G, *len, *alpha, *alpha_try, *alpha_keep, *xyz, *xyz_try, *xyz_best;
+    double *init_copy;   /* init_xyz when the caller passes the output array itself */
     double *ltarget, *lpath, *res, *grad, *diag, *pcg, *jw, *fanwork, *fanr, *fanth, *fanal, *vclos, *verr;
     int have_vertex_results;
     int64_t nfactor;        /* numeric factorizations in the last solve */
@@ -243,6 +244,7 @@ static es_status alloc_work(es_embedder *emb)
     ALLOC(emb->xyz, 3 * nv);
     ALLOC(emb->xyz_try, 3 * nv);
     ALLOC(emb->xyz_best, 3 * nv);
+    ALLOC(emb->init_copy, 3 * nv);
     ALLOC(emb->ltarget, ne);
     ALLOC(emb->lpath, ne);
     ALLOC(emb->res, 9 * nv + ne);
@@ -453,7 +455,7 @@ void es_embedder_free(es_embedder *emb)
     void *bufs[] = {emb->slot_corner, emb->edge_slot, emb->pinned, emb->vweight, emb->rank,
                     emb->nlow, emb->var, emb->amap_off, emb->amap, emb->adiag, emb->ang,
                     emb->theta, emb->C, emb->G, emb->len, emb->alpha, emb->alpha_try, emb->alpha_keep, emb->xyz,
-                    emb->xyz_try, emb->xyz_best, emb->ltarget, emb->lpath, emb->res, emb->grad, emb->diag, emb->pcg,
+                    emb->xyz_try, emb->xyz_best, emb->init_copy, emb->ltarget, emb->lpath, emb->res, emb->grad, emb->diag, emb->pcg,
                     emb->jw, emb->fanwork, emb->fanr, emb->fanth, emb->fanal, emb->vclos,
                     emb->verr};
     for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++) es__free(ctx, bufs[i]);
@@ -1143,9 +1145,9 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
             if (!emb->eb[e] && !isfinite(init_alpha[e]))
                 ES_FAIL(ctx, ES_EINVAL, "embed: initial dihedral of edge %lld is not finite",
                         (long long)e);
-    if (init_xyz)
+    if (init_xyz)   /* all vertices: those in no face are copied to the output */
         for (int64_t i = 0; i < n3; i++)
-            if (!isfinite(init_xyz[i]) && emb->vweight[i / 3] > 0)
+            if (!isfinite(init_xyz[i]))
                 ES_FAIL(ctx, ES_EINVAL, "embed: initial position of vertex %lld is not finite",
                         (long long)(i / 3));
 
@@ -1302,6 +1304,16 @@ es_status es_embed_solve(es_embedder *emb, const double *target, double scale,
 {
     es_status rc;
     int want = opts ? opts->blas_threads : 1, had = 0;
+    /* init_xyz may be the output array (a sequence aligned frame to frame):
+     * the solve writes its output before it aligns it to init_xyz, so it
+     * must read a copy then */
+    if (emb && init_xyz && xyz) {
+        uintptr_t a = (uintptr_t)init_xyz, b = (uintptr_t)xyz, n = 3 * (uintptr_t)emb->nv * sizeof *xyz;
+        if (a < b + n && b < a + n) {
+            memcpy(emb->init_copy, init_xyz, (size_t)n);
+            init_xyz = emb->init_copy;
+        }
+    }
 #ifdef ES_HAVE_BLAS_THREADS
     if (want > 0 && openblas_set_num_threads && openblas_get_num_threads) {
         had = openblas_get_num_threads();

@@ -12,6 +12,7 @@
  */
 #include "mesh_internal.h"
 
+#include <math.h>
 #include <stdlib.h>
 
 /* ---- validation of the raw face list ---- */
@@ -209,6 +210,13 @@ es_status es_mesh_new(es_ctx *ctx, int64_t nverts, int64_t nfaces, const int64_t
         ES_FAIL(ctx, ES_ERANGE, "mesh: %lld faces / %lld vertices overflow",
                 (long long)nfaces, (long long)nverts);
     if ((rc = check_indices(ctx, nverts, nfaces, faces)) != ES_OK) return rc;
+    /* reference positions are what embeddings align to and put unused
+     * vertices at: one NaN would spread through the alignment */
+    if (xyz)
+        for (int64_t i = 0; i < 3 * nverts; i++)
+            if (!isfinite(xyz[i]))
+                ES_FAIL(ctx, ES_EINVAL, "mesh: vertex %lld has a non-finite coordinate (%g)",
+                        (long long)(i / 3), xyz[i]);
 
     m = es__calloc(ctx, 1, sizeof *m);
     if (!m) return ES_ENOMEM;

@@ -395,12 +395,55 @@ static void test_components(es_ctx *ctx)
                      sqrt(d / (double)nv) / diag);
         ES_CHECK(out[3 * (nv - 1)] == 7 && out[3 * (nv - 1) + 1] == -8 &&
                  out[3 * (nv - 1) + 2] == 9);
+        /* the vertex in no face takes its place from the initial positions:
+         * a NaN there is refused, not copied to the output */
+        memcpy(out, xyz, 3 * (size_t)nv * sizeof *out);
+        out[3 * (nv - 1) + 2] = NAN;
+        ES_CHECK_FAILS(ctx, es_embed_solve(emb, len, 0, al, out, NULL, out, &r), ES_EINVAL,
+                       "initial position of vertex");
         free(len), free(al), free(out);
     }
     es_embedder_free(emb);
     es_mesh_free(mesh);
     free(xyz), free(faces);
     tm_free(&a), tm_free(&b);
+}
+
+/* The alignment reference may be the output array itself, as when a
+ * sequence aligns each frame to the last: the result is the same as with a
+ * separate copy (the solve must not align the output to itself). */
+static void test_align_in_place(es_ctx *ctx)
+{
+    tm_mesh s = icosphere(2);
+    es_mesh *mesh = NULL;
+    es_embedder *emb = NULL;
+    ES_CHECK_OK(ctx, es_mesh_new(ctx, s.nv, s.nf, s.faces, s.xyz, &mesh));
+    if (mesh) ES_CHECK_OK(ctx, es_embedder_new(ctx, mesh, &emb));
+    if (emb) {
+        int64_t ne = es_mesh_nedges(mesh), n3 = 3 * s.nv;
+        double *len = malloc((size_t)ne * sizeof *len), *al = malloc((size_t)ne * sizeof *al);
+        double *moved = malloc((size_t)n3 * sizeof *moved), *out = malloc((size_t)n3 * sizeof *out);
+        double c = cos(1.1), sn = sin(1.1), d = 0, diag = es_bbox_diagonal(s.nv, s.xyz);
+        es_embed_report r;
+        /* the reference turned and shifted: an output aligned to it is it */
+        for (int64_t v = 0; v < s.nv; v++) {
+            const double *p = s.xyz + 3 * v;
+            moved[3 * v] = c * p[0] - sn * p[1] + 3;
+            moved[3 * v + 1] = sn * p[0] + c * p[1] - 2;
+            moved[3 * v + 2] = p[2] + 1;
+        }
+        memcpy(out, moved, (size_t)n3 * sizeof *out);
+        ES_CHECK_OK(ctx, es_edge_lengths(ctx, mesh, s.xyz, len));
+        ES_CHECK_OK(ctx, es_dihedral_angles(ctx, mesh, s.xyz, al));
+        ES_CHECK_OK(ctx, es_embed_solve(emb, len, 0, al, out, NULL, out, &r));
+        for (int64_t i = 0; i < n3; i++) d += (out[i] - moved[i]) * (out[i] - moved[i]);
+        ES_CHECK_MSG(sqrt(d / (double)s.nv) <= 1e-9 * diag, "in place: %g x diag off the reference",
+                     sqrt(d / (double)s.nv) / diag);
+        free(len), free(al), free(moved), free(out);
+    }
+    es_embedder_free(emb);
+    es_mesh_free(mesh);
+    tm_free(&s);
 }
 
 /* es_kabsch_align_parts: two parts moved by different rigid motions come
@@ -589,6 +632,12 @@ static void test_garbage(es_ctx *ctx)
         ES_CHECK_FAILS(ctx, es_embed_solve(emb, len, 0, al, NULL, NULL, out, &r), ES_EINVAL,
                        "dihedral");
         al[2] = keep;
+        /* every initial position must be finite, also at a vertex in no face
+         * (the output takes it from there) */
+        memcpy(out, s.xyz, 3 * (size_t)s.nv * sizeof *out);
+        out[3 * 5 + 1] = NAN;
+        ES_CHECK_FAILS(ctx, es_embed_solve(emb, len, 0, NULL, out, NULL, out, &r), ES_EINVAL,
+                       "vertex 5");
         /* impossible triangles and random lengths: flagged best effort, finite */
         len[3] *= 5;
         ES_CHECK_OK(ctx, es_embed_solve(emb, len, 0, al, NULL, NULL, out, &r));
@@ -633,6 +682,7 @@ int main(void)
     test_roundtrips(ctx);
     test_components(ctx);
     test_kabsch_parts(ctx);
+    test_align_in_place(ctx);
     test_blas_threads(ctx);
     test_interp(ctx);
     test_garbage(ctx);

@@ -45,6 +45,31 @@ int main(void)
         snprintf(p, sizeof p, "%s/seq_%02d.obj", dir, i);
         ES_CHECK_MSG(access(p, F_OK) == 0, "missing %s", p);
     }
+    /* the frames do not jump: each is already where the best rigid motion
+     * onto the one before would put it */
+    {
+        es_ctx *ctx = NULL;
+        es_meshdata prev = {0}, cur = {0};
+        ES_CHECK(es_ctx_new(&ctx) == ES_OK);
+        for (int i = 0; ctx && i < 3; i++) {
+            double raw = 0, fitted;
+            snprintf(p, sizeof p, "%s/seq_%02d.obj", dir, i);
+            ES_CHECK_OK(ctx, es_meshdata_read(ctx, p, ES_FORMAT_OBJ, &cur));
+            if (i > 0 && cur.nverts == prev.nverts) {
+                for (int64_t k = 0; k < 3 * cur.nverts; k++)
+                    raw += (cur.xyz[k] - prev.xyz[k]) * (cur.xyz[k] - prev.xyz[k]);
+                raw = sqrt(raw / (double)cur.nverts);
+                ES_CHECK_OK(ctx, es_kabsch_align(ctx, cur.nverts, cur.xyz, prev.xyz, NULL, &fitted));
+                ES_CHECK_MSG(raw <= fitted * (1 + 1e-6) + 1e-9, "frame %d: %g from frame %d, %g "
+                             "after a rigid fit", i, raw, i - 1, fitted);
+            }
+            es_meshdata_clear(ctx, &prev);
+            prev = cur;
+            memset(&cur, 0, sizeof cur);
+        }
+        if (ctx) es_meshdata_clear(ctx, &prev);
+        es_ctx_free(ctx);
+    }
     ES_RUN(&r, dir, "info", store);
     ES_CHECK_MSG(strstr(r.out, "seq_00") && strstr(r.out, "seq_02"), "info: %s", r.out);
     /* weights, extrapolation */

@@ -373,6 +373,11 @@ static void test_rejections(es_ctx *ctx)
     ES_CHECK_FAILS(ctx, es_mesh_new(ctx, 4, 2, range, NULL, &m), ES_ETOPOLOGY,
                    "face 1: vertex index 7 out of range");
     ES_CHECK(m == NULL);
+    double bad_xyz[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    int64_t tri[] = {0, 1, 2};
+    bad_xyz[3 * 2 + 1] = NAN;   /* the reference embeddings align to */
+    ES_CHECK_FAILS(ctx, es_mesh_new(ctx, 4, 1, tri, bad_xyz, &m), ES_EINVAL,
+                   "vertex 2 has a non-finite coordinate");
     int64_t neg[] = {0, -1, 2};
     ES_CHECK_FAILS(ctx, es_mesh_new(ctx, 4, 1, neg, NULL, &m), ES_ETOPOLOGY,
                    "face 0: vertex index -1");

@@ -127,9 +127,12 @@ ES_API void es_embedder_free(es_embedder *emb);
  *   init_xyz   [in]  3 x V positions of a mesh with this topology, or NULL: its
  *                    dihedrals are the start when init_alpha is NULL, it is the
  *                    start of continuation, and the output is aligned to it.
- *                    At least one of init_alpha, init_xyz is required.
+ *                    At least one of init_alpha, init_xyz is required. It may
+ *                    be the xyz array itself (the last frame of a sequence).
  *   opts       [in]  NULL for defaults.
- *   xyz        [out] 3 x V positions (isolated vertices: at the origin).
+ *   xyz        [out] 3 x V positions. Vertices in no face are put where the
+ *                    alignment reference (init_xyz, else the mesh's positions)
+ *                    has them, at the origin when there is none.
  *   report     [out] quality report, or NULL.
  * Errors: ES_EINVAL on a length that is not finite and positive (names the
  * edge), a non-finite initial angle or position, neither initialization;

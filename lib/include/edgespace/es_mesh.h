@@ -39,7 +39,8 @@ typedef struct es_mesh es_mesh;
  * an index out of range, a repeated index in a face, an edge shared by 3+
  * faces, a duplicated face, a non-manifold vertex (its faces form more than
  * one fan), inconsistent orientation of two faces sharing an edge.
- * Unreferenced vertices are allowed and warned about (log callback). */
+ * Unreferenced vertices are allowed and warned about (log callback).
+ * Fails with ES_EINVAL, naming the vertex, on a non-finite position. */
 ES_API es_status es_mesh_new(es_ctx *ctx, int64_t nverts, int64_t nfaces,
                              const int64_t *faces, const double *xyz, es_mesh **out);
 ES_API void es_mesh_free(es_mesh *mesh);
