@@ -202,7 +202,8 @@ es_status es__synth_tube(es_ctx *ctx, const es_synth_opts *o, int closed, es_syn
 {
     const double r = 1.0, len = 8.0;
     int64_t res = o->resolution ? o->resolution : 8, n = o->n ? o->n : 7;
-    int64_t nseg = 2 * res, nring = 4 * res + 1, ncap = closed ? (res + 1) / 2 : 0;
+    /* at least 3 segments around: 2 would put two faces on each side of a ring edge */
+    int64_t nseg = res < 2 ? 3 : 2 * res, nring = 4 * res + 1, ncap = closed ? (res + 1) / 2 : 0;
     int64_t nr = nring + 2 * ncap, nv = nr * nseg + (closed ? 2 : 0);
     int64_t nf = 2 * nseg * (nr - 1) + (closed ? 2 * nseg : 0);
     es_status rc = es__synth_alloc(ctx, s, nv, nf, n, 1);

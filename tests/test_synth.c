@@ -215,6 +215,19 @@ static void test_tubes(es_ctx *ctx)
         }
         es_mesh_free(m);
         es_synth_set_clear(ctx, &s);
+        /* the coarsest resolution still makes valid tubes (it made 2 faces
+         * on each side of a ring edge: 2 segments around) */
+        es_synth_opts o;
+        es_synth_opts_init(&o);
+        o.resolution = 1;
+        ES_CHECK_OK(ctx, es_synth_generate(ctx, closed ? ES_SYNTH_TUBE_CLOSED : ES_SYNTH_TUBE, &o,
+                                           &s));
+        if (!s.xyz) continue;
+        m = topology(ctx, &s);
+        ES_CHECK_MSG(m != NULL, "tube at resolution 1: %s", es_ctx_errmsg(ctx));
+        if (m) check_topology(m, closed ? 0 : 2, 0);
+        es_mesh_free(m);
+        es_synth_set_clear(ctx, &s);
     }
 }
 
