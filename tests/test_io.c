@@ -6,6 +6,8 @@
 #include "es_test.h"
 
 #include <dirent.h>
+#include <signal.h>
+#include <sys/resource.h>
 #include <inttypes.h>
 
 #define SRC ES_SOURCE_ROOT "/tests/data"
@@ -437,6 +439,38 @@ static void test_round_trips(es_ctx *ctx)
     ES_CHECK_FAILS(ctx, es__meshdata_write(ctx, "/nonexistent-dir/x.obj", ES_FORMAT_AUTO, nv,
                                            1, faces, xyz, NULL),
                    ES_EIO, "/nonexistent-dir/x.obj");
+    faces[5] = 0;
+    /* a write that fails part way (here: past a file-size limit) leaves the
+     * file that was there before as it was, and no partial file beside it */
+    {
+        const char *keep = ES_BUILD_ROOT "/test_io_keep.obj";
+        const int64_t tri[3] = {0, 1, 2};
+        struct rlimit lim, small;
+        es_meshdata back;
+        ES_CHECK_OK(ctx, es__meshdata_write(ctx, keep, ES_FORMAT_AUTO, 3, 1, tri, xyz, NULL));
+        if (getrlimit(RLIMIT_FSIZE, &lim) == 0) {
+            void (*old)(int) = signal(SIGXFSZ, SIG_IGN);
+            small = lim;
+            small.rlim_cur = 4096;
+            ES_CHECK(setrlimit(RLIMIT_FSIZE, &small) == 0);
+            ES_CHECK_FAILS(ctx, es__meshdata_write(ctx, keep, ES_FORMAT_AUTO, nv, nf, faces, xyz,
+                                                   NULL),
+                           ES_EIO, "test_io_keep.obj");
+            ES_CHECK(setrlimit(RLIMIT_FSIZE, &lim) == 0);
+            signal(SIGXFSZ, old);
+            ES_CHECK_OK(ctx, es_meshdata_read(ctx, keep, ES_FORMAT_AUTO, &back));
+            ES_CHECK_MSG(back.nverts == 3 && back.nfaces == 1, "kept file: %lld vertices",
+                         (long long)back.nverts);
+            es_meshdata_clear(ctx, &back);
+            DIR *d = opendir(ES_BUILD_ROOT);
+            struct dirent *de;
+            while (d && (de = readdir(d)))
+                ES_CHECK_MSG(!strstr(de->d_name, "test_io_keep.obj."), "left behind: %s",
+                             de->d_name);
+            if (d) closedir(d);
+        }
+        remove(keep);
+    }
     free(xyz);
     free(faces);
     free(rgb);
