@@ -21,7 +21,8 @@ typedef struct mstate {
     const char *name;
     es_status rc;
     int64_t line;          /* physical line being fed (1-based) */
-    int64_t rec_line;      /* line where the current record started, 0: none */
+    int64_t rec_line;      /* line where the current record started */
+    int64_t field_line;    /* line where the record's last complete field ended */
     char **fields;         /* current record */
     int64_t nf, capf;
     es_manifest *m;
@@ -61,7 +62,7 @@ static void on_field(void *s, size_t len, void *data)
     char *f;
     size_t ok;
     if (st->rc) return;
-    if (!st->rec_line) st->rec_line = st->line;
+    st->field_line = st->line;
     if ((ok = utf8_valid_prefix(s, s ? len : 0)) < (s ? len : 0)) {
         st->rc = es__fail(ctx, ES_EFORMAT, "manifest '%s' line %lld, field %lld: invalid "
                           "UTF-8 at byte %zu", st->name, (long long)st->rec_line,
@@ -85,7 +86,6 @@ static void drop_fields(mstate *st)
 {
     for (int64_t i = 0; i < st->nf; i++) es__free(st->ctx, st->fields[i]);
     st->nf = 0;
-    st->rec_line = 0;
 }
 
 static void on_record(int c, void *data)
@@ -101,7 +101,6 @@ static void on_record(int c, void *data)
         m->colnames = st->fields;
         st->fields = NULL;
         st->nf = st->capf = 0;
-        st->rec_line = 0;
         st->have_header = true;
         return;
     }
@@ -137,7 +136,6 @@ static void on_record(int c, void *data)
     m->lines[m->nrows] = st->rec_line;
     m->nrows++;
     st->nf = 0;
-    st->rec_line = 0;
 }
 
 void es_id_from_path(const char *path, char *buf, size_t n)
@@ -250,20 +248,33 @@ es_status es_manifest_parse(es_ctx *ctx, const char *name, const char *dir, cons
     }
     if (len >= 3 && !memcmp(buf, "\xef\xbb\xbf", 3)) pos = 3;
     while (pos < len && !st.rc) {
-        const char *nl = memchr(buf + pos, '\n', len - pos);
-        size_t seg = nl ? (size_t)(nl - (buf + pos)) + 1 : len - pos;
+        /* one physical line: up to LF, CRLF or a lone CR (all record ends) */
+        size_t e = pos;
+        bool eol = false;
+        while (e < len && buf[e] != '\n' && buf[e] != '\r') e++;
+        if (e < len) {
+            eol = true;
+            e += buf[e] == '\r' && e + 1 < len && buf[e + 1] == '\n' ? 2 : 1;
+        }
+        size_t seg = e - pos;
+        /* between records (libcsv's ROW_NOT_BEGUN state is 0), a record
+         * that starts now starts on this line, even if its first field is
+         * quoted over several lines */
+        if (p.pstate == 0) st.rec_line = st.line;
         if (csv_parse(&p, buf + pos, seg, on_field, on_record, &st) != seg && !st.rc) {
             st.rc = es__fail(ctx, ES_EFORMAT, "manifest '%s' line %lld: malformed CSV (%s; "
                              "a quote inside an unquoted field, or text after a closing "
                              "quote)", name, (long long)st.line, csv_strerror(csv_error(&p)));
         }
         pos += seg;
-        if (nl) st.line++;
+        if (eol) st.line++;
     }
+    /* an open quoted field began right after the record's last complete
+     * field (on the line of its comma), or with the record */
     if (!st.rc && csv_fini(&p, on_field, on_record, &st) != 0 && !st.rc)
         st.rc = es__fail(ctx, ES_EFORMAT, "manifest '%s' line %lld: unterminated quoted field "
                          "(opened on line %lld)", name, (long long)st.line,
-                         (long long)(st.rec_line ? st.rec_line : st.line));
+                         (long long)(st.nf ? st.field_line : st.rec_line));
     csv_free(&p);
     drop_fields(&st);
     es__free(ctx, st.fields);

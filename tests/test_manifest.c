@@ -75,6 +75,30 @@ int main(void)
     ES_CHECK_FAILS(ctx, es_manifest_read(ctx, "/nonexistent/m.csv", &m), ES_ENOTFOUND,
                    "/nonexistent/m.csv");
 
+    /* a record is reported at the line it starts on, also when its first
+     * field is quoted over several lines, and an unterminated quote at the
+     * line of the quote itself */
+    ES_CHECK_OK(ctx, parse(ctx, "file,id\n\"sub/\nb.obj\",X\nc.obj,Y\n", &m));
+    ES_CHECK(m && m->nrows == 2 && m->lines[0] == 2 && m->lines[1] == 4);
+    es_manifest_free(ctx, m);
+    m = NULL;
+    ES_CHECK_FAILS(ctx, parse(ctx, "file,id\n\"sub/\nb.obj\",X,extra\n", &m), ES_EFORMAT,
+                   "manifest 'm.csv' line 2: 3 fields, but the header has 2");
+    ES_CHECK_FAILS(ctx, parse(ctx, "file,label\n\"a\nb.obj\",\xff\n", &m), ES_EFORMAT,
+                   "manifest 'm.csv' line 2, field 2: invalid UTF-8");
+    ES_CHECK_FAILS(ctx, parse(ctx, "file,id\nsub/a.obj,A\n\"sub/b.obj\",B\n\"sub/b.obj,B\nx\ny\n",
+                              &m), ES_EFORMAT, "unterminated quoted field (opened on line 4)");
+    ES_CHECK_FAILS(ctx, parse(ctx, "file,a,b\nx.obj,\"p\nq\",\"open\nmore\n", &m), ES_EFORMAT,
+                   "unterminated quoted field (opened on line 3)");
+
+    /* CR-only line ends count lines like LF and CRLF, inside quotes too */
+    ES_CHECK_OK(ctx, parse(ctx, "file,note\ra.obj,\"x\ry\"\r\rb.obj,z\r", &m));
+    ES_CHECK(m && m->nrows == 2 && m->lines[0] == 2 && m->lines[1] == 5);
+    es_manifest_free(ctx, m);
+    m = NULL;
+    ES_CHECK_FAILS(ctx, parse(ctx, "file,id\rsub/a.obj,CR1\rsub/b.obj,CR1\r", &m), ES_EFORMAT,
+                   "manifest 'm.csv' line 3: id 'CR1' repeats line 2");
+
     /* header only: zero rows is a valid manifest */
     ES_CHECK_OK(ctx, parse(ctx, "file\n", &m));
     ES_CHECK(m && m->nrows == 0);
