@@ -193,17 +193,20 @@ static es_status check(es_ctx *ctx, es_manifest *m, const char *name)
         return ES_ENOMEM;
     for (int64_t r = 0; r < m->nrows; r++) {
         const char *file = m->cells[r * m->ncols + m->file_col];
-        char id[1024];
+        char idbuf[1024];  /* a file name's stem: NAME_MAX (255) bytes at most */
+        const char *id;
         if (!*file)
             ES_FAIL(ctx, ES_EFORMAT, "manifest '%s' line %lld: empty 'file' field", name,
                     (long long)m->lines[r]);
         if (m->id_col >= 0) {
-            snprintf(id, sizeof id, "%s", m->cells[r * m->ncols + m->id_col]);
+            /* the cell itself: a copy into a fixed buffer would cut long ids */
+            id = m->cells[r * m->ncols + m->id_col];
             if (!*id)
                 ES_FAIL(ctx, ES_EFORMAT, "manifest '%s' line %lld: empty 'id' field", name,
                         (long long)m->lines[r]);
         } else {
-            es_id_from_path(file, id, sizeof id);
+            es_id_from_path(file, idbuf, sizeof idbuf);
+            id = idbuf;
             if (!*id)
                 ES_FAIL(ctx, ES_EFORMAT, "manifest '%s' line %lld: cannot make an id from "
                         "file '%s'", name, (long long)m->lines[r], file);

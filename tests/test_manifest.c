@@ -99,6 +99,23 @@ int main(void)
     ES_CHECK_FAILS(ctx, parse(ctx, "file,id\rsub/a.obj,CR1\rsub/b.obj,CR1\r", &m), ES_EFORMAT,
                    "manifest 'm.csv' line 3: id 'CR1' repeats line 2");
 
+    /* ids are kept whole, however long: two that share a 1100-byte prefix
+     * differ, two equal ones repeat */
+    {
+        char id1[1102], id2[1102], text[2400];
+        memset(id1, 'a', 1100);
+        memcpy(id2, id1, 1100);
+        memcpy(id1 + 1100, "1", 2);
+        memcpy(id2 + 1100, "2", 2);
+        snprintf(text, sizeof text, "file,id\na.obj,%s\nb.obj,%s\n", id1, id2);
+        ES_CHECK_OK(ctx, parse(ctx, text, &m));
+        ES_CHECK(m && m->nrows == 2 && !strcmp(m->ids[0], id1) && !strcmp(m->ids[1], id2));
+        es_manifest_free(ctx, m);
+        m = NULL;
+        snprintf(text, sizeof text, "file,id\na.obj,%s\nb.obj,%s\n", id1, id1);
+        ES_CHECK_FAILS(ctx, parse(ctx, text, &m), ES_EFORMAT, "manifest 'm.csv' line 3: id 'aaa");
+    }
+
     /* header only: zero rows is a valid manifest */
     ES_CHECK_OK(ctx, parse(ctx, "file\n", &m));
     ES_CHECK(m && m->nrows == 0);
