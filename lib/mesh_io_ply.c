@@ -399,6 +399,7 @@ static es_status ascii_value(plyp *P, const elem *e, int64_t i, bool want_int, d
 static es_status body_ascii(plyp *P)
 {
     es_status rc;
+    const char *w;
     for (int ei = 0; ei < P->nelems; ei++) {
         const elem *e = &P->elems[ei];
         if (e->nprops == 0) continue;
@@ -458,6 +459,11 @@ static es_status body_ascii(plyp *P)
             }
         }
     }
+    /* more values than the header declares (a face or vertex count that is
+     * too small) would otherwise be dropped without a word */
+    if (next_token(P, &w))
+        ES_FAIL(P->ctx, ES_EFORMAT, "%s:%" PRId64 ": unexpected data after the last element "
+                "(the header's counts are too small?)", P->name, P->line);
     return ES_OK;
 }
 

@@ -306,6 +306,26 @@ static void test_syntax(es_ctx *ctx)
     ES_CHECK(md.nverts == 3 && md.nfaces == 1);
     es_meshdata_clear(ctx, &md);
 
+    /* ascii: blank space after the last element is fine, a value is not,
+     * even on the last element's line */
+    {
+        const char *head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\n"
+                           "property double y\nproperty double z\nelement face 1\n"
+                           "property list uchar int vertex_indices\nend_header\n"
+                           "0 0 0\n1 0 0\n0 1 0\n3 0 2 1";
+        char text[512];
+        snprintf(text, sizeof text, "%s \t\r\n\n  \n", head);
+        ES_CHECK_OK(ctx, parse_str(ctx, "trailing-space.ply", text, &md));
+        ES_CHECK(md.nverts == 3 && md.nfaces == 1);
+        es_meshdata_clear(ctx, &md);
+        snprintf(text, sizeof text, "%s 2\n", head);
+        ES_CHECK_FAILS(ctx, parse_str(ctx, "extra.ply", text, &md), ES_EFORMAT,
+                       "extra.ply:13: unexpected data after the last element");
+        snprintf(text, sizeof text, "%s\n\n3 0 1 2\n", head);
+        ES_CHECK_FAILS(ctx, parse_str(ctx, "extra.ply", text, &md), ES_EFORMAT,
+                       "extra.ply:15: unexpected data after the last element");
+    }
+
     /* format from the name, from the contents, or forced */
     ES_CHECK(es_mesh_format_from_path("a/b.OBJ") == ES_FORMAT_OBJ);
     ES_CHECK(es_mesh_format_from_path("x.ply") == ES_FORMAT_PLY);
