@@ -70,6 +70,25 @@ int main(void)
         if (ctx) es_meshdata_clear(ctx, &prev);
         es_ctx_free(ctx);
     }
+    /* %% in the pattern is a literal percent sign */
+    snprintf(pat, sizeof pat, "%s/pct_%%d%%%%.obj", dir);
+    ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-1", "--steps", "2",
+           "--refine-iters", "0", "--no-store", "-o", pat);
+    snprintf(p, sizeof p, "%s/pct_1%%.obj", dir);
+    ES_CHECK_MSG(r.status == 0 && access(p, F_OK) == 0, "%%%% pattern: %d %s", r.status, r.err);
+    snprintf(pat, sizeof pat, "%s/two_%%d_%%d.obj", dir);
+    ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-1", "--steps", "2",
+           "-o", pat);
+    ES_CHECK(r.status == 2 && strstr(r.err, "pattern"));
+    snprintf(pat, sizeof pat, "%s/seq_%%02d.obj", dir);
+    /* render: a view direction of 0,0,0 is a usage error */
+    snprintf(p, sizeof p, "%s/seq_00.obj", dir);
+    snprintf(out, sizeof out, "%s/seq_00.png", dir);
+    ES_RUN(&r, dir, "render", p, "--view", "0,0,0", "-o", out);
+    ES_CHECK_MSG(r.status == 2 && strstr(r.err, "direction"), "render --view 0,0,0: %d %s",
+                 r.status, r.err);
+    ES_RUN(&r, dir, "render", p, "--view", "0,0,-1", "--width", "64", "--height", "64", "-o", out);
+    ES_CHECK_MSG(r.status == 0 && access(out, F_OK) == 0, "render: %d %s", r.status, r.err);
     ES_RUN(&r, dir, "info", store);
     ES_CHECK_MSG(strstr(r.out, "seq_00") && strstr(r.out, "seq_02"), "info: %s", r.out);
     /* weights, extrapolation */

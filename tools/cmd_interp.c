@@ -26,7 +26,7 @@ static const char usage[] =
     "      --t0 T, --t1 T    range of t (default 0 and 1)\n"
     "  -w, --weights EXPR    w1*row:a + w2*row:b + ... (two or more rows)\n"
     "  -o, --output PATTERN  mesh file; with several frames a printf pattern with\n"
-    "                        one integer conversion, e.g. 'cat_%02d.obj'\n"
+    "                        one integer conversion, e.g. 'cat_%02d.obj' (%% for %)\n"
     "  -n, --name NAME       result name in the store (default: output base name)\n"
     "      --no-store        do not write reports into the store\n"
     "      --refine-iters N  refinement iterations per frame (default 12)\n"
@@ -74,20 +74,39 @@ static int parse_weights(const char *expr, double *w, char ids[][256])
     return n;
 }
 
-/* Expand a pattern with one %d, %Nd or %0Nd conversion; -1 if malformed. */
+/* Expand a pattern with one %d, %Nd or %0Nd conversion (%% is a literal
+ * percent sign); -1 if malformed. */
 static int expand_pattern(const char *pat, int i, char *out, size_t n)
 {
-    const char *pc = strchr(pat, '%'), *q;
-    int zero = 0, width = 0;
-    char num[32];
-    if (!pc || strchr(pc + 1, '%')) return -1;
-    q = pc + 1;
-    if (*q == '0') zero = 1, q++;
-    while (isdigit((unsigned char)*q)) width = width * 10 + (*q++ - '0');
-    if (*q != 'd' || width > 20) return -1;
-    if (zero) snprintf(num, sizeof num, "%0*d", width, i);
-    else snprintf(num, sizeof num, "%*d", width, i);
-    return snprintf(out, n, "%.*s%s%s", (int)(pc - pat), pat, num, q + 1) < (int)n ? 0 : -1;
+    size_t k = 0;
+    int seen = 0;
+    for (const char *p = pat; *p; p++) {
+        char num[32];
+        int zero = 0, width = 0, w;
+        if (*p != '%') {
+            if (k + 1 >= n) return -1;
+            out[k++] = *p;
+            continue;
+        }
+        if (p[1] == '%') {
+            if (k + 1 >= n) return -1;
+            out[k++] = '%';
+            p++;
+            continue;
+        }
+        if (seen++) return -1;
+        p++;
+        if (*p == '0') zero = 1, p++;
+        while (isdigit((unsigned char)*p)) width = width * 10 + (*p++ - '0');
+        if (*p != 'd' || width > 20) return -1;
+        w = zero ? snprintf(num, sizeof num, "%0*d", width, i)
+                 : snprintf(num, sizeof num, "%*d", width, i);
+        if (k + (size_t)w >= n) return -1;
+        memcpy(out + k, num, (size_t)w);
+        k += (size_t)w;
+    }
+    out[k] = 0;
+    return seen == 1 ? 0 : -1;
 }
 
 static void base_name(const char *path, char *buf, size_t n)

@@ -61,7 +61,8 @@ static int parse_vec3(const char *s, double v[3])
         if (k == 3 || cli_parse_double(t, &v[k])) return -1;
         k++;
     }
-    return k == 3 ? 0 : -1;
+    /* a direction: 0,0,0 has none */
+    return k == 3 && (v[0] != 0 || v[1] != 0 || v[2] != 0) ? 0 : -1;
 }
 
 /* First column of a CSV file as doubles; a first line that is not a number
@@ -150,11 +151,11 @@ int cmd_render(int argc, char **argv)
         switch (c) {
         case 'o': out = optarg; break;
         case 'v':
-            if (parse_vec3(optarg, spec.view)) return cli_usage_error(VERB, "--view wants X,Y,Z");
+            if (parse_vec3(optarg, spec.view)) return cli_usage_error(VERB, "--view wants a direction X,Y,Z (not 0,0,0)");
             spec.has_view = 1;
             break;
         case 'u':
-            if (parse_vec3(optarg, spec.up)) return cli_usage_error(VERB, "--up wants X,Y,Z");
+            if (parse_vec3(optarg, spec.up)) return cli_usage_error(VERB, "--up wants a direction X,Y,Z (not 0,0,0)");
             spec.has_up = 1;
             break;
         case 's':
