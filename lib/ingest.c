@@ -262,6 +262,22 @@ static void record_error(job *j, int64_t i, es_status rc, const char *msg)
     pthread_mutex_unlock(&j->mu);
 }
 
+/* Coincident vertices give edges of length 0: valid in the statistics, but
+ * no mesh realizes a point with a zero length, so embedding such a row (or
+ * a point that keeps the zero) fails later; say so while the file is known. */
+static void warn_zero_edges(es_ctx *ctx, const char *path, const es_mesh *mesh,
+                            const double *len, int64_t ne)
+{
+    const int64_t *ev = es_mesh_edges(mesh);
+    int64_t n = 0, first = -1;
+    for (int64_t e = 0; e < ne; e++)
+        if (len[e] == 0 && n++ == 0) first = e;
+    if (n)
+        es__warn(ctx, "'%s': %lld edge%s of length 0 (first: edge %lld, vertices %lld-%lld); "
+                 "such a shape cannot be embedded", path, (long long)n, n == 1 ? "" : "s",
+                 (long long)first, (long long)ev[2 * first], (long long)ev[2 * first + 1]);
+}
+
 /* One input into slot i. */
 static es_status process_one(worker *w, int64_t i, char **buf, size_t *cap, es_meshdata *md)
 {
@@ -296,6 +312,7 @@ static es_status process_one(worker *w, int64_t i, char **buf, size_t *cap, es_m
             snprintf(msg, sizeof msg, "%s", es_ctx_errmsg(ctx));
             rc = es__fail(ctx, rc, "'%s': %s", path, msg);
         } else {
+            warn_zero_edges(ctx, path, j->r->mesh, li, b->E);
             memcpy(b->xyz + i * 3 * b->V, md->xyz, (size_t)(3 * b->V) * sizeof(double));
         }
     }
@@ -479,6 +496,7 @@ static es_status ingest(es_ctx *ctx, const char *store_path, int64_t n, const in
             rc = es__fail(ctx, rc, "'%s': %s", in[0].path, msg);
             goto done;
         }
+        warn_zero_edges(ctx, in[0].path, r.mesh, b.len, b.E);
         memcpy(b.xyz, md.xyz, (size_t)(3 * b.V) * sizeof(double));
         es_meshdata_clear(ctx, &md);
         first = 1;

@@ -185,6 +185,19 @@ static void shared_sets(es_ctx *ctx, const char *dir)
     }
 }
 
+typedef struct {
+    char text[4096];
+    size_t n;
+} log_capture;
+
+static void capture_log(void *ud, es_log_level level, const char *msg)
+{
+    log_capture *c = ud;
+    (void)level;
+    int k = snprintf(c->text + c->n, sizeof c->text - c->n, "%s\n", msg);
+    if (k > 0) c->n = c->n + (size_t)k < sizeof c->text ? c->n + (size_t)k : sizeof c->text - 1;
+}
+
 int main(void)
 {
     es_ctx *ctx = NULL;
@@ -486,6 +499,36 @@ int main(void)
         }
         es_store_close(s);
         s = NULL;
+    }
+
+    /* ---- coincident vertices: ingested, with a warning naming the file
+     * and the zero-length edge (first input and a later one) ---- */
+    {
+        int64_t V = NU * NV, F = 2 * V;
+        double *xyz = malloc(3 * (size_t)V * sizeof *xyz);
+        int64_t *faces = malloc(3 * (size_t)F * sizeof *faces);
+        char pz[4300], p0[4300], sz[4300];
+        log_capture cap = {{0}, 0};
+        es_test_torus(NU, NV, 0, xyz, faces);
+        memcpy(xyz + 3, xyz, 3 * sizeof *xyz);   /* vertex 1 onto vertex 0 */
+        snprintf(pz, sizeof pz, "%s/meshes/zero.obj", dir);
+        snprintf(p0, sizeof p0, "%s/meshes/t0.obj", dir);
+        ES_CHECK(es_test_write_obj(pz, V, xyz, F, faces) == 0);
+        es_ctx_set_log(ctx, capture_log, &cap);
+        for (int order = 0; order < 2; order++) {
+            const char *files[2] = {order ? p0 : pz, order ? pz : p0};
+            snprintf(sz, sizeof sz, "%s/zero%d.h5", dir, order);
+            cap.n = 0;
+            cap.text[0] = 0;
+            ES_CHECK_OK(ctx, es_ingest_files(ctx, sz, 2, files, NULL, &rep));
+            ES_CHECK(rep.rows_added == 2);
+            ES_CHECK_MSG(strstr(cap.text, "zero.obj': 1 edge of length 0 (first: edge") &&
+                         strstr(cap.text, "vertices 0-1"), "order %d: warnings '%s'", order,
+                         cap.text);
+            remove(sz);
+        }
+        es_ctx_set_log(ctx, NULL, NULL);
+        free(xyz), free(faces);
     }
 
     shared_sets(ctx, dir);
