@@ -11,6 +11,7 @@
  * phase 2 also leaves the old store intact.
  */
 #include "es_internal.h"
+#include "mesh_internal.h"
 #include "edgespace/es_geom.h"
 #include "edgespace/es_ingest.h"
 #include "edgespace/es_io.h"
@@ -432,8 +433,9 @@ static es_status ingest(es_ctx *ctx, const char *store_path, int64_t n, const in
             rc = ES_ENOMEM;
             goto done;
         }
+        /* quiet: vertices in no face were warned about at the store's first ingest */
         if ((rc = es_store_read_faces(ctx, st, store_faces)) ||
-            (rc = es_mesh_new(ctx, r.V, r.F, store_faces, NULL, &r.mesh)))
+            (rc = es__mesh_new(ctx, r.V, r.F, store_faces, NULL, 0, &r.mesh)))
             goto done;
         r.faces = store_faces;
         snprintf(r.what, sizeof r.what, "the store '%s'", store_path);
@@ -476,12 +478,20 @@ static es_status ingest(es_ctx *ctx, const char *store_path, int64_t n, const in
         memcpy(ref_faces, md.faces, (size_t)nf3 * sizeof *ref_faces);
         r.faces = ref_faces;
         snprintf(r.what, sizeof r.what, "the first input '%s'", in[0].path);
-        if ((rc = es_mesh_new(ctx, r.V, r.F, r.faces, md.xyz, &r.mesh))) {
+        if ((rc = es__mesh_new(ctx, r.V, r.F, r.faces, md.xyz, 0, &r.mesh))) {
             char msg[900];
             snprintf(msg, sizeof msg, "%s", es_ctx_errmsg(ctx));
             rc = es__fail(ctx, rc, "'%s': %s", in[0].path, msg);
             es__free(ctx, buf);
             goto done;
+        }
+        {
+            es_mesh_summary sum;
+            es_mesh_summarize(r.mesh, &sum);
+            if (sum.n_unreferenced > 0)
+                es__warn(ctx, "'%s': %lld of %lld vertices are in no face (kept, with their "
+                         "positions; they have no edges)", in[0].path,
+                         (long long)sum.n_unreferenced, (long long)r.V);
         }
         if ((rc = batch_alloc(ctx, &b, n, r.V, es_mesh_nedges(r.mesh)))) {
             es__free(ctx, buf);

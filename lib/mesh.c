@@ -198,6 +198,12 @@ static es_status build_flags(es_ctx *ctx, es_mesh *m)
 es_status es_mesh_new(es_ctx *ctx, int64_t nverts, int64_t nfaces, const int64_t *faces,
                       const double *xyz, es_mesh **out)
 {
+    return es__mesh_new(ctx, nverts, nfaces, faces, xyz, 1, out);
+}
+
+es_status es__mesh_new(es_ctx *ctx, int64_t nverts, int64_t nfaces, const int64_t *faces,
+                       const double *xyz, int warn_unreferenced, es_mesh **out)
+{
     es_status rc;
     int64_t n3;
     es_mesh *m;
@@ -235,7 +241,7 @@ es_status es_mesh_new(es_ctx *ctx, int64_t nverts, int64_t nfaces, const int64_t
         (rc = es__mesh_build_stars(ctx, m)) != ES_OK ||
         (rc = es__mesh_build_boundary(ctx, m)) != ES_OK)
         goto fail;
-    if (m->sum.n_unreferenced > 0) {
+    if (warn_unreferenced && m->sum.n_unreferenced > 0) {
         int64_t first = -1;
         for (int64_t v = 0; v < nverts && first < 0; v++)
             if (m->star_off[v + 1] == m->star_off[v]) first = v;

@@ -35,6 +35,11 @@ struct es_mesh {
  * check. Needs faces, edges, face_edges, edge_faces and the boundary flags. */
 es_status es__mesh_build_stars(es_ctx *ctx, es_mesh *m);
 
+/* es_mesh_new; warn_unreferenced 0 leaves the warning about vertices in no
+ * face to a caller that can name the file (or has warned once already). */
+es_status es__mesh_new(es_ctx *ctx, int64_t nverts, int64_t nfaces, const int64_t *faces,
+                       const double *xyz, int warn_unreferenced, es_mesh **out);
+
 /* FNV-1a 64 over the little-endian bytes of head[0..nhead) then
  * vals[0..nvals), as 16 lowercase hex digits plus NUL: the fingerprint of
  * face lists (es_faces_fingerprint) and of edge-only stores. */

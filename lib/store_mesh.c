@@ -67,7 +67,7 @@ es_status es_store_mesh(es_ctx *ctx, es_store *store, es_mesh **out)
         if (!(xyz = es__alloc_array(ctx, 3 * V, sizeof *xyz))) { rc = ES_ENOMEM; goto done; }
         if ((rc = es_store_read_positions(ctx, store, 0, xyz))) goto done;
     }
-    rc = es_mesh_new(ctx, V, F, faces, xyz, out);
+    rc = es__mesh_new(ctx, V, F, faces, xyz, 0, out);   /* unused vertices: warned at ingest */
     if (rc == ES_OK && es_mesh_nedges(*out) != es_store_nedges(store)) {
         int64_t ne = es_mesh_nedges(*out);
         es_mesh_free(*out);

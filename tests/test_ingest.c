@@ -527,6 +527,37 @@ int main(void)
                          cap.text);
             remove(sz);
         }
+        /* a vertex in no face: one warning naming the first file, none
+         * when later files are added to that store */
+        {
+            double *x1 = malloc(3 * (size_t)(V + 1) * sizeof *x1);
+            char pa[4300], pb[4300];
+            const char *one[1];
+            for (int k = 0; k < 2; k++) {
+                es_test_torus(NU, NV, k, x1, faces);
+                x1[3 * V] = 9, x1[3 * V + 1] = 9, x1[3 * V + 2] = 9;
+                snprintf(k ? pb : pa, sizeof pa, "%s/meshes/spare%d.obj", dir, k);
+                ES_CHECK(es_test_write_obj(k ? pb : pa, V + 1, x1, F, faces) == 0);
+            }
+            snprintf(sz, sizeof sz, "%s/spare.h5", dir);
+            cap.n = 0;
+            cap.text[0] = 0;
+            one[0] = pa;
+            ES_CHECK_OK(ctx, es_ingest_files(ctx, sz, 1, one, NULL, &rep));
+            char want[128];
+            snprintf(want, sizeof want, "spare0.obj': 1 of %lld vertices are in no face",
+                     (long long)(V + 1));
+            const char *w = strstr(cap.text, want);
+            ES_CHECK_MSG(w && !strstr(w + strlen(want), "in no face"), "first ingest: '%s'", cap.text);
+            cap.n = 0;
+            cap.text[0] = 0;
+            one[0] = pb;
+            ES_CHECK_OK(ctx, es_ingest_files(ctx, sz, 1, one, NULL, &rep));
+            ES_CHECK_MSG(rep.rows_total == 2 && !strstr(cap.text, "in no face"),
+                         "second ingest: '%s'", cap.text);
+            remove(sz);
+            free(x1);
+        }
         es_ctx_set_log(ctx, NULL, NULL);
         free(xyz), free(faces);
     }
