@@ -122,21 +122,34 @@ typedef struct builder {
     double *scale;
 } builder;
 
+/* Specimens the builder first makes room for; it doubles from there. */
+enum { FIRST_CAP = 16 };
+
+/* line is 0 for CSV, where k is the largest landmark number, not an LM= line. */
 static es_status builder_add(builder *b, int64_t k, int d, const char *file, int64_t line)
 {
     if (b->n == 0) {
+        /* k comes from the file: check that the first FIRST_CAP specimens'
+         * bytes fit int64, so that a huge count is named here rather than
+         * wrapping into a tiny allocation */
+        if (!es__mul_i64(k, d, &b->kd) ||
+            b->kd > INT64_MAX / (FIRST_CAP * (int64_t)sizeof(double)))
+            ES_FAIL(b->ctx, ES_ERANGE, "landmarks: %s: %lld landmarks in %dD are too many%s",
+                    file, (long long)k, d,
+                    line > 0 ? " (LM= count)" : " (largest landmark number)");
         b->k = k;
         b->d = d;
-        b->kd = k * d;
     } else if (k != b->k || d != b->d) {
         ES_FAIL(b->ctx, ES_EMISMATCH, "landmarks: %s:%lld: specimen %lld has %lld landmarks in "
                 "%dD, the first had %lld in %dD", file, (long long)line, (long long)b->n + 1,
                 (long long)k, d, (long long)b->k, b->d);
     }
     if (b->n == b->cap) {
-        int64_t nc = b->cap ? 2 * b->cap : 16, bytes;
-        if (!es__mul_i64(nc, b->kd, &bytes)) ES_FAIL(b->ctx, ES_ERANGE, "landmarks: too large");
-        double *x = es__realloc(b->ctx, b->xyz, (size_t)bytes * sizeof *x);
+        int64_t nc = b->cap ? 2 * b->cap : FIRST_CAP, bytes;
+        if (!es__mul_i64(nc, b->kd, &bytes) || !es__mul_i64(bytes, (int64_t)sizeof(double), &bytes))
+            ES_FAIL(b->ctx, ES_ERANGE, "landmarks: %s: %lld specimens of %lld landmarks in %dD "
+                    "are too many", file, (long long)nc, (long long)b->k, b->d);
+        double *x = es__realloc(b->ctx, b->xyz, (size_t)bytes);
         if (!x) return ES_ENOMEM;
         b->xyz = x;
         char **ids = es__realloc(b->ctx, b->ids, (size_t)nc * sizeof *ids);

@@ -5,6 +5,7 @@
 #include "es_internal.h"
 #include "es_test.h"
 #include "es_test_alloc.h"
+#include "es_test_files.h"
 #include "edgespace/edgespace.h"
 
 #include <stdarg.h>
@@ -117,6 +118,37 @@ static void test_csv(es_ctx *ctx)
     }
 }
 
+/* A landmark count from the file sizes the buffers: a count whose
+ * k * d * sizeof(double) overflows is refused with the file's name, not
+ * wrapped into a tiny allocation (2^56 landmarks used to crash the reader). */
+static void test_size_overflow(es_ctx *ctx)
+{
+    const char *dir = es_test_tmpdir("landmarks");
+    static const struct { const char *file, *text, *msg; } bad[] = {
+        {"big.tps", "LM=72057594037927936\n1 2\nID=a\n",
+         "landmarks: big.tps: 72057594037927936 landmarks in 2D are too many (LM= count)"},
+        {"big3d.tps", "LM3=4611686018427387904\n1 2 3\n",
+         "big3d.tps: 4611686018427387904 landmarks in 3D are too many"},
+        {"big.csv", "specimen,landmark,x,y\na,1,0,0\na,2,1,0\na,72057594037927936,0,1\n",
+         "landmarks: big.csv: 72057594037927936 landmarks in 2D are too many (largest "
+         "landmark number)"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        char path[4200];
+        snprintf(path, sizeof path, "%s/%s", dir, bad[i].file);
+        es_test_write_file(path, bad[i].text);
+        es_landmarks *lm = (es_landmarks *)1;
+        if (strstr(bad[i].file, ".tps"))
+            ES_CHECK_FAILS(ctx, es_landmarks_read_tps(ctx, path, 1, &lm), ES_ERANGE, bad[i].msg);
+        else
+            ES_CHECK_FAILS(ctx, es_landmarks_read_csv(ctx, path, NULL, &lm), ES_ERANGE,
+                           bad[i].msg);
+        ES_CHECK(lm == NULL);
+        remove(path);
+    }
+    rmdir(dir);
+}
+
 /* The rshapes apes table holds gorf (specimens 1-30) and the oracle's
  * gorf_input.csv is the same data with numeric ids. */
 static void test_shared(es_ctx *ctx)
@@ -188,6 +220,7 @@ int main(void)
     es_ctx_set_log(ctx, on_log, NULL);
     test_tps(ctx);
     test_csv(ctx);
+    test_size_overflow(ctx);
     test_shared(ctx);
     test_alloc_sweep();
     es_ctx_free(ctx);

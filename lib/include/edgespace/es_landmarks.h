@@ -49,7 +49,8 @@ typedef struct es_landmarks {
 
 /* Read a TPS file. Caller owns *out (es_landmarks_free). ES_EIO if the file
  * cannot be read, ES_EFORMAT with file:line on malformed content,
- * ES_EMISMATCH when specimens differ in k or d. */
+ * ES_EMISMATCH when specimens differ in k or d, ES_ERANGE when the landmark
+ * count is too large to hold (the message names the file). */
 ES_API es_status es_landmarks_read_tps(es_ctx *ctx, const char *path, int apply_scale,
                                        es_landmarks **out);
 
