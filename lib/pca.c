@@ -377,6 +377,9 @@ es_status es_pca_fit(es_ctx *ctx, const es_source *src, const es_pca_opts *opts,
             es_pca_free(p);
             return rc;
         }
+        /* numerically zero components (rank < K, constant data) are dropped
+         * as in the exact routes: their directions are arbitrary */
+        p->ncomp = rank_of(p->eigenvalues, p->ncomp, N > E ? N : E, N, p->ncomp);
         es__pca_finish(p);
         *out = p;
         return ES_OK;

@@ -270,20 +270,38 @@ static void test_randomized(es_ctx *ctx)
     free(X);
 }
 
-/* Rank-deficient data: identical rows except two give one component. */
+/* Rank-deficient data: every route, the randomized one included, returns
+ * only the components above max(N, E) eps (largest), so rank-1 data asked
+ * for 3 gives 1 and constant data gives none (the randomized route used to
+ * return its null directions with eigenvalues ~1e-34 or 0). */
 static void test_rank(es_ctx *ctx)
 {
-    const int64_t E = 10, N = 6;
-    double X[60];
-    for (int64_t j = 0; j < N; j++)
-        for (int64_t e = 0; e < E; e++) X[e + j * E] = 0.1 + (j % 2 ? 0.01 * (double)(e % 3) : 0);
-    es_source src = es_source_matrix((es_mat){X, E, N, E}, NULL, 0);
-    es_pca *p = NULL;
-    ES_CHECK_OK(ctx, es_pca_fit(ctx, &src, NULL, &p));
-    if (p) {
-        ES_CHECK(p->ncomp == 1);
-        ES_CHECK_CLOSE(p->explained[0], 1.0, 1e-12, 0);
-        es_pca_free(p);
+    const int64_t E = 12, N = 40;
+    double X[12 * 40];
+    static const es_pca_method methods[] = {ES_PCA_AUTO, ES_PCA_GRAM, ES_PCA_COVARIANCE,
+                                            ES_PCA_RANDOMIZED};
+    for (int constant = 0; constant < 2; constant++) {
+        for (int64_t j = 0; j < N; j++)
+            for (int64_t e = 0; e < E; e++)
+                X[e + j * E] = 1.0 / (double)E +
+                               (constant ? 0 : 1e-3 * (double)(j % 5) * sin((double)e));
+        es_source src = es_source_matrix((es_mat){X, E, N, E}, NULL, 0);
+        for (size_t m = 0; m < sizeof methods / sizeof methods[0]; m++) {
+            es_pca_opts o;
+            es_pca_opts_init(&o);
+            o.method = methods[m];
+            o.ncomp = 3;
+            es_pca *p = NULL;
+            ES_CHECK_OK(ctx, es_pca_fit(ctx, &src, &o, &p));
+            if (!p) continue;
+            ES_CHECK_MSG(p->ncomp == (constant ? 0 : 1), "method %d, constant %d: %lld "
+                         "components", (int)methods[m], constant, (long long)p->ncomp);
+            for (int64_t k = 0; k < p->ncomp; k++)
+                ES_CHECK_MSG(p->eigenvalues[k] > 0, "method %d: eigenvalue %lld is %g",
+                             (int)methods[m], (long long)k, p->eigenvalues[k]);
+            if (!constant && p->ncomp > 0) ES_CHECK_CLOSE(p->explained[0], 1.0, 1e-12, 0);
+            es_pca_free(p);
+        }
     }
 }
 
