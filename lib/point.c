@@ -198,7 +198,8 @@ static es_status parse_number(parser *p, form *f)
     return ES_OK;
 }
 
-/* mean or mean[col=value,...]: the filter is stored as "col=value,col=value". */
+/* mean or mean[col=value,...]: the filter is stored as "col=value,col=value",
+ * in es_store_select's syntax. */
 static es_status parse_mean(parser *p, form *f)
 {
     size_t save = p->pos;
@@ -215,7 +216,14 @@ static es_status parse_mean(parser *p, form *f)
         const char *w = NULL, *v = NULL; /* set by word(); initialized for -O3 */
         size_t wl = 0, vl = 0;
         skip_ws(p);
+        size_t wat = p->pos;
         if ((rc = word(p, is_id_char, "a column name", &w, &wl)) != ES_OK) break;
+        /* es_store_select splits terms at ',' and the name from the value at
+         * the first '=', so a quoted name cannot hold them */
+        if (memchr(w, ',', wl) || memchr(w, '=', wl)) {
+            rc = perr(p, wat, "a column name cannot contain ',' or '='");
+            break;
+        }
         skip_ws(p);
         if (p->s[p->pos] != '=') {
             char b[8];
@@ -226,7 +234,9 @@ static es_status parse_mean(parser *p, form *f)
         p->pos++;
         skip_ws(p);
         if ((rc = word(p, is_id_char, "a value", &v, &vl)) != ES_OK) break;
-        char *nf = es__realloc(p->ctx, filt, flen + wl + vl + 3);
+        /* a value holding ',' is passed quoted (es_store_select's col="v") */
+        int q = memchr(v, ',', vl) != NULL;
+        char *nf = es__realloc(p->ctx, filt, flen + wl + vl + 5);
         if (!nf) {
             rc = ES_ENOMEM;
             break;
@@ -236,8 +246,10 @@ static es_status parse_mean(parser *p, form *f)
         memcpy(filt + flen, w, wl);
         flen += wl;
         filt[flen++] = '=';
+        if (q) filt[flen++] = '"';
         memcpy(filt + flen, v, vl);
         flen += vl;
+        if (q) filt[flen++] = '"';
         filt[flen] = '\0';
         skip_ws(p);
         if (p->s[p->pos] == ',') {

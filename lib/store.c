@@ -1391,6 +1391,16 @@ es_status es_store_select(es_ctx *ctx, const es_store *s, const char *filter, in
         const char *comma = strchr(p, ','), *end = comma ? comma : p + strlen(p);
         const char *eq = memchr(p, '=', (size_t)(end - p));
         char name[256];
+        bool quoted = false;
+        if (eq && eq[1] == '"') {
+            /* col="value" may hold ',' (labels with commas) */
+            const char *close = strchr(eq + 2, '"');
+            if (!close || (close[1] && close[1] != ','))
+                ES_FAIL(ctx, ES_EFORMAT, "store: bad quoted value in filter '%s'", filter);
+            quoted = true;
+            end = close + 1;
+            comma = *end == ',' ? end : NULL;
+        }
         if (!eq || eq == p)
             ES_FAIL(ctx, ES_EFORMAT, "store: bad filter term '%.*s' (want column=value)",
                     (int)(end - p), p);
@@ -1402,8 +1412,8 @@ es_status es_store_select(es_ctx *ctx, const es_store *s, const char *filter, in
                 ES_FAIL(ctx, ES_ENOTFOUND, "store: no label column '%s' in '%s'", name,
                         s->path);
         }
-        vals[nterms] = eq + 1;
-        vlen[nterms] = (size_t)(end - eq - 1);
+        vals[nterms] = eq + 1 + quoted;
+        vlen[nterms] = (size_t)(end - eq - 1) - 2 * (size_t)quoted;
         nterms++;
         p = comma ? comma + 1 : end;
     }

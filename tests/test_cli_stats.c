@@ -256,6 +256,58 @@ int main(void)
         es_store_close(st);
     }
 
+    /* a label value holding ',' (quoted in the manifest) is selected
+     * quoted, col="a,b", by --where and by mean[...] in a point; unquoted,
+     * the ',' separates terms */
+    snprintf(path, sizeof path, "%s/odd.csv", dir);
+    if ((m = fopen(path, "w"))) {
+        fputs("file,grp\ns1_neutral.obj,\"a,b\"\ns2_neutral.obj,a\ns3_neutral.obj,\"a,b\"\n"
+              "s4_neutral.obj,b\n", m);
+        fclose(m);
+    }
+    ES_CHECK(run(out, sizeof out, "ingest odd.h5 --manifest odd.csv -q") == 0);
+    ES_CHECK(run(out, sizeof out, "mean odd.h5 --where 'grp=\"a,b\"' --name ab") == 0);
+    ES_CHECK(run(out, sizeof out, "point odd.h5 'mean[grp=\"a,b\"]' --name ab") == 0);
+    ES_CHECK(run(out, sizeof out, "mean odd.h5 --where 'grp=a,b'") == 1);
+    ES_CHECK_MSG(strstr(out, "bad filter term 'b'"), "%s", out);
+    snprintf(path, sizeof path, "%s/odd.h5", dir);
+    ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_READ, &st));
+    if (st) {
+        const int64_t E = es_store_nedges(st), col = es_store_find_column(st, "grp");
+        int64_t ab[4], nab = 0, *sel = NULL, nsel = 0, *counts = NULL, nc = 0, n1 = 0;
+        for (int64_t i = 0; i < es_store_nrows(st) && nab < 4; i++)
+            if (!strcmp(es_store_label(st, i, col), "a,b")) ab[nab++] = i;
+        ES_CHECK(nab == 2 && !strcmp(es_store_row_id(st, ab[0]), "s1_neutral") &&
+                 !strcmp(es_store_row_id(st, ab[1]), "s3_neutral"));
+        ES_CHECK_OK(ctx, es_store_select(ctx, st, "grp=\"a,b\"", &sel, &nsel));
+        ES_CHECK(nsel == nab && sel && !memcmp(sel, ab, (size_t)nab * sizeof *sel));
+        double *want = malloc((size_t)E * sizeof *want), *pt = NULL;
+        es_mat mm = {NULL, 0, 0, 0};
+        es_source src;
+        ES_CHECK_OK(ctx, es_source_store(ctx, st, ab, nab, &src));
+        ES_CHECK_OK(ctx, es_mean(ctx, &src, want));
+        ES_CHECK_OK(ctx, es_store_get_ints(ctx, st, "mean/ab/counts", &counts, &nc));
+        ES_CHECK(nc == 1 && counts && counts[0] == 2);
+        ES_CHECK_OK(ctx, es_store_get_matrix(ctx, st, "mean/ab/means", &mm));
+        ES_CHECK_OK(ctx, es_store_get_vector(ctx, st, "point/ab/lengths", &pt, &n1));
+        if (mm.data && mm.rows == E && mm.cols == 1 && pt && n1 == E)
+            for (int64_t e = 0; e < E; e++) {
+                ES_CHECK_CLOSE(mm.data[e], want[e], 1e-14, 0);
+                ES_CHECK_CLOSE(pt[e], want[e], 1e-14, 0);
+            }
+        else
+            ES_CHECK_MSG(0, "means %lld x %lld, point %lld, E %lld", (long long)mm.rows,
+                         (long long)mm.cols, (long long)n1, (long long)E);
+        free(want);
+        es_free(ctx, sel);
+        es_free(ctx, counts);
+        es_free(ctx, mm.data);
+        es_free(ctx, pt);
+        es_store_close(st);
+        st = NULL;
+    }
+    snprintf(path, sizeof path, "%s/study.h5", dir);
+
     /* project a new file and a stored row */
     ES_CHECK(run(out, sizeof out, "project study.h5 --pca p new.obj s2_happy --csv proj.csv") == 0);
     ES_CHECK(count_lines("proj.csv") == 3);

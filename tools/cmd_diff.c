@@ -29,6 +29,7 @@ static const char usage[] =
     "                       other than KEY in which both values occur)\n"
     "  -n, --name NAME      result name\n"
     "  -w, --where FILTER   only rows matching \"col=value[,...]\"\n"
+    "                       (quote a value holding ',': col=\"a,b\")\n"
     "  -o, --csv PATH       write edge,v0,v1,mean,sd,se,t (- for stdout)\n"
     "  -h, --help           show this help\n"
     "\n"

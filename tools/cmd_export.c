@@ -19,6 +19,7 @@ static const char usage[] =
     "  -M, --meshes DIR      write meshes into DIR (created if absent)\n"
     "  -f, --format FMT      mesh format: obj (default), ply, ply-ascii, off\n"
     "  -s, --select FILTER   only rows matching col=value[,col=value...]\n"
+    "                        (quote a value holding ',': col=\"a,b\")\n"
     "  -h, --help            show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";

@@ -21,6 +21,7 @@ static const char usage[] =
     "      --no-scale          partial GPA: rotation and translation only\n"
     "      --allow-reflection  allow reflections in the rotations\n"
     "  -w, --where FILTER      rows whose labels match col=value[,col=value...]\n"
+    "                          (quote a value holding ',': col=\"a,b\")\n"
     "      --tol T             convergence tolerance (default 1e-10)\n"
     "      --max-iter N        iteration limit (default 1000)\n"
     "      --pcs N             principal components stored (default min(10, n-1))\n"

@@ -22,6 +22,7 @@ static const char usage[] =
     "\n"
     "  -n, --name NAME        result name (default: \"default\")\n"
     "  -w, --where FILTER     only rows matching \"col=value[,col=value...]\"\n"
+    "                         (quote a value holding ',': col=\"a,b\")\n"
     "  -k, --components K     keep the top K, fewer if the numerical rank is lower\n"
     "                         (default: all, the numerical rank)\n"
     "  -m, --method M         auto (default), gram, covariance, or randomized\n"

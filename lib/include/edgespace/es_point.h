@@ -37,7 +37,8 @@ extern "C" {
 #endif
 
 typedef enum es_point_leaf {
-    ES_POINT_MEAN = 0,  /* arg: the filter "col=value,..." ("" for all rows) */
+    ES_POINT_MEAN = 0,  /* arg: the filter "col=value,..." ("" for all rows;
+                           a value holding ',' is quoted, as es_store_select reads) */
     ES_POINT_ROW,       /* arg: the row id */
     ES_POINT_FILE,      /* arg: the path */
     ES_POINT_PC,        /* index: K (1-based), arg "" */

@@ -156,7 +156,9 @@ ES_API const char *es_store_label(const es_store *store, int64_t row, int64_t co
 
 /* Rows matching a filter "col=value[,col=value...]" (all must hold; NULL or
  * "" selects every row; the column "id" means the row id unless a label
- * column has that name), in row order. *rows is allocated with the ctx
+ * column has that name), in row order. A value that holds ',' is written
+ * quoted, col="a,b" (any characters but '"'); ES_EFORMAT on a quote that
+ * is not closed or not followed by ',' or the end. *rows is allocated with the ctx
  * allocator (es_free). Unknown columns fail with ES_ENOTFOUND. */
 ES_API es_status es_store_select(es_ctx *ctx, const es_store *store, const char *filter,
                                  int64_t **rows, int64_t *nrows);
