@@ -113,8 +113,12 @@ int cmd_diff(int argc, char **argv)
         norm += d->mean[e] * d->mean[e];
         if (fabs(d->t[e]) > tmax) tmax = fabs(d->t[e]), emax = e;
     }
-    printf("|mean difference| = %.6g; largest |t| = %.3g at edge %lld (%lld degrees of freedom)\n",
-           sqrt(norm), tmax, (long long)emax, (long long)(d->npairs - 1));
+    if (emax >= 0)
+        printf("|mean difference| = %.6g; largest |t| = %.3g at edge %lld (%lld degrees of "
+               "freedom)\n", sqrt(norm), tmax, (long long)emax, (long long)(d->npairs - 1));
+    else   /* one pair: no spread, so no t */
+        printf("|mean difference| = %.6g; no t statistics (%lld pair)\n", sqrt(norm),
+               (long long)d->npairs);
     if ((rc = es_store_commit(ctx, st)) != ES_OK) {
         cli_fail("diff", ctx, rc);
         goto done;

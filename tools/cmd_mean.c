@@ -12,6 +12,7 @@
 
 static const char usage[] =
     "usage: edgespace mean STORE [--by COLUMN] [--where FILTER] [--name NAME] [--csv PATH]\n"
+    "                            [--no-store]\n"
     "\n"
     "Mean scale-normalized edge lengths of the rows of STORE: of all rows, of\n"
     "the rows matching FILTER (\"col=value[,col=value...]\", all must hold; a\n"

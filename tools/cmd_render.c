@@ -48,7 +48,8 @@ static void usage(FILE *f)
           "      --fit-each         each mesh fills its panel (default: one scale)\n"
           "      --same-view        all panels use the first mesh's automatic view\n"
           "      --columns N        wrap the panels into rows of N\n"
-          "  -h, --help             show this help\n", f);
+          "  -h, --help             show this help\n\n"
+          "Exit status: 0 ok, 1 failure, 2 usage error.\n", f);
 }
 
 static int parse_vec3(const char *s, double v[3])
@@ -151,11 +152,13 @@ int cmd_render(int argc, char **argv)
         switch (c) {
         case 'o': out = optarg; break;
         case 'v':
-            if (parse_vec3(optarg, spec.view)) return cli_usage_error(VERB, "--view wants a direction X,Y,Z (not 0,0,0)");
+            if (parse_vec3(optarg, spec.view))
+                return cli_usage_error(VERB, "--view wants a direction X,Y,Z (not 0,0,0)");
             spec.has_view = 1;
             break;
         case 'u':
-            if (parse_vec3(optarg, spec.up)) return cli_usage_error(VERB, "--up wants a direction X,Y,Z (not 0,0,0)");
+            if (parse_vec3(optarg, spec.up))
+                return cli_usage_error(VERB, "--up wants a direction X,Y,Z (not 0,0,0)");
             spec.has_up = 1;
             break;
         case 's':

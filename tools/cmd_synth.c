@@ -28,7 +28,9 @@ static const char usage[] =
     "  -r, --resolution R     mesh density 1..64 (default 8)\n"
     "      --noise X          per-vertex noise sd relative to size\n"
     "      --subdivide K      apply 1-to-4 subdivision K times\n"
-    "  -h, --help             show this help\n";
+    "  -h, --help             show this help\n"
+    "\n"
+    "Exit status: 0 ok, 1 failure, 2 usage error.\n";
 
 int cmd_synth(int argc, char **argv)
 {
@@ -92,9 +94,9 @@ int cmd_synth(int argc, char **argv)
     if ((rc = es_synth_generate(ctx, fam, &o, &set)) == ES_OK) {
         if ((rc = es_synth_subdivide(ctx, &set, (int)subdiv)) == ES_OK &&
             (rc = es_synth_write(ctx, &set, dir)) == ES_OK)
-            printf("%s: %lld meshes, %lld vertices, %lld faces -> %s/manifest.csv\n",
+            printf("%s: %lld meshes, %lld vertices, %lld faces -> %s%smanifest.csv\n",
                    es_synth_family_name(fam), (long long)set.nmembers, (long long)set.nverts,
-                   (long long)set.nfaces, dir);
+                   (long long)set.nfaces, dir, dir[strlen(dir) - 1] == '/' ? "" : "/");
         es_synth_set_clear(ctx, &set);
     }
     int ret = rc == ES_OK ? CLI_OK : cli_fail(verb, ctx, rc);
