@@ -7,7 +7,8 @@
  * the closure energy), and the RMS ratio is asserted <= 1e-5 and printed:
  * the issue asks for 1e-6, reached on three of these meshes with this seed
  * (8.7e-8 to 8.6e-7) but 1.5e-6 on the spacetime face, and 5.4e-8 to
- * 3.4e-6 over three seeds on six meshes (bench_noisy_roundtrip). The
+ * 3.4e-6 over three seeds on six meshes (bench_noisy_roundtrip). With up
+ * to 300 refinement iterations the facecap face is asserted <= 1e-6. The
  * refinement ends at stationary points with a non-zero residual there: a
  * dense eigen-decomposition of the full Hessian at the finger's end point
  * has no negative eigenvalue, so it is a local minimum, not a saddle.
@@ -24,7 +25,7 @@
 
 #include <edgespace/edgespace.h>
 
-static void trip(es_ctx *ctx, const char *data, const char *file, int closed)
+static void trip(es_ctx *ctx, const char *data, const char *file, int closed, int long_refine)
 {
     char p[8400];
     es_meshdata md;
@@ -66,6 +67,23 @@ static void trip(es_ctx *ctx, const char *data, const char *file, int closed)
             if (closed && !level)
                 ES_CHECK_MSG(rms <= 1e-6 * diag, "%s: noise %g: vertex rms %g x diag", file, sigma,
                              rms / diag);
+            /* given the iterations, an open mesh realizes its lengths to the
+             * issue's 1e-6 from 0.05 rad too (facecap: 48-89 refinement
+             * iterations to ~1e-15 over three seeds in bench_noisy_roundtrip
+             * long; the spacetime and face-study faces crawl there, 0.9e-6 to
+             * 2e-6 after 200) */
+            if (level && long_refine) {
+                es_embed_opts o;
+                es_embed_opts_init(&o);
+                o.refine_max_iter = 300;
+                o.refine_rtol = 1e-12;
+                o.refine_tol = 1e-9;
+                ES_CHECK_OK(ctx, es_embed_solve(emb, len, 0, al, NULL, &o, out, &r));
+                fprintf(stderr, "%s noise %g rad, up to 300 refinement iterations: rms ratio %.3g "
+                        "after %lld\n", file, sigma, r.rms_ratio, (long long)r.refine_iters);
+                ES_CHECK_MSG(r.rms_ratio <= 1e-6, "%s: noise %g, long refinement: rms ratio %g",
+                             file, sigma, r.rms_ratio);
+            }
         }
         free(len), free(al), free(out);
     }
@@ -81,10 +99,10 @@ int main(void)
     ES_TEST_BEGIN();
     if (!data) ES_TEST_SKIP("../shared/data absent");
     if (es_ctx_new(&ctx) != ES_OK) return 1;
-    trip(ctx, data, "goast_finger/finger0.obj", 1);
-    trip(ctx, data, "goast_cactus/cactus0.obj", 1);
-    trip(ctx, data, "facecap_arkit/neutral.obj", 0);
-    trip(ctx, data, "goast_spacetime_faces/disgust.obj", 0);
+    trip(ctx, data, "goast_finger/finger0.obj", 1, 0);
+    trip(ctx, data, "goast_cactus/cactus0.obj", 1, 0);
+    trip(ctx, data, "facecap_arkit/neutral.obj", 0, 1);
+    trip(ctx, data, "goast_spacetime_faces/disgust.obj", 0, 0);
     es_ctx_free(ctx);
     ES_TEST_END();
 }
