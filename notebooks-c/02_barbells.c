@@ -140,7 +140,6 @@ static int heatmaps(notebook *nb, const shapes *s, const char *stem, const char 
         hs.colorbar_label = "distance";
         if ((rc = es_plot_heatmap(nb->ctx, &hs, nb_path(nb, "%s", file), NULL)) != ES_OK)
             return nb_fail(nb, rc, "heat map");
-        nb_output(nb, file);
     }
     return 0;
 }
@@ -181,8 +180,9 @@ static int barbells(notebook *nb, double *ratio_proc, double *ratio_len)
     if (from_positions(nb, &s, set.nmembers, set.nverts, set.nfaces, set.faces, xyz)) goto done;
     if (align_and_compare(nb, &s, 0)) goto done;
     nb_p(nb, "%lld barbells (%lld vertices, %lld edges each): sphere-like and cube-like ends, "
-         "bars of %lld lengths from 1 to 6 (the bulbs have radius 1).",
-         (long long)s.n, (long long)s.V, (long long)s.E, (long long)nlen);
+         "bars of %lld lengths from %g to %g (the bulbs have radius 1).",
+         (long long)s.n, (long long)s.V, (long long)s.E, (long long)nlen,
+         atof(set.labels[3 * 0 + 2]), atof(set.labels[3 * (nlen - 1) + 2]));
     if (!(f = nb_csv_open(nb, "barbells_pairs.csv",
                           "bar_length,d_procrustes,d_lengths,d_procrustes_rel,d_lengths_rel")))
         goto done;
@@ -245,14 +245,17 @@ static int barbells(notebook *nb, double *ratio_proc, double *ratio_len)
         es_render_mesh rm[4];
         es_render_spec rs;
         int64_t pick[4] = {0, nlen, nlen - 1, 2 * nlen - 1};
+        char plabel[4][64];
         double *pos = malloc(sizeof(double) * (size_t)(3 * s.V * 4));
         if (!pos) goto done;
         es_render_spec_init(&rs);
         for (int i = 0; i < 4; i++) {
             es_procrustes_to_xyz(s.V, s.cfg + pick[i] * 3 * s.V, pos + i * 3 * s.V);
+            snprintf(plabel[i], sizeof plabel[i], "%s ends, bar %g",
+                     pick[i] < nlen ? "sphere" : "cube", atof(set.labels[3 * pick[i] + 2]));
             memset(&rm[i], 0, sizeof rm[i]);
             rm[i] = (es_render_mesh){.nverts = s.V, .nfaces = s.F, .xyz = pos + i * 3 * s.V,
-                                     .faces = set.faces, .label = s.ids[pick[i]]};
+                                     .faces = set.faces, .label = plabel[i]};
         }
         rs.nmeshes = 4;
         rs.meshes = rm;
@@ -365,9 +368,9 @@ static int load_faces(notebook *nb, shapes *s, const char **what)
         es_synth_set_clear(nb->ctx, &set);
         *what = "synthetic faces";
         nb_input(nb, "labelled set", "synthetic face family, %lld subjects", (long long)so.n);
-        nb_p(nb, "> **Data: synthetic.** `../shared/data/face-study` was not found, so the "
-             "labelled set is the project's synthetic face family (%lld subjects x {neutral, "
-             "happy, angry}).", (long long)so.n);
+        nb_p(nb, "> **Data: synthetic.** `../shared/data/face-study` was not found (or "
+             "`--synthetic` was given), so the labelled set is the project's synthetic face "
+             "family (%lld subjects x {neutral, happy, angry}).", (long long)so.n);
     }
     if (nb->failed) goto done;
     for (int64_t i = 0; i < n; i++)
@@ -400,7 +403,7 @@ static int labelled(notebook *nb, double *p_len)
 
     memset(&s, 0, sizeof s);
     nb_step(nb, "labelled set: faces by expression in both spaces");
-    nb_h(nb, 2, "(b) A real labelled set: faces by expression");
+    nb_h(nb, 2, "(b) A labelled set: faces by expression");
     if (load_faces(nb, &s, &what) || align_and_compare(nb, &s, nb->small ? 199 : 999))
         goto done;
     {

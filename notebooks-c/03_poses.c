@@ -39,7 +39,7 @@ typedef struct study {
     es_mesh *mesh;
     double *xa, *xb;          /* 3V: the two poses (B rigidly aligned to A) */
     char id_a[128], id_b[128];
-    int z_up;
+    int up_axis;              /* stored up axis: 1 = +y (the cat), 2 = +z (the cactus), 0 = auto */
     int64_t nt;               /* frames, including both ends */
     double *t;                /* nt */
     double *frames;           /* 3V x nt embedded frames */
@@ -125,7 +125,7 @@ static int load(notebook *nb, study *s)
                  "the farthest of the first %lld poses from A in scaled edge-length distance "
                  "(%.3g).", dir, s->id_a, s->id_b, (long long)nmax, sqrt(bestd));
         nb_input(nb, "dataset", "%s", dataset);
-        s->z_up = !is_cat;
+        s->up_axis = is_cat ? 1 : 2;
         free(la);
         free(lb);
         es_manifest_free(nb->ctx, m);
@@ -158,9 +158,10 @@ static int load(notebook *nb, study *s)
         if (rc != ES_OK) return nb_fail(nb, rc, "synthetic tubes");
         s->E = es_mesh_nedges(s->mesh);
         nb_input(nb, "dataset", "es_synth tube-closed, 0 and 180 degrees");
-        nb_p(nb, "> **Data: synthetic.** `../shared/data/goast_cactus` was not found, so the "
-             "two poses are the project's closed bent tube (`es_synth` \"tube-closed\"), "
-             "straight (A) and bent by 180 degrees (B).");
+        nb_p(nb, "> **Data: synthetic.** Neither `sumner_cat_poses` nor `goast_cactus` was "
+             "found under the data folder (or `--synthetic` was given), so the two poses are "
+             "the project's closed bent tube (`es_synth` \"tube-closed\"), straight (A) and "
+             "bent by 180 degrees (B).");
     }
     return 0;
 }
@@ -308,14 +309,14 @@ static int report(notebook *nb, study *s)
     rs.height = 320;
     /* one camera for all frames: the automatic view of the last (most bent)
      * frame, whose principal axes are well defined (a straight tube's are
-     * not); the cactus is stored z-up */
+     * not); the cat is stored y-up, the cactus z-up */
     if ((rc = es_render_auto_view(nb->ctx, s->V, s->frames + 3 * s->V * (s->nt - 1), s->F,
                                   es_mesh_faces(s->mesh), rs.view, rs.up)) != ES_OK)
         return nb_fail(nb, rc, "camera");
     rs.has_view = rs.has_up = 1;
-    if (s->z_up) {
-        rs.up[0] = rs.up[1] = 0;
-        rs.up[2] = 1;
+    if (s->up_axis) {
+        rs.up[0] = rs.up[1] = rs.up[2] = 0;
+        rs.up[s->up_axis] = 1;
     }
     rs.title = "Embedded frames of the edge-length interpolation";
     if ((rc = es_render(nb->ctx, &rs, nb_path(nb, "frames.png"), NULL)) != ES_OK)
