@@ -59,6 +59,7 @@ struct es_store {
     bool is_new;           /* created by es_store_create, not yet published */
     bool broken;           /* a write failed half-way: never commit */
     struct stat orig;      /* identity of the original when it was copied */
+    struct stat opened;    /* identity of the file the in-memory rows came from */
     unsigned tmp_counter;
     int64_t nrows, nverts, nfaces, nedges;
     es_topology_kind kind;
@@ -718,6 +719,12 @@ static es_status open_impl(es_ctx *ctx, const char *path, es_store_mode mode, es
     s->file = -1;
     s->mode = mode;
     if (!(s->path = es__strdup(ctx, path))) { rc = ES_ENOMEM; goto fail; }
+    /* Before opening: if another writer replaces the file in between, the
+     * first write sees a different identity and refuses (never stale rows). */
+    if (stat(path, &s->opened) != 0) {
+        rc = es__fail(ctx, ES_EIO, "store: cannot open '%s': %s", path, strerror(errno));
+        goto fail;
+    }
     fapl = file_access();
     s->file = H5Fopen(path, H5F_ACC_RDONLY, fapl);
     close_id(fapl);
@@ -899,6 +906,17 @@ static es_status begin_write(es_store *s)
     clean_stale(s->path);
     if (!(s->work = temp_name(s))) return ES_ENOMEM;
     if ((rc = copy_file(ctx, s->path, s->work, &s->orig))) goto fail;
+    if (s->orig.st_ino != s->opened.st_ino || s->orig.st_dev != s->opened.st_dev ||
+        s->orig.st_size != s->opened.st_size ||
+        s->orig.st_mtim.tv_sec != s->opened.st_mtim.tv_sec ||
+        s->orig.st_mtim.tv_nsec != s->opened.st_mtim.tv_nsec) {
+        /* Rows, ids and columns in memory are those of the file we opened;
+         * writing them onto another writer's newer store would corrupt it. */
+        unlink(s->work);
+        rc = es__fail(ctx, ES_EIO, "store: '%s' was changed by another writer since it was "
+                      "opened; nothing written", s->path);
+        goto fail;
+    }
     H5Fclose(s->file);
     fapl = file_access();
     s->file = H5Fopen(s->work, H5F_ACC_RDWR, fapl);
@@ -969,6 +987,7 @@ static es_status commit_impl(es_ctx *ctx, es_store *s)
             goto fail;
         }
     }
+    if (stat(s->path, &s->opened) != 0) memset(&s->opened, 0, sizeof s->opened);
     if ((dir = path_dir(ctx, s->path))) {
         fsync_path(ctx, dir, true);
         es__free(ctx, dir);

@@ -108,6 +108,44 @@ static void test_select_quoted(es_ctx *ctx, const char *dir)
     es_store_abort(s);
 }
 
+/* Two writers on one store: the one whose rows in memory are older than
+ * the file (another writer committed since it opened) is refused at its
+ * first write, and the other's commit survives intact. */
+static void test_stale_writer(es_ctx *ctx, const char *path)
+{
+    es_store *a = NULL, *b = NULL;
+    es_provenance prov = {"test", NULL, -1, NULL};
+    double v[2] = {1, 2};
+    ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_WRITE, &a));
+    ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_WRITE, &b));
+    if (!a || !b) goto done;
+    ES_CHECK_OK(ctx, es_store_result_begin(ctx, b, "mean", "by_b", &prov));
+    ES_CHECK_OK(ctx, es_store_put_vector(ctx, b, "mean/by_b/v", v, 2));
+    ES_CHECK_OK(ctx, es_store_commit(ctx, b));
+    ES_CHECK_FAILS(ctx, es_store_result_begin(ctx, a, "mean", "by_a", &prov), ES_EIO,
+                   "changed by another writer");
+    es_store_abort(a);
+    a = NULL;
+    es_store_close(b);
+    b = NULL;
+    ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_READ, &b));
+    if (b) {
+        ES_CHECK(es_store_has(b, "mean/by_b/v") && !es_store_has(b, "mean/by_a"));
+        /* a handle that committed may write again: its own commit is not
+         * another writer's */
+        es_store_close(b);
+        b = NULL;
+        ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_WRITE, &b));
+        ES_CHECK_OK(ctx, es_store_result_begin(ctx, b, "mean", "again1", &prov));
+        ES_CHECK_OK(ctx, es_store_commit(ctx, b));
+        ES_CHECK_OK(ctx, es_store_result_begin(ctx, b, "mean", "again2", &prov));
+        ES_CHECK_OK(ctx, es_store_commit(ctx, b));
+    }
+done:
+    if (a) es_store_abort(a);
+    if (b) es_store_close(b);
+}
+
 int main(void)
 {
     es_ctx *ctx = NULL;
@@ -384,6 +422,7 @@ int main(void)
         es_store_close(s);
         s = NULL;
     }
+    test_stale_writer(ctx, path);
     es_ctx_free(ctx);
     ES_TEST_END();
 }
