@@ -53,6 +53,12 @@ static es_status slurp(es_ctx *ctx, const char *path, char **buf, size_t *len)
         ES_FAIL(ctx, ES_EIO, "landmarks: error reading '%s'", path);
     }
     b[n] = 0;
+    /* A UTF-8 byte order mark (Excel's "CSV UTF-8", Windows editors) is not
+     * data: drop it, as the manifest and mesh readers do. */
+    if (n >= 3 && !memcmp(b, "\xEF\xBB\xBF", 3)) {
+        memmove(b, b + 3, n - 2);
+        n -= 3;
+    }
     *buf = b;
     *len = n;
     return ES_OK;
@@ -539,6 +545,15 @@ es_status es_landmarks_read_csv(es_ctx *ctx, const char *path, const char *speci
             es__free(ctx, order);
             rc = es__fail(ctx, ES_EFORMAT, "landmarks: %s:%lld: landmark '%s' is not a positive "
                           "integer", file, (long long)row->line, row->f[cl]);
+            goto fail;
+        }
+        if (lmk > t.nrows) {
+            /* every specimen needs rows for landmarks 1..k: k <= the rows */
+            es__free(ctx, order);
+            rc = es__fail(ctx, ES_ERANGE, "landmarks: %s: %lld landmarks in %dD are too many "
+                          "(largest landmark number) for %lld data rows (line %lld)",
+                          file, (long long)lmk, d, (long long)(t.nrows - 1),
+                          (long long)row->line);
             goto fail;
         }
         k = lmk > k ? lmk : k;

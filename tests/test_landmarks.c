@@ -132,6 +132,10 @@ static void test_size_overflow(es_ctx *ctx)
         {"big.csv", "specimen,landmark,x,y\na,1,0,0\na,2,1,0\na,72057594037927936,0,1\n",
          "landmarks: big.csv: 72057594037927936 landmarks in 2D are too many (largest "
          "landmark number)"},
+        /* allocatable but absurd: more landmarks than the file has rows */
+        {"many.csv", "specimen,landmark,x,y\na,1,0,0\na,2,1,0\na,99999999999,0,1\n",
+         "landmarks: many.csv: 99999999999 landmarks in 2D are too many (largest landmark "
+         "number) for 3 data rows (line 4)"},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         char path[4200];
@@ -146,6 +150,31 @@ static void test_size_overflow(es_ctx *ctx)
         ES_CHECK(lm == NULL);
         remove(path);
     }
+    rmdir(dir);
+}
+
+/* A UTF-8 byte order mark (Excel's "CSV UTF-8") is not data. */
+static void test_bom(es_ctx *ctx)
+{
+    const char *dir = es_test_tmpdir("landmarks-bom");
+    char path[4200];
+    es_landmarks *lm = NULL;
+    snprintf(path, sizeof path, "%s/bom.csv", dir);
+    es_test_write_file(path, "\xef\xbb\xbfspecimen,landmark,x,y\na,1,1,2\na,2,3,4\n");
+    ES_CHECK_OK(ctx, es_landmarks_read_csv(ctx, path, NULL, &lm));
+    if (lm) ES_CHECK(lm->n == 1 && lm->k == 2 && lm->d == 2 && lm->xyz[3] == 4);
+    es_landmarks_free(lm);
+    lm = NULL;
+    remove(path);
+    snprintf(path, sizeof path, "%s/bom.tps", dir);
+    es_test_write_file(path, "\xef\xbb\xbfLM=2\n1 2\n3 4\nID=a\n");
+    ES_CHECK_OK(ctx, es_landmarks_read_tps(ctx, path, 1, &lm));
+    if (lm)
+        ES_CHECK_MSG(lm->n == 1 && lm->k == 2 && !strcmp(lm->ids[0], "a") && lm->xyz[0] == 1 &&
+                     lm->xyz[3] == 4, "tps: n %lld k %lld id %s", (long long)lm->n,
+                     (long long)lm->k, lm->ids[0]);
+    es_landmarks_free(lm);
+    remove(path);
     rmdir(dir);
 }
 
@@ -221,6 +250,7 @@ int main(void)
     test_tps(ctx);
     test_csv(ctx);
     test_size_overflow(ctx);
+    test_bom(ctx);
     test_shared(ctx);
     test_alloc_sweep();
     es_ctx_free(ctx);
