@@ -70,6 +70,16 @@ es_status es_export_lengths_csv(es_ctx *ctx, es_store *s, const int64_t *rows, i
     }
     if ((rc = es_store_read_edges(ctx, s, edges)) || (rc = es_store_read_scales(ctx, s, scales)))
         goto done;
+    {
+        /* Never truncate the store itself (export STORE --lengths STORE). */
+        struct stat so, sp;
+        if (stat(es_store_path(s), &so) == 0 && stat(path, &sp) == 0 &&
+            so.st_dev == sp.st_dev && so.st_ino == sp.st_ino) {
+            rc = es__fail(ctx, ES_EINVAL, "export: '%s' is the store itself; not overwriting it",
+                          path);
+            goto done;
+        }
+    }
     if (!(f = fopen(path, "w"))) {
         rc = es__fail(ctx, ES_EIO, "export: cannot create '%s': %s", path, strerror(errno));
         goto done;

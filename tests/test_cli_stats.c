@@ -312,6 +312,11 @@ int main(void)
     ES_CHECK(run(out, sizeof out, "project study.h5 --pca p new.obj s2_happy --csv proj.csv") == 0);
     ES_CHECK(count_lines("proj.csv") == 3);
     ES_CHECK(run(out, sizeof out, "project study.h5 --pca p nothing_here") == 1);
+    /* a failure part way leaves no partial table */
+    ES_CHECK(run(out, sizeof out, "project study.h5 --pca p s2_happy nothing_here --csv part.csv")
+             == 1);
+    snprintf(path, sizeof path, "%s/part.csv", dir);
+    ES_CHECK_MSG(access(path, F_OK) != 0, "project left %s behind", path);
 
     /* figures */
     ES_CHECK(run(out, sizeof out, "plot-pca study.h5 --pca p --pcs 1,2 --color expression "

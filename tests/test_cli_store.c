@@ -121,6 +121,20 @@ int main(void)
     }
     ES_RUN(&r, dir, "export", store, "--lengths", csv, "--select", "colour=red");
     ES_CHECK(r.status == 1 && strstr(r.err, "colour"));
+    /* the store given as the output (by mistake) is refused and left as it was,
+     * and so for a stats command's --csv */
+    {
+        size_t n0;
+        char *before = es_test_slurp(store, &n0);
+        ES_RUN(&r, dir, "export", store, "--lengths", store);
+        ES_CHECK_MSG(r.status == 1 && strstr(r.err, "store itself"), "export onto the store: %d %s",
+                     r.status, r.err);
+        ES_RUN(&r, dir, "mean", store, "--no-store", "--csv", store);
+        ES_CHECK_MSG(r.status == 1 && strstr(r.err, "HDF5"), "mean --csv onto the store: %d %s",
+                     r.status, r.err);
+        ES_CHECK(before && es_test_same_bytes(store, before, n0));
+        free(before);
+    }
     snprintf(outdir, sizeof outdir, "%s/out", dir);
     ES_RUN(&r, dir, "export", store, "--meshes", outdir);
     ES_CHECK(r.status == 0);

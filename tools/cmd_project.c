@@ -126,6 +126,8 @@ int cmd_project(int argc, char **argv)
     ret = CLI_OK;
 done:
     if (f && csv && stats_csv_close("project", f, csv)) ret = CLI_FAIL;
+    /* A failed run leaves no partial table behind. */
+    if (f && csv && ret != CLI_OK && strcmp(csv, "-")) remove(csv);
     free(x);
     free(scores);
     es_free(ctx, rows);
