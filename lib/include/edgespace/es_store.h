@@ -16,8 +16,9 @@
  * the first write), and es_store_commit (also run by es_store_close)
  * replaces the store with it by an atomic rename() after fsync. A process
  * that fails or is killed before the commit leaves the store byte-for-byte
- * as it was; its stale working copy is removed by the next writer. A commit
- * refuses (ES_EIO) if the store was replaced by another writer meanwhile.
+ * as it was; its stale working copy is removed by the next writer. The
+ * first write refuses (ES_EIO) if another writer replaced the store since
+ * this handle opened it, and a commit if it was replaced since the copy.
  */
 #ifndef EDGESPACE_ES_STORE_H
 #define EDGESPACE_ES_STORE_H
