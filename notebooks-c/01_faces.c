@@ -689,11 +689,13 @@ static void self_check(notebook *nb, const study *s)
      * length). The mean neutral face is an average of realizable faces and
      * must embed an order of magnitude below that noise (1e-3); the
      * extrapolated points (mean + difference, +-2 sd) need not be exactly
-     * realizable, and must embed within twice that noise (2e-2). */
+     * realizable (some break the triangle inequality), and must embed within
+     * the bar set for interpolated points, 0.5% RMS (measured: 3e-4 on
+     * face-study, 1.2e-5 on the synthetic faces). */
     {
         char name[128];
         snprintf(name, sizeof name, "worst embedding RMS ratio (%s)", s->pt_name[worst_p]);
-        nb_check(nb, name, worst, "<", 2e-2);
+        nb_check(nb, name, worst, "<", 5e-3);
     }
     nb_check(nb, "mean neutral face RMS ratio", s->rep[0].rms_ratio, "<", 1e-3);
 }
