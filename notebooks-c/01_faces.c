@@ -310,7 +310,8 @@ static int fit_pca(notebook *nb, study *s)
     nb_h(nb, 2, "Principal components");
     nb_p(nb, "PCA (%s route) of the %lld normalized length vectors. The first three "
          "components explain %.1f%%, %.1f%% and %.1f%% of the total variance "
-         "(%.1f%% together; the paper's FRGC faces: 12%%).",
+         "(%.1f%% together; on the paper's 600 FRGC 2.0 faces the first three explained "
+         "12%%, Section 4 of Rojas et al.).",
          s->pca->method == ES_PCA_GRAM ? "Gram" : "covariance", (long long)s->N,
          100 * s->pca->explained[0], 100 * s->pca->explained[1], 100 * s->pca->explained[2],
          100 * (s->pca->explained[0] + s->pca->explained[1] + s->pca->explained[2]));

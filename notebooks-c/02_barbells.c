@@ -112,7 +112,10 @@ static int align_and_compare(notebook *nb, shapes *s, int64_t permutations)
                           (es_mat){s->cfg, 3 * s->V, s->n, 3 * s->V}, s->group,
                           s->group ? s->ngroups : 0, &co, &s->cmp);
     if (rc != ES_OK) return nb_fail(nb, rc, "comparison study");
-    nb_p(nb, "Full GPA of %lld shapes converged in %lld iterations (RMS rho %.3g).",
+    nb_p(nb, "Full GPA of %lld shapes converged in %lld iterations (RMS rho %.3g). Procrustes "
+         "distances here are Euclidean distances between the aligned configurations in the "
+         "data's units: full GPA keeps the inputs' total size (as R's procGPA does), so they "
+         "are not the unit-size Procrustes distance of the textbooks.",
          (long long)s->n, (long long)gr.iterations, gr.rmsrho);
     return 0;
 }
@@ -125,6 +128,7 @@ static int heatmaps(notebook *nb, const shapes *s, const char *stem, const char 
     const double *d[2] = {s->cmp->d_len, s->cmp->d_proc};
     const char *space[2] = {"lengths", "procrustes"};
     const char *nice[2] = {"scaled edge-length distance", "Procrustes distance"};
+    const char *unit[2] = {"distance (lengths scaled to sum 1)", "distance (data units)"};
     for (int k = 0; k < 2; k++) {
         es_heatmap_spec_init(&hs);
         snprintf(file, sizeof file, "%s_%s.png", stem, space[k]);
@@ -137,7 +141,7 @@ static int heatmaps(notebook *nb, const shapes *s, const char *stem, const char 
             hs.row_labels = (const char *const *)s->ids;
             hs.col_labels = (const char *const *)s->ids;
         }
-        hs.colorbar_label = "distance";
+        hs.colorbar_label = unit[k];
         if ((rc = es_plot_heatmap(nb->ctx, &hs, nb_path(nb, "%s", file), NULL)) != ES_OK)
             return nb_fail(nb, rc, "heat map");
     }
@@ -419,6 +423,18 @@ static int labelled(notebook *nb, double *p_len)
                c->groups_proc.p);
         nb_p(nb, "R^2: the share of the squared distances that lies between the expression "
              "means (a one-factor test on the distance matrix, permutations of the labels).");
+        /* the verdict on the expected finding, from the numbers above */
+        nb_p(nb, "**Finding.** %s; the two spaces %s (Spearman %.2f between their distances, "
+             "%.0f%% shared nearest neighbours).",
+             c->groups_len.p < 0.05 && c->groups_proc.p < 0.05
+                 ? "Both spaces separate the expressions (p < 0.05)"
+                 : c->groups_len.p < 0.05 ? "Only the edge-length space separates the expressions "
+                                            "(p < 0.05); the Procrustes space does not"
+                 : c->groups_proc.p < 0.05 ? "Only the Procrustes space separates the "
+                                             "expressions (p < 0.05)"
+                                           : "Neither space separates the expressions at p < 0.05",
+             c->mantel_rho >= 0.5 ? "broadly agree" : "agree only weakly", c->mantel_rho,
+             100 * c->nn_agreement);
         *p_len = c->groups_len.p;
         nb_table(nb, "groups|edge-length distance of means|p|Procrustes distance of means|p");
         for (int64_t a = 0; a < s.ngroups; a++)

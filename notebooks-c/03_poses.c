@@ -24,8 +24,9 @@
  * relative edge error, for the embedded frames and for the vertex
  * interpolation (1 - t) x_A + t x_B (B rigidly aligned to A first).
  *
- * Expected finding. The embedded frames follow l(t) closely (the paper:
- * RMS ratio below 1%, worst edge 15% on the arm); vertex interpolation is
+ * Expected finding. The embedded frames follow l(t) closely (the paper,
+ * Fig. 12: RMS ratio about 0.75%, worst edge 15% on the arm); vertex
+ * interpolation is
  * exact at the ends but loses length in the middle where parts rotate.
  */
 #include "notebook.h"

@@ -64,8 +64,10 @@ static int load(notebook *nb, study *s)
         if ((rc = es_landmarks_read_csv(nb->ctx, lp, sp, &s->lm)) != ES_OK)
             return nb_fail(nb, rc, "reading the apes");
         s->what = "apes";
-        nb_p(nb, "**Data:** `landmarks_rshapes/apes` from `%s`: great-ape skulls, 8 "
-             "landmarks in 2D, groups by species and sex (R package shapes).", dir);
+        nb_p(nb, "**Data:** `landmarks_rshapes/apes` from `%s`: great-ape skulls, %lld "
+             "landmarks in %dD, groups by species and sex (R package shapes: gor = gorilla, "
+             "pan = chimpanzee, pongo = orang-utan; f = female, m = male).", dir,
+             (long long)s->lm->k, s->lm->d);
     } else {
         es_synth_opts so;
         es_synth_set set;
@@ -103,8 +105,8 @@ static int load(notebook *nb, study *s)
             return nb_fail(nb, rc, "reading the synthetic landmarks");
         s->what = "synthetic face landmarks";
         nb_input(nb, "dataset", "12 vertices of es_synth face, %lld subjects", (long long)so.n);
-        nb_p(nb, "> **Data: synthetic.** `../shared/data/landmarks_rshapes` was not found, so "
-             "the landmarks are 12 vertices of each mesh of the project's synthetic face family "
+        nb_p(nb, "> **Data: synthetic.** `../shared/data/landmarks_rshapes` was not found (or "
+             "`--synthetic` was given), so the landmarks are 12 vertices of each mesh of the project's synthetic face family "
              "(%lld subjects x {neutral, happy, angry}; 3D), grouped by expression.",
              (long long)so.n);
     }
@@ -379,8 +381,9 @@ int main(int argc, char **argv)
     nb_p(&nb, "**Question.** Do GPA and a permutation test find the groups of a landmark set, "
          "and do the scaled edge lengths of a triangulation of the landmarks agree?");
     nb_p(&nb, "**Expected.** Both spaces find the groups (p < 0.05) and their distances "
-         "agree closely: a triangulation of a few landmarks is rigid and determines the "
-         "configuration.");
+         "agree closely: a triangulation of a few landmarks in 2D is rigid and determines the "
+         "configuration (in 3D a planar triangulation has fewer edges than the 3k - 6 degrees "
+         "of freedom and does not).");
     if (!load(&nb, &s) && !procrustes(&nb, &s, perms) && !edge_lengths(&nb, &s, perms)) {
         verdicts(&nb, &s, perms);
         nb_step(&nb, "self-check");
