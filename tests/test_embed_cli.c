@@ -111,6 +111,42 @@ int main(void)
                  r.err);
     ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out, "--init", "mean");
     ES_CHECK_MSG(r.status == 0 && strstr(r.out, "circular mean"), "embed mean: %s", r.err);
+    /* from a given mesh: it is the alignment reference too, so a mesh moved
+     * rigidly brings the output along; a mesh of another topology is refused */
+    {
+        char moved[4300], other[4300];
+        int64_t nv = 0;
+        double *x;
+        snprintf(p, sizeof p, "%s/mesh-2.obj", dir);
+        snprintf(moved, sizeof moved, "%s/moved.obj", dir);
+        x = es_test_obj_positions(p, &nv);
+        if (x) {
+            int64_t V = 16 * 8, F = 2 * V;
+            double *xt = malloc(3 * (size_t)V * sizeof *xt);
+            int64_t *faces = malloc(3 * (size_t)F * sizeof *faces);
+            es_test_torus(16, 8, 2, xt, faces);
+            for (int64_t i = 0; i < 3 * nv; i++) x[i] += i % 3 == 0 ? 10.0 : 0.0;
+            ES_CHECK(nv == V && es_test_write_obj(moved, V, x, F, faces) == 0);
+            snprintf(pat, sizeof pat, "mesh:%s", moved);
+            ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out, "--init", pat,
+                   "--no-store");
+            ES_CHECK_MSG(r.status == 0 && strstr(r.out, "init: mesh "), "embed mesh: %d %s",
+                         r.status, r.err);
+            int64_t nout = 0;
+            double *y = es_test_obj_positions(out, &nout), d = 0;
+            for (int64_t i = 0; y && nout == nv && i < 3 * nv; i++)
+                d = fmax(d, fabs(y[i] - x[i]));
+            ES_CHECK_MSG(y && nout == nv && d < 1e-6, "embed from a moved mesh: %g off it", d);
+            free(y), free(x), free(xt), free(faces);
+        }
+        snprintf(other, sizeof other, "%s/tri.obj", dir);
+        es_test_write_file(other, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+        snprintf(pat, sizeof pat, "mesh:%s", other);
+        ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out, "--init", pat);
+        ES_CHECK_MSG(r.status == 1 && strstr(r.err, "do not match the store's topology"),
+                     "embed from another topology: %d %s", r.status, r.err);
+        snprintf(pat, sizeof pat, "%s/seq_%%02d.obj", dir);
+    }
     ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out);
     ES_CHECK_MSG(r.status == 0 && strstr(r.out, "nearest row mesh-2"), "embed nearest: %s", r.out);
     {

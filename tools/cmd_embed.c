@@ -24,8 +24,10 @@ static const char usage[] =
     "                       datasets-spec/point-syntax.md)\n"
     "  -o, --output OUT     mesh file (.obj, .ply, .off)\n"
     "  -i, --init HOW       nearest (default: the stored row nearest in edge-length\n"
-    "                       distance), row:ID, or mean[:FILTER] (circular mean of the\n"
-    "                       dihedrals of the selected rows)\n"
+    "                       distance), row:ID, mean[:FILTER] (circular mean of the\n"
+    "                       dihedrals of the selected rows), or mesh:FILE (a mesh with\n"
+    "                       the store's face list: its dihedrals, and the output is\n"
+    "                       aligned to it)\n"
     "  -s, --scale S        sum of edge lengths of the output (default: the point's\n"
     "                       scale, else the mean scale of the store)\n"
     "  -n, --name NAME      result name in the store (default: the output's base name)\n"
@@ -45,6 +47,32 @@ static char *base_name(const char *path, char *buf, size_t n)
     snprintf(buf, n, "%s", b ? b + 1 : path);
     if ((dot = strrchr(buf, '.')) && dot != buf) *dot = 0;
     return buf;
+}
+
+/* --init mesh:FILE: the positions of a mesh with the store's face list.
+ * Prints its own message on failure. */
+static es_status read_init_mesh(es_ctx *ctx, const es_mesh *mesh, const char *path, double *xyz)
+{
+    es_meshdata md;
+    char want[17], got[17];
+    es_status rc = es_meshdata_read(ctx, path, ES_FORMAT_AUTO, &md);
+    if (rc != ES_OK) {
+        fprintf(stderr, "edgespace embed: --init: %s\n", es_ctx_errmsg(ctx));
+        return rc;
+    }
+    es_mesh_fingerprint(mesh, want);
+    es_faces_fingerprint(md.nverts, md.nfaces, md.faces, got);
+    if (strcmp(want, got)) {
+        fprintf(stderr, "edgespace embed: --init '%s': %lld vertices and %lld faces do not match "
+                "the store's topology (%lld vertices, %lld faces, same face list required)\n",
+                path, (long long)md.nverts, (long long)md.nfaces,
+                (long long)es_mesh_nverts(mesh), (long long)es_mesh_nfaces(mesh));
+        rc = ES_EMISMATCH;
+    } else {
+        memcpy(xyz, md.xyz, 3 * (size_t)md.nverts * sizeof *xyz);
+    }
+    es_meshdata_clear(ctx, &md);
+    return rc;
 }
 
 int cmd_embed(int argc, char **argv)
@@ -193,12 +221,15 @@ have_target:
         initrow = sel[0];
         snprintf(initdesc, sizeof initdesc, "circular mean of dihedrals of %lld rows (%s)",
                  (long long)nsel, init);
+    } else if (!strncmp(init, "mesh:", 5)) {
+        if ((rc = read_init_mesh(ctx, mesh, init + 5, init_xyz))) goto done;
+        snprintf(initdesc, sizeof initdesc, "mesh %s", init + 5);
     } else {
         rc = ES_EINVAL;
-        cli_usage_error("embed", "--init wants nearest, row:ID or mean[:FILTER]");
+        cli_usage_error("embed", "--init wants nearest, row:ID, mean[:FILTER] or mesh:FILE");
         goto done;
     }
-    if ((rc = es_store_read_positions(ctx, s, initrow, init_xyz))) goto fail;
+    if (initrow >= 0 && (rc = es_store_read_positions(ctx, s, initrow, init_xyz))) goto fail;
     if (paper) {
         opts.dihedral_mode = ES_EMBED_DIHEDRAL_ON;
         opts.refine_max_iter = 0;
@@ -211,7 +242,7 @@ have_target:
            es_embed_report_format(&rep, text, sizeof text));
     if (store_it) {
         es_provenance prov = {NULL, initrow >= 0 && !sel ? &initrow : sel,
-                              sel ? nsel : 1, NULL};
+                              sel ? nsel : initrow >= 0 ? 1 : 0, NULL};
         char *cmd = cli_command_line(argc, argv), params[256];
         snprintf(params, sizeof params, "point=%s; scale=%.17g", point, scale);
         prov.command = cmd ? cmd : "edgespace embed";
