@@ -36,6 +36,7 @@
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <stdint.h>
 #include <time.h>
@@ -973,21 +974,31 @@ static es_status commit_impl(es_ctx *ctx, es_store *s)
             unlink(s->work);
         }
     } else {
+        /* The identity check and the rename are one step for every writer of
+         * this folder (an advisory lock on the folder): otherwise another
+         * commit landing between them would be replaced unseen. */
+        int dfd = -1;
+        if ((dir = path_dir(ctx, s->path)) && (dfd = open(dir, O_RDONLY | O_DIRECTORY)) >= 0)
+            while (flock(dfd, LOCK_EX) != 0 && errno == EINTR) {
+            }
         if (stat(s->path, &now) != 0 || now.st_ino != s->orig.st_ino ||
             now.st_dev != s->orig.st_dev || now.st_size != s->orig.st_size ||
             now.st_mtim.tv_sec != s->orig.st_mtim.tv_sec ||
             now.st_mtim.tv_nsec != s->orig.st_mtim.tv_nsec) {
             rc = es__fail(ctx, ES_EIO, "store: '%s' was changed by another writer since it "
                           "was opened; nothing written", s->path);
-            goto fail;
-        }
-        if (rename(s->work, s->path) != 0) {
+        } else if (rename(s->work, s->path) != 0) {
             rc = es__fail(ctx, ES_EIO, "store: cannot replace '%s': %s", s->path,
                           strerror(errno));
-            goto fail;
+        } else if (stat(s->path, &s->opened) != 0) {
+            memset(&s->opened, 0, sizeof s->opened);
         }
+        if (dfd >= 0) close(dfd);   /* releases the lock */
+        es__free(ctx, dir);
+        dir = NULL;
+        if (rc != ES_OK) goto fail;
     }
-    if (stat(s->path, &s->opened) != 0) memset(&s->opened, 0, sizeof s->opened);
+    if (s->is_new && stat(s->path, &s->opened) != 0) memset(&s->opened, 0, sizeof s->opened);
     if ((dir = path_dir(ctx, s->path))) {
         fsync_path(ctx, dir, true);
         es__free(ctx, dir);
