@@ -129,22 +129,42 @@ static int heatmaps(notebook *nb, const shapes *s, const char *stem, const char 
     const char *space[2] = {"lengths", "procrustes"};
     const char *nice[2] = {"scaled edge-length distance", "Procrustes distance"};
     const char *unit[2] = {"distance (lengths scaled to sum 1)", "distance (data units)"};
+    /* shapes ordered by group (stable), so that a group shows as a block */
+    int64_t *order = malloc((size_t)s->n * sizeof *order), m = 0;
+    const char *labels[12];
+    double *sorted = malloc((size_t)(s->n * s->n) * sizeof *sorted);
+    if (!order || !sorted) {
+        free(order), free(sorted);
+        return nb_fail(nb, ES_ENOMEM, "heat map");
+    }
+    for (int64_t g = 0; g < (s->group ? s->ngroups : 1); g++)
+        for (int64_t i = 0; i < s->n; i++)
+            if (!s->group || s->group[i] == g) order[m++] = i;
+    for (int64_t i = m; i < s->n; i++) order[i] = i;   /* no group: as they come */
     for (int k = 0; k < 2; k++) {
         es_heatmap_spec_init(&hs);
         snprintf(file, sizeof file, "%s_%s.png", stem, space[k]);
-        snprintf(title, sizeof title, "%s: %s", what, nice[k]);
+        snprintf(title, sizeof title, "%s: %s%s", what, nice[k],
+                 s->group ? " (ordered by group)" : "");
         hs.frame.title = title;
         hs.frame.width = 560;
         hs.frame.height = 520;
-        hs.values = (es_mat){(double *)d[k], s->n, s->n, s->n};
+        for (int64_t j = 0; j < s->n; j++)
+            for (int64_t i = 0; i < s->n; i++)
+                sorted[i + j * s->n] = d[k][order[i] + order[j] * s->n];
+        hs.values = (es_mat){sorted, s->n, s->n, s->n};
         if (s->n <= 12) {
-            hs.row_labels = (const char *const *)s->ids;
-            hs.col_labels = (const char *const *)s->ids;
+            for (int64_t i = 0; i < s->n; i++) labels[i] = s->ids[order[i]];
+            hs.row_labels = labels;
+            hs.col_labels = labels;
         }
         hs.colorbar_label = unit[k];
-        if ((rc = es_plot_heatmap(nb->ctx, &hs, nb_path(nb, "%s", file), NULL)) != ES_OK)
+        if ((rc = es_plot_heatmap(nb->ctx, &hs, nb_path(nb, "%s", file), NULL)) != ES_OK) {
+            free(order), free(sorted);
             return nb_fail(nb, rc, "heat map");
+        }
     }
+    free(order), free(sorted);
     return 0;
 }
 
@@ -486,8 +506,9 @@ static int labelled(notebook *nb, double *p_len)
              "other (data: faces_pairs.csv)");
     if (heatmaps(nb, &s, "faces", "faces")) goto done;
     nb_image(nb, "faces_lengths.png", "Scaled edge-length distances between all faces "
-             "(order: manifest)");
-    nb_image(nb, "faces_procrustes.png", "Procrustes distances between all faces");
+             "(ordered by expression)");
+    nb_image(nb, "faces_procrustes.png", "Procrustes distances between all faces (ordered by "
+             "expression)");
     err = 0;
 done:
     free(x);
