@@ -149,6 +149,32 @@ int main(void)
     }
     ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out);
     ES_CHECK_MSG(r.status == 0 && strstr(r.out, "nearest row mesh-2"), "embed nearest: %s", r.out);
+    /* per-vertex residuals as CSV, drawn by render --scalars */
+    {
+        char res[4300], png[4300];
+        size_t n = 0;
+        snprintf(res, sizeof res, "%s/res.csv", dir);
+        snprintf(png, sizeof png, "%s/res.png", dir);
+        ES_RUN(&r, dir, "embed", store, "--point", "0.5*row:mesh-0 + 0.5*row:mesh-1", "-o", out,
+               "--residuals", res, "--no-store");
+        ES_CHECK_MSG(r.status == 0 && strstr(r.out, "per-vertex residuals"), "--residuals: %s",
+                     r.err);
+        char *text = es_test_slurp(res, &n), *line = text ? strchr(text, '\n') : NULL;
+        int rows = 0, bad = 0;
+        ES_CHECK(text && !strncmp(text, "closure,edge_error\n", 19));
+        while (line && line[1]) {
+            char *end;
+            double a = strtod(line + 1, &end), b = end && *end == ',' ? strtod(end + 1, &end) : -1;
+            bad += !(a >= 0 && b >= 0 && isfinite(a) && isfinite(b));
+            rows++;
+            line = strchr(line + 1, '\n');
+        }
+        ES_CHECK_MSG(rows == 16 * 8 && bad == 0, "residual CSV: %d rows, %d bad", rows, bad);
+        free(text);
+        ES_RUN(&r, dir, "render", out, "--scalars", res, "--width", "64", "--height", "64", "-o",
+               png);
+        ES_CHECK_MSG(r.status == 0 && access(png, F_OK) == 0, "render --scalars: %s", r.err);
+    }
     {
         es_ctx *ctx;
         es_store *s = NULL;
