@@ -50,6 +50,7 @@ struct es_embedder {
     /* work, sized once */
     double *ang, *theta, *C, *G, *len, *alpha, *alpha_try, *alpha_keep, *xyz, *xyz_try, *xyz_best;
     double *init_copy;   /* init_xyz when the caller passes the output array itself */
+    int64_t progress_total; /* progress steps of the solve running (0: none) */
     double *ltarget, *lpath, *res, *grad, *diag, *pcg, *jw, *fanwork, *fanr, *fanth, *fanal, *vclos, *verr;
     int have_vertex_results;
     int64_t nfactor;        /* numeric factorizations in the last solve */
@@ -968,6 +969,10 @@ static es_status stage_refine(es_embedder *emb, const double *L, double *xyz, in
             lambda *= 10.0;
         }
         (*iters)++;
+        if (emb->progress_total) {   /* stages 1-3 were steps 1 and 2 */
+            int64_t done = 3 + (int64_t)it, total = emb->progress_total;
+            es__progress(emb->ctx, "embedding", done < total ? done : total - 1, total);
+        }
         if (verbose)
             es__info(emb->ctx, "embed: refine %d cost %.6g -> %.6g lambda %.3g rho %.3g pcg %d",
                      it, c, c_new, lambda, rho, used);
@@ -1183,6 +1188,9 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
         int mode = o->dihedral_mode;
         if (emb->nvar == 0 || o->dihedral_max_iter <= 0) mode = ES_EMBED_DIHEDRAL_OFF;
         rep.closure_stage1 = rep.closure_before;
+        /* one bar on a terminal: stage 1, stages 2-3, each refinement iteration */
+        emb->progress_total = 3 + (o->refine_max_iter > 0 ? o->refine_max_iter : 0);
+        es__progress(ctx, "embedding", 0, emb->progress_total);
         if (mode != ES_EMBED_DIHEDRAL_OFF) {
             double lambda1 = 1e-3;
             int first = mode == ES_EMBED_DIHEDRAL_AUTO ? 1 : o->dihedral_max_iter;
@@ -1205,7 +1213,9 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
             }
             rep.t_dihedral = now_s() - t1;
         }
+        es__progress(ctx, "embedding", 1, emb->progress_total);
         if ((rc = linear_stages(emb, alpha, L, xyz, &rep)) != ES_OK) return rc;
+        es__progress(ctx, "embedding", 2, emb->progress_total);
         quick_metrics(emb, xyz, L, &rep.rms_ratio_linear, &mx);
         t1 = now_s();
         if (o->refine_max_iter > 0 &&
@@ -1213,6 +1223,8 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
                                o->verbose, &rep.refine_iters)) != ES_OK)
             return rc;
         rep.t_refine = now_s() - t1;
+        es__progress(ctx, "embedding", emb->progress_total, emb->progress_total);
+        emb->progress_total = 0;
         have_dihedral_result = 1;
     }
     /* continuation path */
@@ -1322,6 +1334,10 @@ es_status es_embed_solve(es_embedder *emb, const double *target, double scale,
     }
 #endif
     rc = embed_solve(emb, target, scale, init_alpha, init_xyz, opts, xyz, report);
+    if (emb && emb->progress_total) {   /* failed part way: close the bar */
+        es__progress(emb->ctx, "embedding", emb->progress_total, emb->progress_total);
+        emb->progress_total = 0;
+    }
 #ifdef ES_HAVE_BLAS_THREADS
     if (had > 0) openblas_set_num_threads(had);
 #endif

@@ -446,6 +446,53 @@ static void test_align_in_place(es_ctx *ctx)
     tm_free(&s);
 }
 
+/* Progress: one "embedding" bar per solve, from 0 to its total, never
+ * backwards, ending at the total (which clears a terminal's bar) also when
+ * the refinement stops early. */
+typedef struct {
+    int64_t calls, first, last, total, backwards;
+} progress_log;
+
+static void on_progress(void *ud, const char *what, int64_t done, int64_t total)
+{
+    progress_log *p = ud;
+    if (strcmp(what, "embedding")) return;
+    if (p->calls++ == 0) p->first = done;
+    if (done < p->last) p->backwards++;
+    p->last = done;
+    p->total = total;
+}
+
+static void test_progress(es_ctx *ctx)
+{
+    tm_mesh s = icosphere(2);
+    es_mesh *mesh = NULL;
+    es_embedder *emb = NULL;
+    ES_CHECK_OK(ctx, es_mesh_new(ctx, s.nv, s.nf, s.faces, s.xyz, &mesh));
+    if (mesh) ES_CHECK_OK(ctx, es_embedder_new(ctx, mesh, &emb));
+    if (emb) {
+        int64_t ne = es_mesh_nedges(mesh);
+        double *len = malloc((size_t)ne * sizeof *len), *al = malloc((size_t)ne * sizeof *al);
+        double *out = malloc(3 * (size_t)s.nv * sizeof *out);
+        progress_log p = {0, 0, 0, 0, 0};
+        es_embed_report r;
+        ES_CHECK_OK(ctx, es_edge_lengths(ctx, mesh, s.xyz, len));
+        ES_CHECK_OK(ctx, es_dihedral_angles(ctx, mesh, s.xyz, al));
+        for (int64_t e = 0; e < ne; e++) len[e] *= 1 + 0.05 * sin((double)e);
+        es_ctx_set_progress(ctx, on_progress, &p);
+        ES_CHECK_OK(ctx, es_embed_solve(emb, len, 0, al, NULL, NULL, out, &r));
+        es_ctx_set_progress(ctx, NULL, NULL);
+        ES_CHECK_MSG(p.calls >= 4 && p.first == 0 && p.backwards == 0 && p.last == p.total &&
+                     p.total == 3 + 12, "progress: %lld calls, %lld -> %lld of %lld, %lld back",
+                     (long long)p.calls, (long long)p.first, (long long)p.last,
+                     (long long)p.total, (long long)p.backwards);
+        free(len), free(al), free(out);
+    }
+    es_embedder_free(emb);
+    es_mesh_free(mesh);
+    tm_free(&s);
+}
+
 /* es_kabsch_align_parts: two parts moved by different rigid motions come
  * back each onto its reference; a vertex of part -1 stays where it is. */
 static void test_kabsch_parts(es_ctx *ctx)
@@ -683,6 +730,7 @@ int main(void)
     test_components(ctx);
     test_kabsch_parts(ctx);
     test_align_in_place(ctx);
+    test_progress(ctx);
     test_blas_threads(ctx);
     test_interp(ctx);
     test_garbage(ctx);
