@@ -409,41 +409,65 @@ static void test_components(es_ctx *ctx)
     tm_free(&a), tm_free(&b);
 }
 
+/* The level-2 icosphere with an embedder, its own lengths and dihedrals. */
+typedef struct {
+    tm_mesh s;
+    es_mesh *mesh;
+    es_embedder *emb;
+    int64_t ne;
+    double *len, *al, *out;   /* E, E, 3V */
+} sphere_case;
+
+static int sphere_open(es_ctx *ctx, sphere_case *c)
+{
+    memset(c, 0, sizeof *c);
+    c->s = icosphere(2);
+    ES_CHECK_OK(ctx, es_mesh_new(ctx, c->s.nv, c->s.nf, c->s.faces, c->s.xyz, &c->mesh));
+    if (c->mesh) ES_CHECK_OK(ctx, es_embedder_new(ctx, c->mesh, &c->emb));
+    if (!c->emb) return 0;
+    c->ne = es_mesh_nedges(c->mesh);
+    c->len = malloc((size_t)c->ne * sizeof *c->len);
+    c->al = malloc((size_t)c->ne * sizeof *c->al);
+    c->out = malloc(3 * (size_t)c->s.nv * sizeof *c->out);
+    ES_CHECK_OK(ctx, es_edge_lengths(ctx, c->mesh, c->s.xyz, c->len));
+    ES_CHECK_OK(ctx, es_dihedral_angles(ctx, c->mesh, c->s.xyz, c->al));
+    return 1;
+}
+
+static void sphere_close(sphere_case *c)
+{
+    free(c->len), free(c->al), free(c->out);
+    es_embedder_free(c->emb);
+    es_mesh_free(c->mesh);
+    tm_free(&c->s);
+}
+
 /* The alignment reference may be the output array itself, as when a
  * sequence aligns each frame to the last: the result is the same as with a
  * separate copy (the solve must not align the output to itself). */
 static void test_align_in_place(es_ctx *ctx)
 {
-    tm_mesh s = icosphere(2);
-    es_mesh *mesh = NULL;
-    es_embedder *emb = NULL;
-    ES_CHECK_OK(ctx, es_mesh_new(ctx, s.nv, s.nf, s.faces, s.xyz, &mesh));
-    if (mesh) ES_CHECK_OK(ctx, es_embedder_new(ctx, mesh, &emb));
-    if (emb) {
-        int64_t ne = es_mesh_nedges(mesh), n3 = 3 * s.nv;
-        double *len = malloc((size_t)ne * sizeof *len), *al = malloc((size_t)ne * sizeof *al);
-        double *moved = malloc((size_t)n3 * sizeof *moved), *out = malloc((size_t)n3 * sizeof *out);
-        double c = cos(1.1), sn = sin(1.1), d = 0, diag = es_bbox_diagonal(s.nv, s.xyz);
+    sphere_case c;
+    if (sphere_open(ctx, &c)) {
+        int64_t n3 = 3 * c.s.nv;
+        double *moved = malloc((size_t)n3 * sizeof *moved);
+        double co = cos(1.1), sn = sin(1.1), d = 0, diag = es_bbox_diagonal(c.s.nv, c.s.xyz);
         es_embed_report r;
         /* the reference turned and shifted: an output aligned to it is it */
-        for (int64_t v = 0; v < s.nv; v++) {
-            const double *p = s.xyz + 3 * v;
-            moved[3 * v] = c * p[0] - sn * p[1] + 3;
-            moved[3 * v + 1] = sn * p[0] + c * p[1] - 2;
+        for (int64_t v = 0; v < c.s.nv; v++) {
+            const double *p = c.s.xyz + 3 * v;
+            moved[3 * v] = co * p[0] - sn * p[1] + 3;
+            moved[3 * v + 1] = sn * p[0] + co * p[1] - 2;
             moved[3 * v + 2] = p[2] + 1;
         }
-        memcpy(out, moved, (size_t)n3 * sizeof *out);
-        ES_CHECK_OK(ctx, es_edge_lengths(ctx, mesh, s.xyz, len));
-        ES_CHECK_OK(ctx, es_dihedral_angles(ctx, mesh, s.xyz, al));
-        ES_CHECK_OK(ctx, es_embed_solve(emb, len, 0, al, out, NULL, out, &r));
-        for (int64_t i = 0; i < n3; i++) d += (out[i] - moved[i]) * (out[i] - moved[i]);
-        ES_CHECK_MSG(sqrt(d / (double)s.nv) <= 1e-9 * diag, "in place: %g x diag off the reference",
-                     sqrt(d / (double)s.nv) / diag);
-        free(len), free(al), free(moved), free(out);
+        memcpy(c.out, moved, (size_t)n3 * sizeof *c.out);
+        ES_CHECK_OK(ctx, es_embed_solve(c.emb, c.len, 0, c.al, c.out, NULL, c.out, &r));
+        for (int64_t i = 0; i < n3; i++) d += (c.out[i] - moved[i]) * (c.out[i] - moved[i]);
+        ES_CHECK_MSG(sqrt(d / (double)c.s.nv) <= 1e-9 * diag,
+                     "in place: %g x diag off the reference", sqrt(d / (double)c.s.nv) / diag);
+        free(moved);
     }
-    es_embedder_free(emb);
-    es_mesh_free(mesh);
-    tm_free(&s);
+    sphere_close(&c);
 }
 
 /* Progress: one "embedding" bar per solve, from 0 to its total, never
@@ -465,32 +489,20 @@ static void on_progress(void *ud, const char *what, int64_t done, int64_t total)
 
 static void test_progress(es_ctx *ctx)
 {
-    tm_mesh s = icosphere(2);
-    es_mesh *mesh = NULL;
-    es_embedder *emb = NULL;
-    ES_CHECK_OK(ctx, es_mesh_new(ctx, s.nv, s.nf, s.faces, s.xyz, &mesh));
-    if (mesh) ES_CHECK_OK(ctx, es_embedder_new(ctx, mesh, &emb));
-    if (emb) {
-        int64_t ne = es_mesh_nedges(mesh);
-        double *len = malloc((size_t)ne * sizeof *len), *al = malloc((size_t)ne * sizeof *al);
-        double *out = malloc(3 * (size_t)s.nv * sizeof *out);
+    sphere_case c;
+    if (sphere_open(ctx, &c)) {
         progress_log p = {0, 0, 0, 0, 0};
         es_embed_report r;
-        ES_CHECK_OK(ctx, es_edge_lengths(ctx, mesh, s.xyz, len));
-        ES_CHECK_OK(ctx, es_dihedral_angles(ctx, mesh, s.xyz, al));
-        for (int64_t e = 0; e < ne; e++) len[e] *= 1 + 0.05 * sin((double)e);
+        for (int64_t e = 0; e < c.ne; e++) c.len[e] *= 1 + 0.05 * sin((double)e);
         es_ctx_set_progress(ctx, on_progress, &p);
-        ES_CHECK_OK(ctx, es_embed_solve(emb, len, 0, al, NULL, NULL, out, &r));
+        ES_CHECK_OK(ctx, es_embed_solve(c.emb, c.len, 0, c.al, NULL, NULL, c.out, &r));
         es_ctx_set_progress(ctx, NULL, NULL);
         ES_CHECK_MSG(p.calls >= 4 && p.first == 0 && p.backwards == 0 && p.last == p.total &&
                      p.total == 3 + 12, "progress: %lld calls, %lld -> %lld of %lld, %lld back",
                      (long long)p.calls, (long long)p.first, (long long)p.last,
                      (long long)p.total, (long long)p.backwards);
-        free(len), free(al), free(out);
     }
-    es_embedder_free(emb);
-    es_mesh_free(mesh);
-    tm_free(&s);
+    sphere_close(&c);
 }
 
 /* es_kabsch_align_parts: two parts moved by different rigid motions come
