@@ -7,6 +7,36 @@
 
 #include <edgespace/edgespace.h>
 
+/* The frames dir/<stem>_<i>.obj (i zero-padded to `width` digits) of a
+ * sequence do not jump: each is already where the best rigid motion onto
+ * the one before would put it. */
+static void check_frames_do_not_jump(const char *dir, const char *stem, int width, int nframes)
+{
+    es_ctx *ctx = NULL;
+    es_meshdata prev = {0}, cur = {0};
+    char name[64], p[4400];
+    ES_CHECK(es_ctx_new(&ctx) == ES_OK);
+    for (int i = 0; ctx && i < nframes; i++) {
+        double raw = 0, fitted;
+        snprintf(name, sizeof name, "%s_%0*d.obj", stem, width, i);
+        snprintf(p, sizeof p, "%s/%s", dir, name);
+        ES_CHECK_OK(ctx, es_meshdata_read(ctx, p, ES_FORMAT_OBJ, &cur));
+        if (i > 0 && cur.nverts == prev.nverts) {
+            for (int64_t k = 0; k < 3 * cur.nverts; k++)
+                raw += (cur.xyz[k] - prev.xyz[k]) * (cur.xyz[k] - prev.xyz[k]);
+            raw = sqrt(raw / (double)cur.nverts);
+            ES_CHECK_OK(ctx, es_kabsch_align(ctx, cur.nverts, cur.xyz, prev.xyz, NULL, &fitted));
+            ES_CHECK_MSG(raw <= fitted * (1 + 1e-6) + 1e-9, "%s: %g from the frame before, %g "
+                         "after a rigid fit", name, raw, fitted);
+        }
+        es_meshdata_clear(ctx, &prev);
+        prev = cur;
+        memset(&cur, 0, sizeof cur);
+    }
+    if (ctx) es_meshdata_clear(ctx, &prev);
+    es_ctx_free(ctx);
+}
+
 int main(void)
 {
     static es_test_out r;
@@ -45,30 +75,26 @@ int main(void)
         snprintf(p, sizeof p, "%s/seq_%02d.obj", dir, i);
         ES_CHECK_MSG(access(p, F_OK) == 0, "missing %s", p);
     }
-    /* the frames do not jump: each is already where the best rigid motion
-     * onto the one before would put it */
+    check_frames_do_not_jump(dir, "seq", 2, 3);
+    /* between points that are not both rows: frames exist, do not jump,
+     * are stored; too far an extrapolation is refused naming t */
     {
-        es_ctx *ctx = NULL;
-        es_meshdata prev = {0}, cur = {0};
-        ES_CHECK(es_ctx_new(&ctx) == ES_OK);
-        for (int i = 0; ctx && i < 3; i++) {
-            double raw = 0, fitted;
-            snprintf(p, sizeof p, "%s/seq_%02d.obj", dir, i);
-            ES_CHECK_OK(ctx, es_meshdata_read(ctx, p, ES_FORMAT_OBJ, &cur));
-            if (i > 0 && cur.nverts == prev.nverts) {
-                for (int64_t k = 0; k < 3 * cur.nverts; k++)
-                    raw += (cur.xyz[k] - prev.xyz[k]) * (cur.xyz[k] - prev.xyz[k]);
-                raw = sqrt(raw / (double)cur.nverts);
-                ES_CHECK_OK(ctx, es_kabsch_align(ctx, cur.nverts, cur.xyz, prev.xyz, NULL, &fitted));
-                ES_CHECK_MSG(raw <= fitted * (1 + 1e-6) + 1e-9, "frame %d: %g from frame %d, %g "
-                             "after a rigid fit", i, raw, i - 1, fitted);
-            }
-            es_meshdata_clear(ctx, &prev);
-            prev = cur;
-            memset(&cur, 0, sizeof cur);
-        }
-        if (ctx) es_meshdata_clear(ctx, &prev);
-        es_ctx_free(ctx);
+        snprintf(pat, sizeof pat, "%s/walk_%%d.obj", dir);
+        ES_RUN(&r, dir, "interp", store, "--from", "mean", "--to", "row:mesh-2", "--steps", "3",
+               "-o", pat, "--name", "walk");
+        ES_CHECK_MSG(r.status == 0 && strstr(r.out, "t = 0.5") && strstr(r.out, "walk_NN"),
+                     "interp between points: %d %s %s", r.status, r.out, r.err);
+        check_frames_do_not_jump(dir, "walk", 1, 3);
+        ES_RUN(&r, dir, "info", store);
+        ES_CHECK_MSG(strstr(r.out, "walk_02"), "walk not stored: %s", r.out);
+        ES_RUN(&r, dir, "interp", store, "--from", "mean", "--to", "row:mesh-2", "--steps", "2",
+               "--t1", "400", "-o", pat, "--no-store");
+        ES_CHECK_MSG(r.status == 1 && strstr(r.err, "at t = 400"), "far extrapolation: %d %s",
+                     r.status, r.err);
+        ES_RUN(&r, dir, "interp", store, "--from", "mean[nothing=1]", "--to", "row:mesh-2",
+               "-o", pat, "--no-store");
+        ES_CHECK_MSG(r.status == 1 && strstr(r.err, "nothing"), "bad point: %d %s", r.status,
+                     r.err);
     }
     /* %% in the pattern is a literal percent sign */
     snprintf(pat, sizeof pat, "%s/pct_%%d%%%%.obj", dir);

@@ -6,7 +6,6 @@
 #include "stats_cli.h"
 
 #include <getopt.h>
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -105,8 +104,8 @@ int cmd_embed(int argc, char **argv)
         {"residuals", required_argument, NULL, 'r'},
         {NULL, 0, NULL, 0}};
     const char *point = NULL, *out = NULL, *init = "nearest", *name = NULL, *residuals = NULL;
-    char namebuf[256], path[512], initdesc[512], text[1024];
-    double scale = 0, *target = NULL, *xyz = NULL, *init_xyz = NULL, *alpha = NULL, *scales = NULL;
+    char namebuf[256], initdesc[512], text[1024];
+    double scale = 0, *target = NULL, *xyz = NULL, *init_xyz = NULL, *alpha = NULL;
     int c, store_it = 1, paper = 0;
     int64_t refine_iters;
     es_ctx *ctx;
@@ -116,7 +115,7 @@ int cmd_embed(int argc, char **argv)
     es_embed_opts opts;
     es_embed_report rep;
     es_status rc = ES_OK;
-    int64_t ne, nv, nrows, initrow = -1, *sel = NULL, nsel = 0;
+    int64_t ne, nv, initrow = -1, *sel = NULL, nsel = 0;
     es_embed_opts_init(&opts);
     optind = 1;
     while ((c = getopt_long(argc, argv, "p:o:i:s:n:h", longopts, NULL)) != -1) {
@@ -150,74 +149,20 @@ int cmd_embed(int argc, char **argv)
         goto fail;
     ne = es_mesh_nedges(mesh);
     nv = es_mesh_nverts(mesh);
-    nrows = es_store_nrows(s);
     target = malloc((size_t)ne * sizeof *target);
     xyz = malloc(3 * (size_t)nv * sizeof *xyz);
     init_xyz = malloc(3 * (size_t)nv * sizeof *init_xyz);
     alpha = malloc((size_t)ne * sizeof *alpha);
-    scales = malloc((size_t)(nrows + 1) * sizeof *scales);
-    if (!target || !xyz || !init_xyz || !alpha || !scales) {
+    if (!target || !xyz || !init_xyz || !alpha) {
         rc = ES_ENOMEM;
         goto fail;
     }
-    if ((rc = es_store_read_scales(ctx, s, scales))) goto fail;
-    /* the target */
-    if (!strncmp(point, "row:", 4)) {
-        int64_t r = es_store_find_row(s, point + 4);
-        if (r < 0) {
-            fprintf(stderr, "edgespace embed: no row '%s' in the store\n", point + 4);
-            rc = ES_ENOTFOUND;
-            goto done;
-        }
-        if ((rc = es_store_read_lengths(ctx, s, r, 1, (es_mat){target, ne, 1, ne}))) goto fail;
-        if (scale == 0) scale = scales[r];
-    } else {
-        double *v = NULL;
-        int64_t n = 0;
-        snprintf(path, sizeof path, "point/%s/lengths", point);
-        if (!es_store_has(s, path)) {
-            /* not a stored point: an expression (es_point.h syntax) */
-            es_point_info info;
-            if ((rc = es_analysis_point(ctx, s, NULL, point, NULL, scale, "edgespace embed", &v,
-                                        &info)))
-                goto fail;
-            memcpy(target, v, (size_t)ne * sizeof *target);
-            es_free(ctx, v);
-            if (scale == 0 && isfinite(info.scale) && info.scale > 0) scale = info.scale;
-            if (scale == 0)
-                for (int64_t i = 0; i < nrows; i++) scale += scales[i] / (double)nrows;
-            goto have_target;
-        }
-        if ((rc = es_store_get_vector(ctx, s, path, &v, &n))) goto fail;
-        if (n != ne) {
-            fprintf(stderr, "edgespace embed: point '%s' has %lld lengths, the store's "
-                    "topology %lld edges\n", point, (long long)n, (long long)ne);
-            es_free(ctx, v);
-            rc = ES_EMISMATCH;
-            goto done;
-        }
-        memcpy(target, v, (size_t)ne * sizeof *target);
-        es_free(ctx, v);
-        snprintf(path, sizeof path, "point/%s/scale", point);
-        if (scale == 0 && es_store_has(s, path)) {
-            if ((rc = es_store_get_vector(ctx, s, path, &v, &n))) goto fail;
-            if (n >= 1 && v[0] > 0) scale = v[0];
-            es_free(ctx, v);
-        }
-        if (scale == 0) {
-            for (int64_t i = 0; i < nrows; i++) scale += scales[i] / (double)nrows;
-        }
+    /* the target: at the point's own scale unless --scale gives one */
+    {
+        double own;
+        if ((rc = stats_point_lengths("embed", ctx, s, point, ne, target, &own))) goto done;
+        if (scale == 0) scale = own;
     }
-have_target:
-    /* the target may leave the positive orthant (extrapolation): the
-     * embedding refuses non-positive lengths, so say which */
-    for (int64_t e = 0; e < ne; e++)
-        if (!(target[e] > 0)) {
-            fprintf(stderr, "edgespace embed: the point has length %g at edge %lld: it is "
-                    "outside edge-length space (not realizable)\n", target[e], (long long)e);
-            rc = ES_EINVAL;
-            goto done;
-        }
     /* the initialization */
     if (!strcmp(init, "nearest")) {
         double d;
@@ -290,7 +235,7 @@ done:
     if (rc) es_store_abort(s);
     else es_store_close(s);
     es_free(ctx, sel);
-    free(target), free(xyz), free(init_xyz), free(alpha), free(scales);
+    free(target), free(xyz), free(init_xyz), free(alpha);
     es_ctx_free(ctx);
     return rc ? CLI_FAIL : CLI_OK;
 }

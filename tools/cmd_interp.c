@@ -3,6 +3,7 @@
  * the quality reports (es_interp_embed). */
 #include "cli.h"
 #include "commands.h"
+#include "stats_cli.h"
 
 #include <ctype.h>
 #include <getopt.h>
@@ -11,17 +12,21 @@
 #include <string.h>
 
 static const char usage[] =
-    "usage: edgespace interp STORE --from row:A --to row:B [--steps N] -o PATTERN\n"
+    "usage: edgespace interp STORE --from A --to B [--steps N] -o PATTERN\n"
     "       edgespace interp STORE --weights \"0.2*row:a + 0.3*row:b + 0.5*row:c\" -o OUT\n"
     "\n"
     "Interpolate stored shapes in edge-length space (weighted mean of normalized\n"
     "lengths at the weighted mean scale; dihedrals averaged on the circle as the\n"
-    "start) and embed each result as a mesh. Weights outside [0, 1] extrapolate.\n"
-    "Sequences are aligned frame to frame. Reports are printed and stored under\n"
-    "/analysis/embed/NAME_<i> (per-vertex residuals included).\n"
+    "start) and embed each result as a mesh. Weights or t outside [0, 1]\n"
+    "extrapolate. Between two points that are not both rows (a stored point, a\n"
+    "mean, an expression) each frame starts from the previous frame's dihedrals\n"
+    "(the first from the nearest stored row). Sequences are aligned frame to\n"
+    "frame. Reports are printed and stored under /analysis/embed/NAME_<i>\n"
+    "(per-vertex residuals included).\n"
     "\n"
-    "  -f, --from row:A      first shape (t = 0)\n"
-    "  -t, --to row:B        second shape (t = 1)\n"
+    "  -f, --from A          first shape (t = 0): row:ID, a stored point's name, or\n"
+    "                        an expression such as \"mean[expression=neutral]\"\n"
+    "  -t, --to B            second shape (t = 1), the same kinds\n"
     "  -k, --steps N         frames from t0 to t1 inclusive (default 9)\n"
     "      --t0 T, --t1 T    range of t (default 0 and 1)\n"
     "  -w, --weights EXPR    w1*row:a + w2*row:b + ... (two or more rows)\n"
@@ -122,6 +127,116 @@ static void base_name(const char *path, char *buf, size_t n)
     if (!*buf) snprintf(buf, n, "interp");
 }
 
+/* Frame i of `steps`: its mesh file (the pattern expanded), its report on
+ * stdout after `head`, and, when storing, the result NAME (NAME_<i> in a
+ * sequence) with the provenance and the initialization's description. */
+static es_status emit_frame(es_ctx *ctx, es_store *s, const es_mesh *mesh, es_embedder *emb,
+                            const char *out, const char *name, int64_t steps, int64_t i,
+                            const char *head, const double *target, const double *xyz,
+                            const es_embed_report *rep, const es_provenance *prov,
+                            const char *init)
+{
+    char fname[1024], rname[300], text[1024];
+    es_status rc;
+    if (steps > 1) {
+        expand_pattern(out, (int)i, fname, sizeof fname);
+        snprintf(rname, sizeof rname, "%s_%02d", name, (int)i);
+    } else {
+        snprintf(fname, sizeof fname, "%s", out);
+        snprintf(rname, sizeof rname, "%s", name);
+    }
+    if ((rc = es_mesh_write(ctx, fname, ES_FORMAT_AUTO, mesh, xyz, NULL))) return rc;
+    printf("%s: %s\n%s", fname, head, es_embed_report_format(rep, text, sizeof text));
+    if (!prov) return ES_OK;
+    return es_embed_store_result(ctx, s, rname, prov, emb, target, xyz, rep, init);
+}
+
+/* Commit the stored frames and say where they are. */
+static es_status commit_frames(es_ctx *ctx, es_store *s, const char *name, int64_t steps)
+{
+    es_status rc = es_store_commit(ctx, s);
+    if (rc == ES_OK) printf("stored: /analysis/embed/%s%s\n", name, steps > 1 ? "_NN" : "");
+    return rc;
+}
+
+/* --from/--to points that are not both rows (stored points, means,
+ * expressions): frame t embeds (1 - t) a + t b at the scale (1 - t) s_a +
+ * t s_b (lerp in datasets-spec/point-syntax.md), its dihedrals started from
+ * the previous frame (the first from the stored row nearest to it) and
+ * aligned to it, so the sequence does not jump. Prints its own messages;
+ * commits. */
+static es_status interp_points(es_ctx *ctx, es_store *s, const es_mesh *mesh, es_embedder *emb,
+                               const es_embed_opts *opts, const char *from, const char *to,
+                               double t0, double t1, int64_t steps, const char *out,
+                               const char *name, int store_it, int argc, char **argv,
+                               double *res)
+{
+    int64_t ne = es_mesh_nedges(mesh), nv = es_mesh_nverts(mesh);
+    char initd[320], params[1024];
+    double *a = malloc((size_t)ne * sizeof *a), *b = malloc((size_t)ne * sizeof *b);
+    double *v = malloc((size_t)ne * sizeof *v), *start = malloc(3 * (size_t)nv * sizeof *start);
+    double sa, sb;
+    es_status rc = ES_OK;
+    if (!a || !b || !v || !start) {
+        fprintf(stderr, "edgespace interp: out of memory\n");
+        rc = ES_ENOMEM;
+        goto done;
+    }
+    if ((rc = stats_point_lengths("interp", ctx, s, from, ne, a, &sa)) ||
+        (rc = stats_point_lengths("interp", ctx, s, to, ne, b, &sb)))
+        goto done;
+    for (int64_t i = 0; i < steps; i++) {
+        double t = steps == 1 ? t0 : t0 + (t1 - t0) * (double)i / (double)(steps - 1);
+        double scale = (1 - t) * sa + t * sb;
+        es_embed_report rep;
+        for (int64_t e = 0; e < ne; e++) {
+            v[e] = (1 - t) * a[e] + t * b[e];
+            if (!(v[e] > 0)) {
+                fprintf(stderr, "edgespace interp: at t = %.4g the length of edge %lld is %g: "
+                        "outside edge-length space (extrapolated too far)\n", t, (long long)e,
+                        v[e]);
+                rc = ES_EINVAL;
+                goto done;
+            }
+        }
+        if (!(scale > 0)) {
+            fprintf(stderr, "edgespace interp: at t = %.4g the scale is %g\n", t, scale);
+            rc = ES_EINVAL;
+            goto done;
+        }
+        if (i == 0) {
+            int64_t row;
+            double d;
+            if ((rc = es_embed_nearest_row(ctx, s, v, NULL, 0, &row, &d)) ||
+                (rc = es_store_read_positions(ctx, s, row, start)))
+                goto fail;
+            snprintf(initd, sizeof initd, "first frame: nearest row %s; then the previous frame",
+                     es_store_row_id(s, row));
+        }
+        /* from the second frame on, the previous frame (res itself) is both
+         * the start and the alignment reference */
+        if ((rc = es_embed_solve(emb, v, scale, NULL, i ? res : start, opts, res, &rep)))
+            goto fail;
+        {
+            char *cmd = store_it ? cli_command_line(argc, argv) : NULL, head[64];
+            es_provenance prov = {cmd ? cmd : "edgespace interp", NULL, 0, params};
+            snprintf(params, sizeof params, "from=%s; to=%s; t=%.17g", from, to, t);
+            snprintf(head, sizeof head, "t = %.4g", t);
+            rc = emit_frame(ctx, s, mesh, emb, out, name, steps, i, head, v, res, &rep,
+                            store_it ? &prov : NULL, initd);
+            free(cmd);
+            if (rc) goto fail;
+        }
+    }
+    if (store_it && (rc = commit_frames(ctx, s, name, steps))) goto fail;
+    goto done;
+fail:
+    cli_fail("interp", ctx, rc);
+done:
+    free(a), free(b), free(v), free(start);
+    return rc;
+}
+
 int cmd_interp(int argc, char **argv)
 {
     static const struct option longopts[] = {
@@ -133,10 +248,10 @@ int cmd_interp(int argc, char **argv)
         {"refine-iters", required_argument, NULL, 'R'},
         {NULL, 0, NULL, 0}};
     const char *from = NULL, *to = NULL, *weights = NULL, *out = NULL, *name = NULL;
-    char ids[MAX_IN][256], namebuf[256], fname[1024], rname[300], text[1024];
+    char ids[MAX_IN][256], namebuf[256], fname[1024];
     double w[MAX_IN], t0 = 0, t1 = 1, *xyz[MAX_IN] = {0}, *res = NULL, *len = NULL;
     int64_t steps = 9, rows[MAX_IN], nin = 0, nv, ne;
-    int c, store_it = 1;
+    int c, store_it = 1, points = 0;
     int64_t refine_iters;
     es_embed_opts opts;
     es_ctx *ctx;
@@ -183,11 +298,15 @@ int cmd_interp(int argc, char **argv)
                                    "two or more rows");
         steps = 1;
     } else {
-        if (!from || !to || strncmp(from, "row:", 4) || strncmp(to, "row:", 4))
-            return cli_usage_error("interp", "give --from row:A --to row:B, or --weights");
-        snprintf(ids[0], sizeof ids[0], "%s", from + 4);
-        snprintf(ids[1], sizeof ids[1], "%s", to + 4);
-        nin = 2;
+        if (!from || !to)
+            return cli_usage_error("interp", "give --from A --to B, or --weights");
+        if (!strncmp(from, "row:", 4) && !strncmp(to, "row:", 4)) {
+            snprintf(ids[0], sizeof ids[0], "%s", from + 4);
+            snprintf(ids[1], sizeof ids[1], "%s", to + 4);
+            nin = 2;
+        } else {
+            points = 1;   /* points of the space: no meshes to take dihedrals from */
+        }
     }
     if (steps > 1 && expand_pattern(out, 0, fname, sizeof fname))
         return cli_usage_error("interp", "with several frames, --output must be a pattern "
@@ -207,6 +326,11 @@ int cmd_interp(int argc, char **argv)
     if (!res || !len) {
         rc = ES_ENOMEM;
         goto fail;
+    }
+    if (points) {
+        rc = interp_points(ctx, s, mesh, emb, &opts, from, to, t0, t1, steps, out, name,
+                           store_it, argc, argv, res);
+        goto done;
     }
     for (int64_t k = 0; k < nin; k++) {
         if ((rows[k] = es_store_find_row(s, ids[k])) < 0) {
@@ -231,37 +355,28 @@ int cmd_interp(int argc, char **argv)
         /* frames align to the previous frame so that the sequence does not jump */
         if ((rc = es_interp_embed(emb, nin, in, wi, i ? res : NULL, &opts, res, &rep, &info)))
             goto fail;
-        if (steps > 1) {
-            expand_pattern(out, (int)i, fname, sizeof fname);
-            snprintf(rname, sizeof rname, "%s_%02d", name, (int)i);
-        } else {
-            snprintf(fname, sizeof fname, "%s", out);
-            snprintf(rname, sizeof rname, "%s", name);
-        }
-        if ((rc = es_mesh_write(ctx, fname, ES_FORMAT_AUTO, mesh, res, NULL))) goto fail;
-        if (weights) printf("%s: weights", fname);
-        else printf("%s: t = %.4g", fname, t);
-        printf(" (%lld dihedrals wrapped, %lld lengths clamped)\n%s",
-               (long long)info.n_wrapped, (long long)info.n_clamped,
-               es_embed_report_format(&rep, text, sizeof text));
-        if (store_it) {
-            char *cmd = cli_command_line(argc, argv), params[512], initd[64];
+        {
+            char *cmd = store_it ? cli_command_line(argc, argv) : NULL, params[512], head[128];
             es_provenance prov = {cmd ? cmd : "edgespace interp", rows, nin, params};
             int off = 0;
             for (int64_t k = 0; k < nin && off < (int)sizeof params - 40; k++)
                 off += snprintf(params + off, sizeof params - (size_t)off, "%sw[%s]=%.6g",
                                 k ? "; " : "", ids[k], wi[k]);
-            snprintf(initd, sizeof initd, "circular mean of the inputs' dihedrals");
-            if (!(rc = es_interp_targets(ctx, mesh, nin, in, wi, len, NULL, NULL)))
-                rc = es_embed_store_result(ctx, s, rname, &prov, emb, len, res, &rep, initd);
+            if (weights)
+                snprintf(head, sizeof head, "weights (%lld dihedrals wrapped, %lld lengths "
+                         "clamped)", (long long)info.n_wrapped, (long long)info.n_clamped);
+            else
+                snprintf(head, sizeof head, "t = %.4g (%lld dihedrals wrapped, %lld lengths "
+                         "clamped)", t, (long long)info.n_wrapped, (long long)info.n_clamped);
+            /* the stored target: the interpolated lengths */
+            if (!store_it || !(rc = es_interp_targets(ctx, mesh, nin, in, wi, len, NULL, NULL)))
+                rc = emit_frame(ctx, s, mesh, emb, out, name, steps, i, head, len, res, &rep,
+                                store_it ? &prov : NULL, "circular mean of the inputs' dihedrals");
             free(cmd);
             if (rc) goto fail;
         }
     }
-    if (store_it) {
-        if ((rc = es_store_commit(ctx, s))) goto fail;
-        printf("stored: /analysis/embed/%s%s\n", name, steps > 1 ? "_NN" : "");
-    }
+    if (store_it && (rc = commit_frames(ctx, s, name, steps))) goto fail;
     goto done;
 fail:
     cli_fail("interp", ctx, rc);

@@ -3,6 +3,7 @@
 #include "cli.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -86,4 +87,77 @@ int stats_write_edge_csv(const char *verb, es_ctx *ctx, es_store *store, const c
     }
     free(edges);
     return stats_csv_close(verb, f, path) ? CLI_FAIL : CLI_OK;
+}
+
+/* The mean scale of the store's rows: the scale of a point without one. */
+static es_status mean_row_scale(es_ctx *ctx, es_store *store, double *scale)
+{
+    int64_t n = es_store_nrows(store);
+    double *scales = malloc((size_t)(n + 1) * sizeof *scales);
+    es_status rc;
+    if (!scales) return ES_ENOMEM;
+    *scale = 0;
+    if ((rc = es_store_read_scales(ctx, store, scales)) == ES_OK)
+        for (int64_t i = 0; i < n; i++) *scale += scales[i] / (double)n;
+    free(scales);
+    return rc;
+}
+
+es_status stats_point_lengths(const char *verb, es_ctx *ctx, es_store *store, const char *spec,
+                              int64_t ne, double *lengths, double *scale)
+{
+    char path[512];
+    double *v = NULL;
+    int64_t n = 0;
+    es_status rc = ES_OK;
+    *scale = 0;
+    snprintf(path, sizeof path, "point/%s/lengths", spec);
+    if (!strncmp(spec, "row:", 4)) {
+        int64_t r = es_store_find_row(store, spec + 4);
+        if (r < 0) {
+            fprintf(stderr, "edgespace %s: no row '%s' in the store\n", verb, spec + 4);
+            return ES_ENOTFOUND;
+        }
+        double *scales = malloc((size_t)(es_store_nrows(store) + 1) * sizeof *scales);
+        if (!scales) rc = ES_ENOMEM;
+        else if (!(rc = es_store_read_lengths(ctx, store, r, 1, (es_mat){lengths, ne, 1, ne})) &&
+                 !(rc = es_store_read_scales(ctx, store, scales)))
+            *scale = scales[r];
+        free(scales);
+    } else if (es_store_has(store, path)) {   /* a stored point */
+        if (!(rc = es_store_get_vector(ctx, store, path, &v, &n)) && n != ne) {
+            fprintf(stderr, "edgespace %s: point '%s' has %lld lengths, the store's topology "
+                    "%lld edges\n", verb, spec, (long long)n, (long long)ne);
+            es_free(ctx, v);
+            return ES_EMISMATCH;
+        }
+        if (rc == ES_OK) memcpy(lengths, v, (size_t)ne * sizeof *lengths);
+        es_free(ctx, v);
+        v = NULL;
+        snprintf(path, sizeof path, "point/%s/scale", spec);
+        if (rc == ES_OK && es_store_has(store, path) &&
+            !(rc = es_store_get_vector(ctx, store, path, &v, &n)) && n >= 1 && v[0] > 0)
+            *scale = v[0];
+        es_free(ctx, v);
+    } else {   /* an expression (es_point.h syntax) */
+        es_point_info info;
+        if (!(rc = es_analysis_point(ctx, store, NULL, spec, NULL, 0, "edgespace", &v, &info))) {
+            memcpy(lengths, v, (size_t)ne * sizeof *lengths);
+            if (isfinite(info.scale) && info.scale > 0) *scale = info.scale;
+        }
+        es_free(ctx, v);
+    }
+    if (rc == ES_OK && *scale == 0) rc = mean_row_scale(ctx, store, scale);
+    if (rc != ES_OK) {
+        cli_fail(verb, ctx, rc);
+        return rc;
+    }
+    /* beyond the positive orthant (extrapolation) no mesh realizes the point */
+    for (int64_t e = 0; e < ne; e++)
+        if (!(lengths[e] > 0)) {
+            fprintf(stderr, "edgespace %s: the point has length %g at edge %lld: it is outside "
+                    "edge-length space (not realizable)\n", verb, lengths[e], (long long)e);
+            return ES_EINVAL;
+        }
+    return ES_OK;
 }

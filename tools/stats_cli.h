@@ -29,4 +29,13 @@ int64_t *stats_edges(const char *verb, es_ctx *ctx, es_store *store);
 int stats_write_edge_csv(const char *verb, es_ctx *ctx, es_store *store, const char *path,
                          int64_t ncol, const char *const *names, const double *values);
 
+/* The E scale-normalized lengths of a point given on the command line:
+ * row:ID, the name of a stored point (/analysis/point/NAME), or an
+ * expression (datasets-spec/point-syntax.md); *scale gets the point's own
+ * scale, else the mean scale of the store's rows. Non-positive lengths
+ * (extrapolated too far) are an error naming the edge. 0 ok, else the
+ * status, with the message printed. */
+es_status stats_point_lengths(const char *verb, es_ctx *ctx, es_store *store, const char *spec,
+                              int64_t ne, double *lengths, double *scale);
+
 #endif
