@@ -1,6 +1,6 @@
-/* tools/stats_cli.h — glue shared by the statistics commands (mean, pca,
- * diff, project, point, plot): the command line as provenance, CSV output,
- * opening a store. */
+/* tools/stats_cli.h — glue shared by the commands that work on a store's
+ * statistics (mean, pca, diff, project, point, plot, and embed and interp for
+ * their points): CSV output, edge tables, a point given on the command line. */
 #ifndef EDGESPACE_TOOLS_STATS_CLI_H
 #define EDGESPACE_TOOLS_STATS_CLI_H
 
