@@ -71,13 +71,25 @@ es_status es_export_lengths_csv(es_ctx *ctx, es_store *s, const int64_t *rows, i
     if ((rc = es_store_read_edges(ctx, s, edges)) || (rc = es_store_read_scales(ctx, s, scales)))
         goto done;
     {
-        /* Never truncate the store itself (export STORE --lengths STORE). */
+        /* Never truncate the store itself (export STORE --lengths STORE), nor
+         * another store: any HDF5 file, told by its signature. */
         struct stat so, sp;
+        char sig[8];
+        FILE *g;
         if (stat(es_store_path(s), &so) == 0 && stat(path, &sp) == 0 &&
             so.st_dev == sp.st_dev && so.st_ino == sp.st_ino) {
             rc = es__fail(ctx, ES_EINVAL, "export: '%s' is the store itself; not overwriting it",
                           path);
             goto done;
+        }
+        if ((g = fopen(path, "rb"))) {
+            int h5 = fread(sig, 1, 8, g) == 8 && !memcmp(sig, "\x89HDF\r\n\x1a\n", 8);
+            fclose(g);
+            if (h5) {
+                rc = es__fail(ctx, ES_EINVAL, "export: '%s' is an HDF5 file (a store?); not "
+                              "overwriting it with CSV", path);
+                goto done;
+            }
         }
     }
     if (!(f = fopen(path, "w"))) {

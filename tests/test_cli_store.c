@@ -71,6 +71,15 @@ int main(void)
                      strstr(r.err, "odd.obj"), "%d: %s", r.status, r.err);
         ES_CHECK(before && es_test_same_bytes(store, before, n0));
         free(before);
+        /* nor another HDF5 file (another store) */
+        snprintf(p, sizeof p, "%s/other.h5", dir);
+        es_test_write_file(p, "\x89HDF\r\n\x1a\nnot CSV\n");
+        ES_RUN(&r, dir, "export", store, "--lengths", p);
+        ES_CHECK_MSG(r.status == 1 && strstr(r.err, "HDF5"), "export onto another store: %d %s",
+                     r.status, r.err);
+        before = es_test_slurp(p, &n0);
+        ES_CHECK(before && n0 == 16 && !memcmp(before, "\x89HDF", 4));
+        free(before);
     }
     ES_RUN(&r, dir, "ingest", "--no-create", "nothere.h5", p);
     ES_CHECK(r.status == 1 && strstr(r.err, "does not exist"));
@@ -177,8 +186,11 @@ int main(void)
                 ok[2 * round + w] = st == 0;
                 nok += st == 0;
             }
+            /* a writer is refused only because the other committed */
+            ES_CHECK_MSG(ok[2 * round] || ok[2 * round + 1], "round %d: both writers refused",
+                         round);
         }
-        ES_CHECK(nok >= 8);   /* at least one writer of each round gets through */
+        ES_CHECK(nok >= 8);
         es_ctx *ctx = NULL;
         es_store *st = NULL;
         ES_CHECK(es_ctx_new(&ctx) == ES_OK);

@@ -87,10 +87,14 @@ int main(void)
         check_frames_do_not_jump(dir, "walk", 1, 3);
         ES_RUN(&r, dir, "info", store);
         ES_CHECK_MSG(strstr(r.out, "walk_02"), "walk not stored: %s", r.out);
+        snprintf(p, sizeof p, "%s/far_0.obj", dir);
+        snprintf(pat, sizeof pat, "%s/far_%%d.obj", dir);
         ES_RUN(&r, dir, "interp", store, "--from", "mean", "--to", "row:mesh-2", "--steps", "2",
                "--t1", "400", "-o", pat, "--no-store");
         ES_CHECK_MSG(r.status == 1 && strstr(r.err, "at t = 400"), "far extrapolation: %d %s",
                      r.status, r.err);
+        /* refused before any frame is written */
+        ES_CHECK_MSG(access(p, F_OK) != 0, "a refused walk left %s", p);
         ES_RUN(&r, dir, "interp", store, "--from", "mean[nothing=1]", "--to", "row:mesh-2",
                "-o", pat, "--no-store");
         ES_CHECK_MSG(r.status == 1 && strstr(r.err, "nothing"), "bad point: %d %s", r.status,

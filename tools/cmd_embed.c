@@ -214,8 +214,10 @@ int cmd_embed(int argc, char **argv)
         printf("per-vertex residuals: %s (render --scalars draws the closure)\n", residuals);
     }
     if (store_it) {
-        es_provenance prov = {NULL, initrow >= 0 && !sel ? &initrow : sel,
-                              sel ? nsel : initrow >= 0 ? 1 : 0, NULL};
+        /* the rows whose positions started the embedding (none for a mesh:
+         * rows non-NULL with 0, as NULL would record every row) */
+        es_provenance prov = {NULL, sel ? sel : &initrow, sel ? nsel : initrow >= 0 ? 1 : 0,
+                              NULL};
         char *cmd = cli_command_line(argc, argv), params[256];
         snprintf(params, sizeof params, "point=%s; scale=%.17g", point, scale);
         prov.command = cmd ? cmd : "edgespace embed";

@@ -159,6 +159,34 @@ static es_status commit_frames(es_ctx *ctx, es_store *s, const char *name, int64
     return rc;
 }
 
+/* t of frame i of `steps` from t0 to t1 inclusive. */
+static double frame_t(double t0, double t1, int64_t steps, int64_t i)
+{
+    return steps == 1 ? t0 : t0 + (t1 - t0) * (double)i / (double)(steps - 1);
+}
+
+/* Frame t of a walk from a (scale sa) to b (scale sb): v = (1 - t) a + t b
+ * at the scale (1 - t) sa + t sb. Past the positive orthant (extrapolated
+ * too far) it says so, naming t and the edge, and fails. */
+static es_status lerp_frame(const double *a, const double *b, double sa, double sb, int64_t ne,
+                            double t, double *v, double *scale)
+{
+    *scale = (1 - t) * sa + t * sb;
+    for (int64_t e = 0; e < ne; e++) {
+        v[e] = (1 - t) * a[e] + t * b[e];
+        if (!(v[e] > 0)) {
+            fprintf(stderr, "edgespace interp: at t = %.4g the length of edge %lld is %g: "
+                    "outside edge-length space (extrapolated too far)\n", t, (long long)e, v[e]);
+            return ES_EINVAL;
+        }
+    }
+    if (!(*scale > 0)) {
+        fprintf(stderr, "edgespace interp: at t = %.4g the scale is %g\n", t, *scale);
+        return ES_EINVAL;
+    }
+    return ES_OK;
+}
+
 /* --from/--to points that are not both rows (stored points, means,
  * expressions): frame t embeds (1 - t) a + t b at the scale (1 - t) s_a +
  * t s_b (lerp in datasets-spec/point-syntax.md), its dihedrals started from
@@ -175,7 +203,8 @@ static es_status interp_points(es_ctx *ctx, es_store *s, const es_mesh *mesh, es
     char initd[320], params[1024];
     double *a = malloc((size_t)ne * sizeof *a), *b = malloc((size_t)ne * sizeof *b);
     double *v = malloc((size_t)ne * sizeof *v), *start = malloc(3 * (size_t)nv * sizeof *start);
-    double sa, sb;
+    double sa, sb, scale;
+    int64_t row = -1;   /* the first frame's nearest row: the only row used */
     es_status rc = ES_OK;
     if (!a || !b || !v || !start) {
         fprintf(stderr, "edgespace interp: out of memory\n");
@@ -185,27 +214,15 @@ static es_status interp_points(es_ctx *ctx, es_store *s, const es_mesh *mesh, es
     if ((rc = stats_point_lengths("interp", ctx, s, from, ne, a, &sa)) ||
         (rc = stats_point_lengths("interp", ctx, s, to, ne, b, &sb)))
         goto done;
+    /* every frame is checked before the first is written: a refused walk
+     * leaves no partial sequence behind */
+    for (int64_t i = 0; i < steps; i++)
+        if ((rc = lerp_frame(a, b, sa, sb, ne, frame_t(t0, t1, steps, i), v, &scale))) goto done;
     for (int64_t i = 0; i < steps; i++) {
-        double t = steps == 1 ? t0 : t0 + (t1 - t0) * (double)i / (double)(steps - 1);
-        double scale = (1 - t) * sa + t * sb;
+        double t = frame_t(t0, t1, steps, i);
         es_embed_report rep;
-        for (int64_t e = 0; e < ne; e++) {
-            v[e] = (1 - t) * a[e] + t * b[e];
-            if (!(v[e] > 0)) {
-                fprintf(stderr, "edgespace interp: at t = %.4g the length of edge %lld is %g: "
-                        "outside edge-length space (extrapolated too far)\n", t, (long long)e,
-                        v[e]);
-                rc = ES_EINVAL;
-                goto done;
-            }
-        }
-        if (!(scale > 0)) {
-            fprintf(stderr, "edgespace interp: at t = %.4g the scale is %g\n", t, scale);
-            rc = ES_EINVAL;
-            goto done;
-        }
+        lerp_frame(a, b, sa, sb, ne, t, v, &scale);
         if (i == 0) {
-            int64_t row;
             double d;
             if ((rc = es_embed_nearest_row(ctx, s, v, NULL, 0, &row, &d)) ||
                 (rc = es_store_read_positions(ctx, s, row, start)))
@@ -219,7 +236,7 @@ static es_status interp_points(es_ctx *ctx, es_store *s, const es_mesh *mesh, es
             goto fail;
         {
             char *cmd = store_it ? cli_command_line(argc, argv) : NULL, head[64];
-            es_provenance prov = {cmd ? cmd : "edgespace interp", NULL, 0, params};
+            es_provenance prov = {cmd ? cmd : "edgespace interp", &row, 1, params};
             snprintf(params, sizeof params, "from=%s; to=%s; t=%.17g", from, to, t);
             snprintf(head, sizeof head, "t = %.4g", t);
             rc = emit_frame(ctx, s, mesh, emb, out, name, steps, i, head, v, res, &rep,
@@ -345,7 +362,7 @@ int cmd_interp(int argc, char **argv)
         if ((rc = es_store_read_positions(ctx, s, rows[k], xyz[k]))) goto fail;
     }
     for (int64_t i = 0; i < steps; i++) {
-        double t = steps == 1 ? t0 : t0 + (t1 - t0) * (double)i / (double)(steps - 1);
+        double t = frame_t(t0, t1, steps, i);
         double wi[MAX_IN];
         es_embed_report rep;
         es_interp_info info;
