@@ -13,6 +13,7 @@
 
 #include <stdarg.h>
 #include <stdbool.h>
+#include <stdio.h>
 #include <string.h>
 
 #if defined(__GNUC__)
@@ -40,6 +41,20 @@ void *es__realloc(es_ctx *ctx, void *ptr, size_t size);
 void es__free(es_ctx *ctx, void *ptr);
 /* n elements of `size` bytes, n an int64 count (negative counts fail). */
 void *es__alloc_array(es_ctx *ctx, int64_t n, size_t size);
+
+/* Replace a file only when its new content is complete (file_replace.c):
+ * begin opens a part file beside path (through a symlink, beside its target;
+ * with the old file's mode); write to w.f; end closes it and renames it over
+ * the file if rc is ES_OK and the writes succeeded, else removes it. end
+ * returns rc or the write error. */
+typedef struct es__file_replace {
+    FILE *f;
+    char *tmp;          /* the part file */
+    char *target;       /* the symlink's resolution, or NULL */
+    const char *path;   /* as given (for messages) */
+} es__file_replace;
+es_status es__replace_begin(es_ctx *ctx, const char *path, es__file_replace *w);
+es_status es__replace_end(es_ctx *ctx, es__file_replace *w, es_status rc);
 char *es__strdup(es_ctx *ctx, const char *s);
 
 /* Checked products; false on overflow. */

@@ -54,6 +54,7 @@ es_status es_export_lengths_csv(es_ctx *ctx, es_store *s, const int64_t *rows, i
     const int64_t *list;
     double *len = NULL, *scales = NULL;
     es_status rc;
+    es__file_replace w = {0};
     FILE *f = NULL;
     if (!s || !path) ES_FAIL(ctx, ES_EINVAL, "export: NULL argument");
     E = es_store_nedges(s);
@@ -92,10 +93,9 @@ es_status es_export_lengths_csv(es_ctx *ctx, es_store *s, const int64_t *rows, i
             }
         }
     }
-    if (!(f = fopen(path, "w"))) {
-        rc = es__fail(ctx, ES_EIO, "export: cannot create '%s': %s", path, strerror(errno));
-        goto done;
-    }
+    /* a failed export leaves a file that was there before as it was */
+    if ((rc = es__replace_begin(ctx, path, &w))) goto done;
+    f = w.f;
     fputs("id,scale", f);
     for (int64_t e = 0; e < E; e++)
         fprintf(f, ",%lld-%lld", (long long)edges[2 * e], (long long)edges[2 * e + 1]);
@@ -112,10 +112,8 @@ es_status es_export_lengths_csv(es_ctx *ctx, es_store *s, const int64_t *rows, i
         fputc('\n', f);
     }
     es__progress(ctx, "exporting lengths", n, n);
-    if (ferror(f)) rc = es__fail(ctx, ES_EIO, "export: cannot write '%s'", path);
 done:
-    if (f && fclose(f) != 0 && rc == ES_OK)
-        rc = es__fail(ctx, ES_EIO, "export: cannot write '%s': %s", path, strerror(errno));
+    rc = es__replace_end(ctx, &w, rc);
     es__free(ctx, own);
     es__free(ctx, len);
     es__free(ctx, edges);

@@ -547,7 +547,7 @@ es_status es_landmarks_read_csv(es_ctx *ctx, const char *path, const char *speci
                           "integer", file, (long long)row->line, row->f[cl]);
             goto fail;
         }
-        if (lmk > t.nrows) {
+        if (lmk > t.nrows - 1) {
             /* every specimen needs rows for landmarks 1..k: k <= the rows */
             es__free(ctx, order);
             rc = es__fail(ctx, ES_ERANGE, "landmarks: %s: %lld landmarks in %dD are too many "
@@ -565,6 +565,14 @@ es_status es_landmarks_read_csv(es_ctx *ctx, const char *path, const char *speci
     es__free(ctx, order);
     if (nspec == 0) {
         rc = es__fail(ctx, ES_EFORMAT, "landmarks: %s: no data rows", file);
+        goto fail;
+    }
+    /* each specimen has a row per landmark: more than the rows cannot be
+     * complete, and would only allocate nspec * k landmarks to find that */
+    if (nspec > (t.nrows - 1) / k) {
+        rc = es__fail(ctx, ES_EFORMAT, "landmarks: %s: %lld specimens of %lld landmarks need "
+                      "more than its %lld data rows (a specimen lacks landmarks)", file,
+                      (long long)nspec, (long long)k, (long long)(t.nrows - 1));
         goto fail;
     }
     for (int64_t j = 0; j < nspec; j++)

@@ -253,8 +253,8 @@ es_status es__meshdata_write(es_ctx *ctx, const char *path, es_mesh_format forma
                              int64_t nverts, int64_t nfaces, const int64_t *faces,
                              const double *xyz, const uint8_t *rgb)
 {
+    es__file_replace w;
     FILE *f;
-    char *tmp;
     es_status rc;
     if (!path || !faces || !xyz || nverts <= 0 || nfaces < 0)
         ES_FAIL(ctx, ES_EINVAL, "mesh write: missing path, faces or positions");
@@ -265,17 +265,9 @@ es_status es__meshdata_write(es_ctx *ctx, const char *path, es_mesh_format forma
         if (faces[i] < 0 || faces[i] >= nverts)
             ES_FAIL(ctx, ES_ERANGE, "'%s': face %lld has vertex %lld out of range (%lld vertices)",
                     path, (long long)(i / 3), (long long)faces[i], (long long)nverts);
-    /* written beside the target and renamed over it at the end, so that a
-     * failed write leaves a file that was there before as it was */
-    tmp = es__malloc(ctx, strlen(path) + 32);
-    if (!tmp) return ES_ENOMEM;
-    sprintf(tmp, "%s.%ld.part", path, (long)getpid());
-    f = fopen(tmp, "wbx");
-    if (!f) {
-        rc = es__fail(ctx, ES_EIO, "cannot create '%s': %s", tmp, strerror(errno));
-        es__free(ctx, tmp);
-        return rc;
-    }
+    /* a failed write leaves a file that was there before as it was */
+    if ((rc = es__replace_begin(ctx, path, &w)) != ES_OK) return rc;
+    f = w.f;
     switch (format) {
     case ES_FORMAT_OBJ: rc = es__obj_write(ctx, path, f, nverts, nfaces, faces, xyz); break;
     case ES_FORMAT_PLY:
@@ -287,15 +279,7 @@ es_status es__meshdata_write(es_ctx *ctx, const char *path, es_mesh_format forma
     case ES_FORMAT_AUTO:
     default: rc = es__fail(ctx, ES_EINVAL, "'%s': unknown format %d", path, (int)format);
     }
-    if (rc == ES_OK && ferror(f))
-        rc = es__fail(ctx, ES_EIO, "cannot write '%s': %s", path, strerror(errno));
-    if (fclose(f) != 0 && rc == ES_OK)
-        rc = es__fail(ctx, ES_EIO, "cannot write '%s': %s", path, strerror(errno));
-    if (rc == ES_OK && rename(tmp, path) != 0)
-        rc = es__fail(ctx, ES_EIO, "cannot write '%s': %s", path, strerror(errno));
-    if (rc != ES_OK) remove(tmp);
-    es__free(ctx, tmp);
-    return rc;
+    return es__replace_end(ctx, &w, rc);
 }
 
 /* ---------------------------------------------------------------- meshes */

@@ -939,7 +939,7 @@ fail:
 static es_status commit_impl(es_ctx *ctx, es_store *s)
 {
     es_status rc = ES_OK;
-    struct stat now;
+    struct stat now, done;
     char *dir = NULL;
     hid_t fapl;
     if (!s->work) return ES_OK; /* nothing written */
@@ -957,6 +957,10 @@ static es_status commit_impl(es_ctx *ctx, es_store *s)
     }
     s->file = -1;
     if ((rc = fsync_path(ctx, s->work, false))) goto fail;
+    /* the identity the published file will have (link and rename keep the
+     * inode): taken now, a commit landing right after ours is not mistaken
+     * for the file this handle's rows come from */
+    if (stat(s->work, &done) != 0) memset(&done, 0, sizeof done);
     if (s->is_new) {
         /* link() refuses to replace a file that appeared meanwhile. */
         if (link(s->work, s->path) != 0) {
@@ -978,9 +982,12 @@ static es_status commit_impl(es_ctx *ctx, es_store *s)
          * this folder (an advisory lock on the folder): otherwise another
          * commit landing between them would be replaced unseen. */
         int dfd = -1;
-        if ((dir = path_dir(ctx, s->path)) && (dfd = open(dir, O_RDONLY | O_DIRECTORY)) >= 0)
+        if ((dir = path_dir(ctx, s->path)) &&
+            (dfd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC)) >= 0)
             while (flock(dfd, LOCK_EX) != 0 && errno == EINTR) {
             }
+        /* a folder that cannot be opened or locked (unreadable, some network
+         * file systems) leaves the commit unlocked: the identity check alone */
         if (stat(s->path, &now) != 0 || now.st_ino != s->orig.st_ino ||
             now.st_dev != s->orig.st_dev || now.st_size != s->orig.st_size ||
             now.st_mtim.tv_sec != s->orig.st_mtim.tv_sec ||
@@ -990,15 +997,13 @@ static es_status commit_impl(es_ctx *ctx, es_store *s)
         } else if (rename(s->work, s->path) != 0) {
             rc = es__fail(ctx, ES_EIO, "store: cannot replace '%s': %s", s->path,
                           strerror(errno));
-        } else if (stat(s->path, &s->opened) != 0) {
-            memset(&s->opened, 0, sizeof s->opened);
         }
         if (dfd >= 0) close(dfd);   /* releases the lock */
         es__free(ctx, dir);
         dir = NULL;
         if (rc != ES_OK) goto fail;
     }
-    if (s->is_new && stat(s->path, &s->opened) != 0) memset(&s->opened, 0, sizeof s->opened);
+    s->opened = done;
     if ((dir = path_dir(ctx, s->path))) {
         fsync_path(ctx, dir, true);
         es__free(ctx, dir);

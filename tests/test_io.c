@@ -4,10 +4,13 @@
  * prefixes, allocation failures, and the real meshes of ../shared/data. */
 #include "mesh_io_internal.h"
 #include "es_test.h"
+#include "es_test_files.h"
 
 #include <dirent.h>
 #include <signal.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <inttypes.h>
 
 #define SRC ES_SOURCE_ROOT "/tests/data"
@@ -490,6 +493,32 @@ static void test_round_trips(es_ctx *ctx)
             if (d) closedir(d);
         }
         remove(keep);
+    }
+    /* replacing a file keeps its mode, writes through a symlink to its
+     * target, and is not blocked by a part file a killed writer left */
+    {
+        const char *real = ES_BUILD_ROOT "/test_io_real.obj", *link_ = ES_BUILD_ROOT
+            "/test_io_link.obj";
+        const int64_t tri[3] = {0, 1, 2};
+        char stale[600];
+        struct stat st;
+        es_meshdata back;
+        remove(real), remove(link_);
+        ES_CHECK_OK(ctx, es__meshdata_write(ctx, real, ES_FORMAT_AUTO, 3, 1, tri, xyz, NULL));
+        ES_CHECK(chmod(real, 0600) == 0 && symlink("test_io_real.obj", link_) == 0);
+        snprintf(stale, sizeof stale, "%s.%ld.part", real, (long)getpid());
+        es_test_write_file(stale, "left by a killed writer");
+        ES_CHECK_OK(ctx, es__meshdata_write(ctx, real, ES_FORMAT_AUTO, 3, 1, tri, xyz, NULL));
+        ES_CHECK_MSG(stat(real, &st) == 0 && (st.st_mode & 0777) == 0600, "mode %o",
+                     (unsigned)(st.st_mode & 0777));
+        ES_CHECK_OK(ctx, es__meshdata_write(ctx, link_, ES_FORMAT_AUTO, nv, nf, faces, xyz, NULL));
+        ES_CHECK(lstat(link_, &st) == 0 && S_ISLNK(st.st_mode));
+        ES_CHECK_MSG(stat(real, &st) == 0 && (st.st_mode & 0777) == 0600, "mode %o",
+                     (unsigned)(st.st_mode & 0777));
+        ES_CHECK_OK(ctx, es_meshdata_read(ctx, real, ES_FORMAT_AUTO, &back));
+        ES_CHECK(back.nverts == nv);
+        es_meshdata_clear(ctx, &back);
+        remove(stale), remove(link_), remove(real);
     }
     free(xyz);
     free(faces);

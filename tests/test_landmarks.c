@@ -97,7 +97,7 @@ static void test_csv(es_ctx *ctx)
     es_landmarks_free(lm);
 
     static const struct { const char *file, *spec; es_status code; const char *msg; } bad[] = {
-        {"missing_landmark.csv", NULL, ES_EFORMAT, "specimen 's2' lacks landmark 2 (of 2)"},
+        {"missing_landmark.csv", NULL, ES_EFORMAT, "2 specimens of 2 landmarks need more than its 3 data rows (a specimen lacks landmarks)"},
         {"duplicate.csv", NULL, ES_EFORMAT, "duplicate.csv:3: landmark 1 of specimen 's1' "
                                             "appears twice"},
         {"bad_header.csv", NULL, ES_EFORMAT, "bad_header.csv:1: header must name"},

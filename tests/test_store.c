@@ -3,12 +3,15 @@
  * results with provenance, all-or-nothing writes (abort, failed append,
  * concurrent writers, stale working copies), bad files, and an
  * allocation-failure sweep over open. */
+#include "edgespace/es_ingest.h"
 #include "es_internal.h"
 #include "es_test.h"
 #include "es_test_alloc.h"
 #include "es_test_files.h"
 #include "store_internal.h"
 
+#include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 
 /* A tetrahedron: 4 vertices, 4 faces, 6 edges sorted (min, max). */
@@ -144,6 +147,36 @@ static void test_stale_writer(es_ctx *ctx, const char *path)
 done:
     if (a) es_store_abort(a);
     if (b) es_store_close(b);
+}
+
+/* An export that fails part way (past a file-size limit) leaves the CSV
+ * that was there before as it was, and no part file beside it. */
+static void test_export_keeps_old_file(es_ctx *ctx, const char *path, const char *dir)
+{
+    char csv[4400];
+    es_store *s = NULL;
+    struct rlimit lim, small;
+    snprintf(csv, sizeof csv, "%s/old.csv", dir);
+    es_test_write_file(csv, "old content\n");
+    ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_READ, &s));
+    if (s && getrlimit(RLIMIT_FSIZE, &lim) == 0) {
+        void (*old)(int) = signal(SIGXFSZ, SIG_IGN);
+        size_t n = 0;
+        char *text;
+        small = lim;
+        small.rlim_cur = 16;
+        ES_CHECK(setrlimit(RLIMIT_FSIZE, &small) == 0);
+        ES_CHECK_FAILS(ctx, es_export_lengths_csv(ctx, s, NULL, -1, 0, csv), ES_EIO, "old.csv");
+        ES_CHECK(setrlimit(RLIMIT_FSIZE, &lim) == 0);
+        signal(SIGXFSZ, old);
+        text = es_test_slurp(csv, &n);
+        ES_CHECK_MSG(text && !strcmp(text, "old content\n"), "the old CSV became '%.40s'",
+                     text ? text : "(gone)");
+        free(text);
+        ES_CHECK(es_test_count_entries(dir, ".part") == 0);
+    }
+    es_store_close(s);
+    remove(csv);
 }
 
 int main(void)
@@ -423,6 +456,7 @@ int main(void)
         s = NULL;
     }
     test_stale_writer(ctx, path);
+    test_export_keeps_old_file(ctx, path, dir);
     es_ctx_free(ctx);
     ES_TEST_END();
 }

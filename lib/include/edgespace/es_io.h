@@ -60,7 +60,8 @@ ES_API es_status es_mesh_read(es_ctx *ctx, const char *path, es_mesh **out);
  * Coordinates are written exactly (%.17g, or binary doubles); reading the
  * file back gives the same arrays. ES_EIO names the path and the reason.
  * The file is written beside the target (PATH.PID.part) and renamed over
- * it when complete: a failed write leaves an existing file as it was. */
+ * it when complete: a failed write leaves an existing file as it was; the
+ * old file's permissions are kept and a symlink is written through. */
 ES_API es_status es_mesh_write(es_ctx *ctx, const char *path, es_mesh_format format,
                                const es_mesh *mesh, const double *xyz,
                                const uint8_t *vertex_rgb);
