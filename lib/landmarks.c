@@ -567,9 +567,10 @@ es_status es_landmarks_read_csv(es_ctx *ctx, const char *path, const char *speci
         rc = es__fail(ctx, ES_EFORMAT, "landmarks: %s: no data rows", file);
         goto fail;
     }
-    /* each specimen has a row per landmark: more than the rows cannot be
-     * complete, and would only allocate nspec * k landmarks to find that */
-    if (nspec > (t.nrows - 1) / k) {
+    /* each specimen has a row per landmark, so more than the rows can fill
+     * is incomplete anyway; where nspec * k would also dwarf the file, say so
+     * now rather than allocate it to find which specimen lacks what */
+    if (nspec > (t.nrows - 1) / k && nspec / 4 > (t.nrows + 1024) / k) {
         rc = es__fail(ctx, ES_EFORMAT, "landmarks: %s: %lld specimens of %lld landmarks need "
                       "more than its %lld data rows (a specimen lacks landmarks)", file,
                       (long long)nspec, (long long)k, (long long)(t.nrows - 1));

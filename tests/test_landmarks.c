@@ -97,7 +97,7 @@ static void test_csv(es_ctx *ctx)
     es_landmarks_free(lm);
 
     static const struct { const char *file, *spec; es_status code; const char *msg; } bad[] = {
-        {"missing_landmark.csv", NULL, ES_EFORMAT, "2 specimens of 2 landmarks need more than its 3 data rows (a specimen lacks landmarks)"},
+        {"missing_landmark.csv", NULL, ES_EFORMAT, "specimen 's2' lacks landmark 2 (of 2)"},
         {"duplicate.csv", NULL, ES_EFORMAT, "duplicate.csv:3: landmark 1 of specimen 's1' "
                                             "appears twice"},
         {"bad_header.csv", NULL, ES_EFORMAT, "bad_header.csv:1: header must name"},
@@ -147,6 +147,24 @@ static void test_size_overflow(es_ctx *ctx)
         else
             ES_CHECK_FAILS(ctx, es_landmarks_read_csv(ctx, path, NULL, &lm), ES_ERANGE,
                            bad[i].msg);
+        ES_CHECK(lm == NULL);
+        remove(path);
+    }
+    /* many one-landmark specimens and one landmark number as large as the
+     * rows: refused from the counts, before allocating specimens x landmarks */
+    {
+        char path[4200];
+        FILE *f;
+        es_landmarks *lm = (es_landmarks *)1;
+        snprintf(path, sizeof path, "%s/sparse.csv", dir);
+        if ((f = fopen(path, "w"))) {
+            fputs("specimen,landmark,x,y\n", f);
+            for (int i = 0; i < 3000; i++) fprintf(f, "s%d,1,0,0\n", i);
+            fputs("z,3000,0,0\n", f);
+            fclose(f);
+        }
+        ES_CHECK_FAILS(ctx, es_landmarks_read_csv(ctx, path, NULL, &lm), ES_EFORMAT,
+                       "3001 specimens of 3000 landmarks need more than its 3001 data rows");
         ES_CHECK(lm == NULL);
         remove(path);
     }
