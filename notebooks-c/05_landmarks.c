@@ -106,8 +106,9 @@ static int load(notebook *nb, study *s)
         s->what = "synthetic face landmarks";
         nb_input(nb, "dataset", "12 vertices of es_synth face, %lld subjects", (long long)so.n);
         nb_p(nb, "> **Data: synthetic.** `../shared/data/landmarks_rshapes` was not found (or "
-             "`--synthetic` was given), so the landmarks are 12 vertices of each mesh of the project's synthetic face family "
-             "(%lld subjects x {neutral, happy, angry}; 3D), grouped by expression.",
+             "`--synthetic` was given), so the landmarks are 12 vertices of each mesh of the "
+             "project's synthetic face family (%lld subjects x {neutral, happy, angry}; 3D), "
+             "grouped by expression.",
              (long long)so.n);
     }
     s->n = s->lm->n;

@@ -85,6 +85,38 @@ int main(void)
         ES_CHECK_MSG(r.status == 0 && strstr(r.out, "t = 0.5") && strstr(r.out, "walk_NN"),
                      "interp between points: %d %s %s", r.status, r.out, r.err);
         check_frames_do_not_jump(dir, "walk", 1, 3);
+        /* the frame at the row end starts from that row's dihedrals (recorded)
+         * and is that row again */
+        {
+            es_ctx *c2 = NULL;
+            es_mesh *m2 = NULL;
+            es_store *st = NULL;
+            int64_t nw = 0;
+            char w2[4300], init[256] = "";
+            snprintf(p, sizeof p, "%s/mesh-2.obj", dir);
+            snprintf(w2, sizeof w2, "%s/walk_2.obj", dir);
+            double *xw = es_test_obj_positions(w2, &nw), worst = 0;
+            ES_CHECK(es_ctx_new(&c2) == ES_OK);
+            if (c2) ES_CHECK_OK(c2, es_mesh_read(c2, p, &m2));
+            if (m2 && xw && nw == es_mesh_nverts(m2)) {
+                int64_t ne = es_mesh_nedges(m2);
+                double *l0 = malloc((size_t)ne * sizeof *l0), *l1 = malloc((size_t)ne * sizeof *l1);
+                ES_CHECK_OK(c2, es_edge_lengths(c2, m2, es_mesh_xyz(m2), l0));
+                ES_CHECK_OK(c2, es_edge_lengths(c2, m2, xw, l1));
+                for (int64_t e = 0; e < ne; e++) worst = fmax(worst, fabs(l1[e] / l0[e] - 1));
+                free(l0), free(l1);
+            }
+            ES_CHECK_MSG(m2 && xw && worst < 1e-9, "walk end at row mesh-2: edges %g off", worst);
+            if (c2) ES_CHECK_OK(c2, es_store_open(c2, store, ES_STORE_READ, &st));
+            if (st)
+                ES_CHECK_OK(c2, es_store_get_attr(c2, st, "embed/walk_02", "init", init,
+                                                  sizeof init));
+            ES_CHECK_MSG(strstr(init, "dihedrals of row:mesh-2"), "walk_02 init: '%s'", init);
+            es_store_close(st);
+            free(xw);
+            es_mesh_free(m2);
+            es_ctx_free(c2);
+        }
         ES_RUN(&r, dir, "info", store);
         ES_CHECK_MSG(strstr(r.out, "walk_02"), "walk not stored: %s", r.out);
         snprintf(p, sizeof p, "%s/far_0.obj", dir);
@@ -100,6 +132,22 @@ int main(void)
         ES_CHECK_MSG(r.status == 1 && strstr(r.err, "nothing"), "bad point: %d %s", r.status,
                      r.err);
     }
+    /* pc:K with several PCAs stored: --pca names the one meant */
+    ES_RUN(&r, dir, "pca", store, "--name", "one", "-k", "2");
+    ES_CHECK_MSG(r.status == 0, "pca one: %s", r.err);
+    ES_RUN(&r, dir, "pca", store, "--name", "two", "-k", "1");
+    ES_CHECK_MSG(r.status == 0, "pca two: %s", r.err);
+    snprintf(out, sizeof out, "%s/pc.obj", dir);
+    ES_RUN(&r, dir, "embed", store, "--point", "mean + 0.5*pc:1", "-o", out, "--no-store");
+    ES_CHECK_MSG(r.status == 1 && strstr(r.err, "--pca NAME"), "pc:K, two PCAs: %d %s", r.status,
+                 r.err);
+    ES_RUN(&r, dir, "embed", store, "--point", "mean + 0.5*pc:1", "--pca", "one", "-o", out,
+           "--no-store");
+    ES_CHECK_MSG(r.status == 0, "embed --pca one: %s", r.err);
+    snprintf(pat, sizeof pat, "%s/pcwalk_%%d.obj", dir);
+    ES_RUN(&r, dir, "interp", store, "--from", "mean", "--to", "mean + pc:1", "--pca", "two",
+           "--steps", "2", "-o", pat, "--no-store");
+    ES_CHECK_MSG(r.status == 0, "interp --pca two: %s", r.err);
     /* %% in the pattern is a literal percent sign */
     snprintf(pat, sizeof pat, "%s/pct_%%d%%%%.obj", dir);
     ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-1", "--steps", "2",

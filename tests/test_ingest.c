@@ -548,7 +548,8 @@ int main(void)
             snprintf(want, sizeof want, "spare0.obj': 1 of %lld vertices are in no face",
                      (long long)(V + 1));
             const char *w = strstr(cap.text, want);
-            ES_CHECK_MSG(w && !strstr(w + strlen(want), "in no face"), "first ingest: '%s'", cap.text);
+            ES_CHECK_MSG(w && !strstr(w + strlen(want), "in no face"), "first ingest: '%s'",
+                         cap.text);
             cap.n = 0;
             cap.text[0] = 0;
             one[0] = pb;

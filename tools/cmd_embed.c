@@ -23,6 +23,8 @@ static const char usage[] =
     "                       \"mean[expression=neutral] + diff:smile\" (see\n"
     "                       datasets-spec/point-syntax.md)\n"
     "  -o, --output OUT     mesh file (.obj, .ply, .off)\n"
+    "      --pca NAME       the PCA whose components pc:K in SPEC means (needed when\n"
+    "                       several are stored and none is named 'default')\n"
     "  -i, --init HOW       nearest (default: the stored row nearest in edge-length\n"
     "                       distance), row:ID, mean[:FILTER] (circular mean of the\n"
     "                       dihedrals of the selected rows), or mesh:FILE (a mesh with\n"
@@ -101,9 +103,10 @@ int cmd_embed(int argc, char **argv)
         {"name", required_argument, NULL, 'n'},  {"no-store", no_argument, NULL, 'N'},
         {"paper", no_argument, NULL, 'P'},       {"help", no_argument, NULL, 'h'},
         {"refine-iters", required_argument, NULL, 'R'},
-        {"residuals", required_argument, NULL, 'r'},
+        {"residuals", required_argument, NULL, 'r'}, {"pca", required_argument, NULL, 'c'},
         {NULL, 0, NULL, 0}};
     const char *point = NULL, *out = NULL, *init = "nearest", *name = NULL, *residuals = NULL;
+    const char *pca = NULL;
     char namebuf[256], initdesc[512], text[1024];
     double scale = 0, *target = NULL, *xyz = NULL, *init_xyz = NULL, *alpha = NULL;
     int c, store_it = 1, paper = 0;
@@ -124,6 +127,7 @@ int cmd_embed(int argc, char **argv)
         case 'o': out = optarg; break;
         case 'i': init = optarg; break;
         case 'r': residuals = optarg; break;
+        case 'c': pca = optarg; break;
         case 's':
             if (cli_parse_double(optarg, &scale) || !(scale > 0))
                 return cli_usage_error("embed", "--scale wants a positive number");
@@ -160,7 +164,7 @@ int cmd_embed(int argc, char **argv)
     /* the target: at the point's own scale unless --scale gives one */
     {
         double own;
-        if ((rc = stats_point_lengths("embed", ctx, s, point, ne, target, &own))) goto done;
+        if ((rc = stats_point_lengths("embed", ctx, s, point, pca, ne, target, &own))) goto done;
         if (scale == 0) scale = own;
     }
     /* the initialization */

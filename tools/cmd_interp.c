@@ -18,15 +18,19 @@ static const char usage[] =
     "Interpolate stored shapes in edge-length space (weighted mean of normalized\n"
     "lengths at the weighted mean scale; dihedrals averaged on the circle as the\n"
     "start) and embed each result as a mesh. Weights or t outside [0, 1]\n"
-    "extrapolate. Between two points that are not both rows (a stored point, a\n"
+    "extrapolate; between rows, lengths driven to 0 or below are clamped (with a\n"
+    "warning). Between two points that are not both rows (a stored point, a\n"
     "mean, an expression) each frame starts from the previous frame's dihedrals\n"
-    "(the first from the nearest stored row). Sequences are aligned frame to\n"
-    "frame. Reports are printed and stored under /analysis/embed/NAME_<i>\n"
-    "(per-vertex residuals included).\n"
+    "(the first from the nearest stored row; a frame at a row end from that\n"
+    "row's), and a walk that leaves edge-length space is refused before any\n"
+    "frame is written. Sequences are aligned frame to frame. Reports are printed\n"
+    "and stored under /analysis/embed/NAME_<i> (per-vertex residuals included).\n"
     "\n"
     "  -f, --from A          first shape (t = 0): row:ID, a stored point's name, or\n"
     "                        an expression such as \"mean[expression=neutral]\"\n"
     "  -t, --to B            second shape (t = 1), the same kinds\n"
+    "      --pca NAME        the PCA whose components pc:K in A or B means (needed\n"
+    "                        when several are stored and none is named 'default')\n"
     "  -k, --steps N         frames from t0 to t1 inclusive (default 9)\n"
     "      --t0 T, --t1 T    range of t (default 0 and 1)\n"
     "  -w, --weights EXPR    w1*row:a + w2*row:b + ... (two or more rows)\n"
@@ -120,7 +124,9 @@ static void base_name(const char *path, char *buf, size_t n)
     char *q;
     snprintf(buf, n, "%s", b ? b + 1 : path);
     if ((q = strrchr(buf, '.')) && q != buf) *q = 0;
-    if ((q = strchr(buf, '%'))) {
+    q = strchr(buf, '%');   /* the conversion, skipping literal %% */
+    while (q && q[1] == '%') q = strchr(q + 2, '%');
+    if (q) {
         *q = 0;   /* 'cat_%02d' -> 'cat' (frames become cat_00, cat_01, ...) */
         while (q > buf && (q[-1] == '_' || q[-1] == '-')) *--q = 0;
     }
@@ -165,6 +171,24 @@ static double frame_t(double t0, double t1, int64_t steps, int64_t i)
     return steps == 1 ? t0 : t0 + (t1 - t0) * (double)i / (double)(steps - 1);
 }
 
+/* The dihedrals of a row end point ("row:ID"; NULL for another kind): a
+ * frame at that end starts from them, so it is the row itself again. */
+static es_status row_end_dihedrals(es_ctx *ctx, es_store *s, const es_mesh *mesh,
+                                   const char *spec, double *xyz, double **alpha)
+{
+    int64_t row;
+    es_status rc;
+    *alpha = NULL;
+    if (strncmp(spec, "row:", 4) || (row = es_store_find_row(s, spec + 4)) < 0) return ES_OK;
+    if (!(*alpha = malloc((size_t)es_mesh_nedges(mesh) * sizeof **alpha))) return ES_ENOMEM;
+    if ((rc = es_store_read_positions(ctx, s, row, xyz)) ||
+        (rc = es_dihedral_angles(ctx, mesh, xyz, *alpha))) {
+        free(*alpha);
+        *alpha = NULL;
+    }
+    return rc;
+}
+
 /* Frame t of a walk from a (scale sa) to b (scale sb): v = (1 - t) a + t b
  * at the scale (1 - t) sa + t sb. Past the positive orthant (extrapolated
  * too far) it says so, naming t and the edge, and fails. */
@@ -193,17 +217,25 @@ static es_status lerp_frame(const double *a, const double *b, double sa, double 
  * the previous frame (the first from the stored row nearest to it) and
  * aligned to it, so the sequence does not jump. Prints its own messages;
  * commits. */
+typedef struct walk {
+    const char *from, *to, *pca;   /* the end points, and the PCA pc:K refers to */
+    double t0, t1;
+    int64_t steps;
+} walk;
+
 static es_status interp_points(es_ctx *ctx, es_store *s, const es_mesh *mesh, es_embedder *emb,
-                               const es_embed_opts *opts, const char *from, const char *to,
-                               double t0, double t1, int64_t steps, const char *out,
+                               const es_embed_opts *opts, const walk *wk, const char *out,
                                const char *name, int store_it, int argc, char **argv,
                                double *res)
 {
+    const char *from = wk->from, *to = wk->to;
+    double t0 = wk->t0, t1 = wk->t1;
+    int64_t steps = wk->steps;
     int64_t ne = es_mesh_nedges(mesh), nv = es_mesh_nverts(mesh);
     char initd[320], params[1024];
     double *a = malloc((size_t)ne * sizeof *a), *b = malloc((size_t)ne * sizeof *b);
     double *v = malloc((size_t)ne * sizeof *v), *start = malloc(3 * (size_t)nv * sizeof *start);
-    double sa, sb, scale;
+    double sa, sb, scale, *end_alpha[2] = {NULL, NULL};
     int64_t row = -1;   /* the first frame's nearest row: the only row used */
     es_status rc = ES_OK;
     if (!a || !b || !v || !start) {
@@ -211,9 +243,12 @@ static es_status interp_points(es_ctx *ctx, es_store *s, const es_mesh *mesh, es
         rc = ES_ENOMEM;
         goto done;
     }
-    if ((rc = stats_point_lengths("interp", ctx, s, from, ne, a, &sa)) ||
-        (rc = stats_point_lengths("interp", ctx, s, to, ne, b, &sb)))
+    if ((rc = stats_point_lengths("interp", ctx, s, from, wk->pca, ne, a, &sa)) ||
+        (rc = stats_point_lengths("interp", ctx, s, to, wk->pca, ne, b, &sb)))
         goto done;
+    if ((rc = row_end_dihedrals(ctx, s, mesh, from, start, &end_alpha[0])) ||
+        (rc = row_end_dihedrals(ctx, s, mesh, to, start, &end_alpha[1])))
+        goto fail;
     /* every frame is checked before the first is written: a refused walk
      * leaves no partial sequence behind */
     for (int64_t i = 0; i < steps; i++)
@@ -231,16 +266,20 @@ static es_status interp_points(es_ctx *ctx, es_store *s, const es_mesh *mesh, es
                      es_store_row_id(s, row));
         }
         /* from the second frame on, the previous frame (res itself) is both
-         * the start and the alignment reference */
-        if ((rc = es_embed_solve(emb, v, scale, NULL, i ? res : start, opts, res, &rep)))
+         * the start and the alignment reference; a frame at a row end starts
+         * from that row's dihedrals */
+        const double *at_end = t == 0 ? end_alpha[0] : t == 1 ? end_alpha[1] : NULL;
+        if ((rc = es_embed_solve(emb, v, scale, at_end, i ? res : start, opts, res, &rep)))
             goto fail;
         {
             char *cmd = store_it ? cli_command_line(argc, argv) : NULL, head[64];
             es_provenance prov = {cmd ? cmd : "edgespace interp", &row, 1, params};
             snprintf(params, sizeof params, "from=%s; to=%s; t=%.17g", from, to, t);
+            char endd[320];
             snprintf(head, sizeof head, "t = %.4g", t);
+            if (at_end) snprintf(endd, sizeof endd, "the dihedrals of %s", t == 0 ? from : to);
             rc = emit_frame(ctx, s, mesh, emb, out, name, steps, i, head, v, res, &rep,
-                            store_it ? &prov : NULL, initd);
+                            store_it ? &prov : NULL, at_end ? endd : initd);
             free(cmd);
             if (rc) goto fail;
         }
@@ -250,7 +289,7 @@ static es_status interp_points(es_ctx *ctx, es_store *s, const es_mesh *mesh, es
 fail:
     cli_fail("interp", ctx, rc);
 done:
-    free(a), free(b), free(v), free(start);
+    free(a), free(b), free(v), free(start), free(end_alpha[0]), free(end_alpha[1]);
     return rc;
 }
 
@@ -262,9 +301,10 @@ int cmd_interp(int argc, char **argv)
         {"t1", required_argument, NULL, '1'},   {"weights", required_argument, NULL, 'w'},
         {"output", required_argument, NULL, 'o'}, {"name", required_argument, NULL, 'n'},
         {"no-store", no_argument, NULL, 'N'},   {"help", no_argument, NULL, 'h'},
-        {"refine-iters", required_argument, NULL, 'R'},
+        {"refine-iters", required_argument, NULL, 'R'}, {"pca", required_argument, NULL, 'c'},
         {NULL, 0, NULL, 0}};
     const char *from = NULL, *to = NULL, *weights = NULL, *out = NULL, *name = NULL;
+    const char *pca = NULL;
     char ids[MAX_IN][256], namebuf[256], fname[1024];
     double w[MAX_IN], t0 = 0, t1 = 1, *xyz[MAX_IN] = {0}, *res = NULL, *len = NULL;
     int64_t steps = 9, rows[MAX_IN], nin = 0, nv, ne;
@@ -293,6 +333,7 @@ int cmd_interp(int argc, char **argv)
             if (cli_parse_double(optarg, &t1)) return cli_usage_error("interp", "bad --t1");
             break;
         case 'w': weights = optarg; break;
+        case 'c': pca = optarg; break;
         case 'o': out = optarg; break;
         case 'n': name = optarg; break;
         case 'N': store_it = 0; break;
@@ -345,8 +386,8 @@ int cmd_interp(int argc, char **argv)
         goto fail;
     }
     if (points) {
-        rc = interp_points(ctx, s, mesh, emb, &opts, from, to, t0, t1, steps, out, name,
-                           store_it, argc, argv, res);
+        walk wk = {from, to, pca, t0, t1, steps};
+        rc = interp_points(ctx, s, mesh, emb, &opts, &wk, out, name, store_it, argc, argv, res);
         goto done;
     }
     for (int64_t k = 0; k < nin; k++) {

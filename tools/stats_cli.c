@@ -104,7 +104,7 @@ static es_status mean_row_scale(es_ctx *ctx, es_store *store, double *scale)
 }
 
 es_status stats_point_lengths(const char *verb, es_ctx *ctx, es_store *store, const char *spec,
-                              int64_t ne, double *lengths, double *scale)
+                              const char *pca, int64_t ne, double *lengths, double *scale)
 {
     char path[512];
     double *v = NULL;
@@ -141,7 +141,7 @@ es_status stats_point_lengths(const char *verb, es_ctx *ctx, es_store *store, co
         es_free(ctx, v);
     } else {   /* an expression (es_point.h syntax) */
         es_point_info info;
-        if (!(rc = es_analysis_point(ctx, store, NULL, spec, NULL, 0, "edgespace", &v, &info))) {
+        if (!(rc = es_analysis_point(ctx, store, NULL, spec, pca, 0, "edgespace", &v, &info))) {
             memcpy(lengths, v, (size_t)ne * sizeof *lengths);
             if (isfinite(info.scale) && info.scale > 0) *scale = info.scale;
         }

@@ -31,11 +31,12 @@ int stats_write_edge_csv(const char *verb, es_ctx *ctx, es_store *store, const c
 
 /* The E scale-normalized lengths of a point given on the command line:
  * row:ID, the name of a stored point (/analysis/point/NAME), or an
- * expression (datasets-spec/point-syntax.md); *scale gets the point's own
+ * expression (datasets-spec/point-syntax.md; pca: the PCA that pc:K means,
+ * NULL for the only or the 'default' one); *scale gets the point's own
  * scale, else the mean scale of the store's rows. Non-positive lengths
  * (extrapolated too far) are an error naming the edge. 0 ok, else the
  * status, with the message printed. */
 es_status stats_point_lengths(const char *verb, es_ctx *ctx, es_store *store, const char *spec,
-                              int64_t ne, double *lengths, double *scale);
+                              const char *pca, int64_t ne, double *lengths, double *scale);
 
 #endif

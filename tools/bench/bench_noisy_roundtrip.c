@@ -113,7 +113,8 @@ static void run(es_ctx *ctx, const char *file, int closed)
                     x0[i] = md.xyz[i] + moves[m] * diag * es__rng_normal(&rng);
                 if (es_embed_solve(emb, len, 0, NULL, x0, &o, out, &r)) goto fail;
                 es_kabsch_align(ctx, nv, out, md.xyz, NULL, &rms);
-                printf("%-34s %6lld  moved %.0e x diag               %9.2e %9.2e  %9.2e  %3s %3lld\n",
+                printf("%-34s %6lld  moved %.0e x diag               %9.2e %9.2e  %9.2e  %3s "
+                       "%3lld\n",
                        file, (long long)nv, moves[m], r.rms_ratio, r.max_rel, rms / diag, "-",
                        (long long)r.refine_iters);
                 fflush(stdout);
