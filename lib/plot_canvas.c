@@ -133,8 +133,9 @@ void es_plot_nice_ticks(double lo, double hi, int target, double *first, double 
         hi += d;
     }
     if (target < 2) target = 2;
-    double range = nicenum(hi - lo, 0);
-    double d = nicenum(range / (target - 1), 1);
+    /* the step from the data's own range: rounding the range up to a nice
+     * number first (Heckbert) can leave a third of the axis empty */
+    double d = nicenum((hi - lo) / (target - 1), 1);
     *first = floor(lo / d) * d;
     *last = ceil(hi / d) * d;
     /* floor/ceil of a quotient can land one step short by rounding */

@@ -36,6 +36,10 @@ static void test_nice_ticks(void)
         /* the ticks are multiples of the step */
         ES_CHECK(fabs(first / step - round(first / step)) < 1e-6);
     }
+    /* the axis hugs the data: -0.11..0.1 was drawn -0.2..0.1 (a third empty) */
+    es_plot_nice_ticks(-0.11, 0.1, 6, &first, &last, &step);
+    ES_CHECK_MSG(first <= -0.11 && last >= 0.1 && last - first <= 1.25 * 0.21,
+                 "[-0.11, 0.1] -> [%g, %g]", first, last);
     es_plot_nice_ticks(NAN, 1, 5, &first, &last, &step);
     ES_CHECK(isfinite(first) && isfinite(last) && step > 0);
 }
