@@ -270,13 +270,14 @@ static int report(notebook *nb, study *s)
         es_lines_spec_init(&ls);
         /* interior frames only: the ends are the inputs themselves (errors at
          * rounding level, which would only stretch the log axis) */
-        ser[0] = (es_series){"edge-length interpolation, embedded", s->nt - 2, s->t + 1,
+        ser[0] = (es_series){"edge lengths, embedded", s->nt - 2, s->t + 1,
                              (panel ? s->max_emb : s->rms_emb) + 1};
-        ser[1] = (es_series){"vertex interpolation", s->nt - 2, s->t + 1,
+        ser[1] = (es_series){"vertex lerp", s->nt - 2, s->t + 1,
                              (panel ? s->max_lin : s->rms_lin) + 1};
         ls.frame.title = panel ? "Largest relative edge error along t (Fig. 12, right)"
                                : "RMS edge error / mean length along t (Fig. 12, left)";
         ls.frame.xlabel = "t";
+        ls.frame.width = 720;   /* room for the legend beside the curves */
         ls.frame.ylabel = panel ? "max |l - l(t)| / l(t)" : "RMS(l - l(t)) / mean l(t)";
         ls.nseries = 2;
         ls.series = ser;
@@ -286,7 +287,8 @@ static int report(notebook *nb, study *s)
             return nb_fail(nb, rc, "line plot");
     }
     nb_image(nb, "rms_ratio.png", "RMS edge-length error relative to the mean interpolated "
-             "length, along t, interior frames (log scale; data: errors.csv, which has the ends too)");
+             "length, along t, interior frames: the embedded edge-length interpolation against "
+             "vertex interpolation (log scale; data: errors.csv, which has the ends too)");
     nb_image(nb, "max_rel.png", "Largest relative edge-length error along t");
     nb_p(nb, "The embedded frames' worst edge is %.2f%% off its interpolated length (at "
          "t = %.2f); vertex interpolation's worst edge is %.1f%% off (at t = %.2f).",
