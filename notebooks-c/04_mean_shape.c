@@ -47,6 +47,7 @@ typedef struct study {
     es_embed_report rep;
     double *proc;         /* 3V: Procrustes mean, similarity-aligned onto emb */
     double vertex_rms_rel;    /* RMS vertex distance of the two means / RMS radius */
+    double rms_radius;        /* of the edge-length mean (the unit of the distance map) */
     double proc_rms_ratio, proc_max_rel;   /* Procrustes mean vs mean lengths */
     double *vdist;        /* V: per-vertex distance between the means */
 } study;
@@ -221,6 +222,7 @@ static int procrustes_mean(notebook *nb, study *s)
         r2 += t2;
     }
     s->vertex_rms_rel = sqrt(ss / r2);
+    s->rms_radius = sqrt(r2 / (double)V);
     /* put the Procrustes mean in the embedded mean's frame for pictures */
     for (int64_t v = 0; v < V; v++)
         for (int k = 0; k < 3; k++) cx[k] += s->emb[3 * v + k] / (double)V;
@@ -318,12 +320,16 @@ static int report(notebook *nb, study *s)
         return nb_fail(nb, rc, "render");
     nb_image(nb, "inputs.png", "Input poses: first, middle and last");
 
+    /* the map in % of the RMS radius, the unit the text uses */
+    double *pct = malloc(sizeof(double) * (size_t)s->V);
+    if (!pct) return nb_fail(nb, ES_ENOMEM, "render");
+    for (int64_t v = 0; v < s->V; v++) pct[v] = 100 * s->vdist[v] / s->rms_radius;
     memset(rm, 0, sizeof rm);
     rm[0] = (es_render_mesh){.nverts = s->V, .nfaces = s->F, .xyz = s->emb,
                              .faces = es_mesh_faces(s->mesh), .label = "edge-length mean"};
     rm[1] = (es_render_mesh){.nverts = s->V, .nfaces = s->F, .xyz = s->proc,
                              .faces = es_mesh_faces(s->mesh), .label = "Procrustes mean",
-                             .scalar_kind = ES_SCALARS_VERTEX, .scalars = s->vdist};
+                             .scalar_kind = ES_SCALARS_VERTEX, .scalars = pct};
     es_render_spec_init(&sp);
     sp.nmeshes = 2;
     sp.meshes = rm;
@@ -333,9 +339,10 @@ static int report(notebook *nb, study *s)
     sp.has_up = s->z_up;
     sp.up[0] = sp.up[1] = 0;
     sp.up[2] = 1;
-    sp.colorbar_label = "distance to the edge-length mean";
-    if ((rc = es_render(nb->ctx, &sp, nb_path(nb, "means.png"), &rr)) != ES_OK)
-        return nb_fail(nb, rc, "render");
+    sp.colorbar_label = "distance to the edge-length mean (% of its RMS radius)";
+    rc = es_render(nb->ctx, &sp, nb_path(nb, "means.png"), &rr);
+    free(pct);
+    if (rc != ES_OK) return nb_fail(nb, rc, "render");
     nb_image(nb, "means.png", "Left: the embedded edge-length mean (mean_lengths.obj). Right: "
              "the Procrustes mean (mean_procrustes.obj), coloured by each vertex's distance to "
              "the left one (data: vertex_distance.csv)");
