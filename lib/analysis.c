@@ -45,21 +45,13 @@ es_status es_source_store(es_ctx *ctx, es_store *store, const int64_t *rows, int
 es_status es_lengths_from_file(es_ctx *ctx, const es_mesh *mesh, const char *path, double *len,
                                double *scale)
 {
-    es_meshdata md;
-    es_status rc = es_meshdata_read(ctx, path, ES_FORMAT_AUTO, &md);
-    if (rc != ES_OK) return rc;
-    char want[17], got[17];
-    es_mesh_fingerprint(mesh, want);
-    es_faces_fingerprint(md.nverts, md.nfaces, md.faces, got);
-    if (strcmp(want, got)) {
-        rc = es__fail(ctx, ES_EMISMATCH, "'%s': %lld vertices and %lld faces do not match the "
-                      "store's topology (%lld vertices, %lld faces, same face list required)",
-                      path, (long long)md.nverts, (long long)md.nfaces,
-                      (long long)es_mesh_nverts(mesh), (long long)es_mesh_nfaces(mesh));
-    } else if ((rc = es_edge_lengths(ctx, mesh, md.xyz, len)) == ES_OK) {
+    double *xyz = es__alloc_array(ctx, 3 * es_mesh_nverts(mesh), sizeof *xyz);
+    es_status rc;
+    if (!xyz) return ES_ENOMEM;
+    if ((rc = es_mesh_read_positions(ctx, mesh, path, xyz)) == ES_OK &&
+        (rc = es_edge_lengths(ctx, mesh, xyz, len)) == ES_OK)
         rc = es_lengths_normalize(ctx, es_mesh_nedges(mesh), len, len, scale);
-    }
-    es_meshdata_clear(ctx, &md);
+    es__free(ctx, xyz);
     return rc;
 }
 

@@ -456,7 +456,8 @@ void es_embedder_free(es_embedder *emb)
     void *bufs[] = {emb->slot_corner, emb->edge_slot, emb->pinned, emb->vweight, emb->rank,
                     emb->nlow, emb->var, emb->amap_off, emb->amap, emb->adiag, emb->ang,
                     emb->theta, emb->C, emb->G, emb->len, emb->alpha, emb->alpha_try, emb->alpha_keep, emb->xyz,
-                    emb->xyz_try, emb->xyz_best, emb->init_copy, emb->ltarget, emb->lpath, emb->res, emb->grad, emb->diag, emb->pcg,
+                    emb->xyz_try, emb->xyz_best, emb->init_copy, emb->ltarget, emb->lpath,
+                    emb->res, emb->grad, emb->diag, emb->pcg,
                     emb->jw, emb->fanwork, emb->fanr, emb->fanth, emb->fanal, emb->vclos,
                     emb->verr};
     for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++) es__free(ctx, bufs[i]);
@@ -1320,7 +1321,8 @@ es_status es_embed_solve(es_embedder *emb, const double *target, double scale,
      * the solve writes its output before it aligns it to init_xyz, so it
      * must read a copy then */
     if (emb && init_xyz && xyz) {
-        uintptr_t a = (uintptr_t)init_xyz, b = (uintptr_t)xyz, n = 3 * (uintptr_t)emb->nv * sizeof *xyz;
+        uintptr_t a = (uintptr_t)init_xyz, b = (uintptr_t)xyz;
+        uintptr_t n = 3 * (uintptr_t)emb->nv * sizeof *xyz;
         if (a < b + n && b < a + n) {
             memcpy(emb->init_copy, init_xyz, (size_t)n);
             init_xyz = emb->init_copy;

@@ -61,6 +61,17 @@ es_status es_export_lengths_csv(es_ctx *ctx, es_store *s, const int64_t *rows, i
     if (E < 1)
         ES_FAIL(ctx, ES_EINVAL, "export: store '%s' has no edges: it holds landmarks only; give "
                 "--edges or --triangles at ingest", es_store_path(s));
+    {
+        /* Never truncate the store itself (export STORE --lengths STORE), nor
+         * another store */
+        struct stat so, sp;
+        if (stat(es_store_path(s), &so) == 0 && stat(path, &sp) == 0 &&
+            so.st_dev == sp.st_dev && so.st_ino == sp.st_ino)
+            ES_FAIL(ctx, ES_EINVAL, "export: '%s' is the store itself; not overwriting it", path);
+        if (es_file_is_hdf5(path))
+            ES_FAIL(ctx, ES_EINVAL, "export: '%s' is an HDF5 file (a store?); not overwriting it "
+                    "with CSV", path);
+    }
     if ((rc = row_list(ctx, s, rows, nrows, &list, &n, &own))) return rc;
     if (!(len = es__alloc_array(ctx, E, sizeof *len)) ||
         !(edges = es__alloc_array(ctx, 2 * E, sizeof *edges)) ||
@@ -71,28 +82,6 @@ es_status es_export_lengths_csv(es_ctx *ctx, es_store *s, const int64_t *rows, i
     }
     if ((rc = es_store_read_edges(ctx, s, edges)) || (rc = es_store_read_scales(ctx, s, scales)))
         goto done;
-    {
-        /* Never truncate the store itself (export STORE --lengths STORE), nor
-         * another store: any HDF5 file, told by its signature. */
-        struct stat so, sp;
-        char sig[8];
-        FILE *g;
-        if (stat(es_store_path(s), &so) == 0 && stat(path, &sp) == 0 &&
-            so.st_dev == sp.st_dev && so.st_ino == sp.st_ino) {
-            rc = es__fail(ctx, ES_EINVAL, "export: '%s' is the store itself; not overwriting it",
-                          path);
-            goto done;
-        }
-        if ((g = fopen(path, "rb"))) {
-            int h5 = fread(sig, 1, 8, g) == 8 && !memcmp(sig, "\x89HDF\r\n\x1a\n", 8);
-            fclose(g);
-            if (h5) {
-                rc = es__fail(ctx, ES_EINVAL, "export: '%s' is an HDF5 file (a store?); not "
-                              "overwriting it with CSV", path);
-                goto done;
-            }
-        }
-    }
     /* a failed export leaves a file that was there before as it was */
     if ((rc = es__replace_begin(ctx, path, &w))) goto done;
     f = w.f;

@@ -302,6 +302,26 @@ es_status es_mesh_read(es_ctx *ctx, const char *path, es_mesh **out)
     return rc;
 }
 
+es_status es_mesh_read_positions(es_ctx *ctx, const es_mesh *mesh, const char *path,
+                                 double *xyz)
+{
+    es_meshdata md;
+    char want[17], got[17];
+    es_status rc = es_meshdata_read(ctx, path, ES_FORMAT_AUTO, &md);
+    if (rc != ES_OK) return rc;
+    es_mesh_fingerprint(mesh, want);
+    es_faces_fingerprint(md.nverts, md.nfaces, md.faces, got);
+    if (strcmp(want, got))
+        rc = es__fail(ctx, ES_EMISMATCH, "'%s': %lld vertices and %lld faces do not match the "
+                      "store's topology (%lld vertices, %lld faces, same face list required)",
+                      path, (long long)md.nverts, (long long)md.nfaces,
+                      (long long)es_mesh_nverts(mesh), (long long)es_mesh_nfaces(mesh));
+    else
+        memcpy(xyz, md.xyz, 3 * (size_t)md.nverts * sizeof *xyz);
+    es_meshdata_clear(ctx, &md);
+    return rc;
+}
+
 es_status es_mesh_write(es_ctx *ctx, const char *path, es_mesh_format format,
                         const es_mesh *mesh, const double *xyz, const uint8_t *vertex_rgb)
 {

@@ -698,6 +698,14 @@ static void release(es_store *s, bool keep_work)
     es__free(ctx, s);
 }
 
+int es_file_is_hdf5(const char *path)
+{
+    htri_t is = 0;
+    if (!path || access(path, F_OK) != 0) return 0;
+    H5E_BEGIN_TRY { is = H5Fis_hdf5(path); } H5E_END_TRY
+    return is > 0;
+}
+
 static es_status open_impl(es_ctx *ctx, const char *path, es_store_mode mode, es_store **out)
 {
     es_store *s;

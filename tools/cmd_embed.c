@@ -55,32 +55,6 @@ static char *base_name(const char *path, char *buf, size_t n)
     return buf;
 }
 
-/* --init mesh:FILE: the positions of a mesh with the store's face list.
- * Prints its own message on failure. */
-static es_status read_init_mesh(es_ctx *ctx, const es_mesh *mesh, const char *path, double *xyz)
-{
-    es_meshdata md;
-    char want[17], got[17];
-    es_status rc = es_meshdata_read(ctx, path, ES_FORMAT_AUTO, &md);
-    if (rc != ES_OK) {
-        fprintf(stderr, "edgespace embed: --init: %s\n", es_ctx_errmsg(ctx));
-        return rc;
-    }
-    es_mesh_fingerprint(mesh, want);
-    es_faces_fingerprint(md.nverts, md.nfaces, md.faces, got);
-    if (strcmp(want, got)) {
-        fprintf(stderr, "edgespace embed: --init '%s': %lld vertices and %lld faces do not match "
-                "the store's topology (%lld vertices, %lld faces, same face list required)\n",
-                path, (long long)md.nverts, (long long)md.nfaces,
-                (long long)es_mesh_nverts(mesh), (long long)es_mesh_nfaces(mesh));
-        rc = ES_EMISMATCH;
-    } else {
-        memcpy(xyz, md.xyz, 3 * (size_t)md.nverts * sizeof *xyz);
-    }
-    es_meshdata_clear(ctx, &md);
-    return rc;
-}
-
 /* --residuals CSV: per vertex of the output, its vertex-figure closure
  * energy and the mean relative error of its edges; the closure comes first
  * because render --scalars colours by the first column. */
@@ -192,7 +166,7 @@ int cmd_embed(int argc, char **argv)
         snprintf(initdesc, sizeof initdesc, "circular mean of dihedrals of %lld rows (%s)",
                  (long long)nsel, init);
     } else if (!strncmp(init, "mesh:", 5)) {
-        if ((rc = read_init_mesh(ctx, mesh, init + 5, init_xyz))) goto done;
+        if ((rc = es_mesh_read_positions(ctx, mesh, init + 5, init_xyz))) goto fail;
         snprintf(initdesc, sizeof initdesc, "mesh %s", init + 5);
     } else {
         rc = ES_EINVAL;

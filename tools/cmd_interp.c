@@ -215,8 +215,8 @@ static es_status lerp_frame(const double *a, const double *b, double sa, double 
  * expressions): frame t embeds (1 - t) a + t b at the scale (1 - t) s_a +
  * t s_b (lerp in datasets-spec/point-syntax.md), its dihedrals started from
  * the previous frame (the first from the stored row nearest to it) and
- * aligned to it, so the sequence does not jump. Prints its own messages;
- * commits. */
+ * aligned to it, so the sequence does not jump. command: the provenance of
+ * stored frames, NULL to store nothing. Prints its own messages. */
 typedef struct walk {
     const char *from, *to, *pca;   /* the end points, and the PCA pc:K refers to */
     double t0, t1;
@@ -225,8 +225,7 @@ typedef struct walk {
 
 static es_status interp_points(es_ctx *ctx, es_store *s, const es_mesh *mesh, es_embedder *emb,
                                const es_embed_opts *opts, const walk *wk, const char *out,
-                               const char *name, int store_it, int argc, char **argv,
-                               double *res)
+                               const char *name, const char *command, double *res)
 {
     const char *from = wk->from, *to = wk->to;
     double t0 = wk->t0, t1 = wk->t1;
@@ -272,19 +271,16 @@ static es_status interp_points(es_ctx *ctx, es_store *s, const es_mesh *mesh, es
         if ((rc = es_embed_solve(emb, v, scale, at_end, i ? res : start, opts, res, &rep)))
             goto fail;
         {
-            char *cmd = store_it ? cli_command_line(argc, argv) : NULL, head[64];
-            es_provenance prov = {cmd ? cmd : "edgespace interp", &row, 1, params};
+            es_provenance prov = {command, &row, 1, params};
+            char head[64], endd[320];
             snprintf(params, sizeof params, "from=%s; to=%s; t=%.17g", from, to, t);
-            char endd[320];
             snprintf(head, sizeof head, "t = %.4g", t);
             if (at_end) snprintf(endd, sizeof endd, "the dihedrals of %s", t == 0 ? from : to);
-            rc = emit_frame(ctx, s, mesh, emb, out, name, steps, i, head, v, res, &rep,
-                            store_it ? &prov : NULL, at_end ? endd : initd);
-            free(cmd);
-            if (rc) goto fail;
+            if ((rc = emit_frame(ctx, s, mesh, emb, out, name, steps, i, head, v, res, &rep,
+                                 command ? &prov : NULL, at_end ? endd : initd)))
+                goto fail;
         }
     }
-    if (store_it && (rc = commit_frames(ctx, s, name, steps))) goto fail;
     goto done;
 fail:
     cli_fail("interp", ctx, rc);
@@ -306,7 +302,8 @@ int cmd_interp(int argc, char **argv)
     const char *from = NULL, *to = NULL, *weights = NULL, *out = NULL, *name = NULL;
     const char *pca = NULL;
     char ids[MAX_IN][256], namebuf[256], fname[1024];
-    double w[MAX_IN], t0 = 0, t1 = 1, *xyz[MAX_IN] = {0}, *res = NULL, *len = NULL;
+    double w[MAX_IN], t0 = 0, t1 = 1, *xyz[MAX_IN] = {0}, *res = NULL, *len = NULL, *alpha = NULL;
+    char *cmd = NULL;   /* the command line, the provenance of stored frames */
     int64_t steps = 9, rows[MAX_IN], nin = 0, nv, ne;
     int c, store_it = 1, points = 0;
     int64_t refine_iters;
@@ -381,14 +378,16 @@ int cmd_interp(int argc, char **argv)
     ne = es_mesh_nedges(mesh);
     res = malloc(3 * (size_t)nv * sizeof *res);
     len = malloc((size_t)ne * sizeof *len);
-    if (!res || !len) {
+    alpha = malloc((size_t)ne * sizeof *alpha);
+    if (!res || !len || !alpha || (store_it && !(cmd = cli_command_line(argc, argv)))) {
         rc = ES_ENOMEM;
         goto fail;
     }
     if (points) {
         walk wk = {from, to, pca, t0, t1, steps};
-        rc = interp_points(ctx, s, mesh, emb, &opts, &wk, out, name, store_it, argc, argv, res);
-        goto done;
+        if ((rc = interp_points(ctx, s, mesh, emb, &opts, &wk, out, name, cmd, res)))
+            goto done;   /* it said why */
+        goto commit;
     }
     for (int64_t k = 0; k < nin; k++) {
         if ((rows[k] = es_store_find_row(s, ids[k])) < 0) {
@@ -410,12 +409,16 @@ int cmd_interp(int argc, char **argv)
         const double *const *in = (const double *const *)xyz;
         if (weights) memcpy(wi, w, (size_t)nin * sizeof *wi);
         else wi[0] = 1 - t, wi[1] = t;
-        /* frames align to the previous frame so that the sequence does not jump */
-        if ((rc = es_interp_embed(emb, nin, in, wi, i ? res : NULL, &opts, res, &rep, &info)))
+        /* the targets once (es_interp_embed would not hand the lengths back
+         * for storing); frames align to the previous frame so that the
+         * sequence does not jump, the first to the reference input */
+        if ((rc = es_interp_targets(ctx, mesh, nin, in, wi, len, alpha, &info)) ||
+            (rc = es_embed_solve(emb, len, 0, alpha, i ? res : in[info.reference], &opts, res,
+                                 &rep)))
             goto fail;
         {
-            char *cmd = store_it ? cli_command_line(argc, argv) : NULL, params[512], head[128];
-            es_provenance prov = {cmd ? cmd : "edgespace interp", rows, nin, params};
+            char params[512], head[128];
+            es_provenance prov = {cmd, rows, nin, params};
             int off = 0;
             for (int64_t k = 0; k < nin && off < (int)sizeof params - 40; k++)
                 off += snprintf(params + off, sizeof params - (size_t)off, "%sw[%s]=%.6g",
@@ -426,14 +429,12 @@ int cmd_interp(int argc, char **argv)
             else
                 snprintf(head, sizeof head, "t = %.4g (%lld dihedrals wrapped, %lld lengths "
                          "clamped)", t, (long long)info.n_wrapped, (long long)info.n_clamped);
-            /* the stored target: the interpolated lengths */
-            if (!store_it || !(rc = es_interp_targets(ctx, mesh, nin, in, wi, len, NULL, NULL)))
-                rc = emit_frame(ctx, s, mesh, emb, out, name, steps, i, head, len, res, &rep,
-                                store_it ? &prov : NULL, "circular mean of the inputs' dihedrals");
-            free(cmd);
-            if (rc) goto fail;
+            if ((rc = emit_frame(ctx, s, mesh, emb, out, name, steps, i, head, len, res, &rep,
+                                 cmd ? &prov : NULL, "circular mean of the inputs' dihedrals")))
+                goto fail;
         }
     }
+commit:
     if (store_it && (rc = commit_frames(ctx, s, name, steps))) goto fail;
     goto done;
 fail:
@@ -444,7 +445,7 @@ done:
     if (rc) es_store_abort(s);
     else es_store_close(s);
     for (int k = 0; k < MAX_IN; k++) free(xyz[k]);
-    free(res), free(len);
+    free(res), free(len), free(alpha), free(cmd);
     es_ctx_free(ctx);
     return rc ? CLI_FAIL : CLI_OK;
 }

@@ -11,18 +11,12 @@ FILE *stats_csv_open(const char *verb, const char *path)
 {
     if (!strcmp(path, "-")) return stdout;
     /* Refuse to truncate an HDF5 file (the store given as --csv by mistake). */
-    FILE *f = fopen(path, "rb");
-    if (f) {
-        char sig[8];
-        int h5 = fread(sig, 1, 8, f) == 8 && !memcmp(sig, "\x89HDF\r\n\x1a\n", 8);
-        fclose(f);
-        if (h5) {
-            fprintf(stderr, "edgespace %s: '%s' is an HDF5 file (a store?); not overwriting it "
-                    "with CSV\n", verb, path);
-            return NULL;
-        }
+    if (es_file_is_hdf5(path)) {
+        fprintf(stderr, "edgespace %s: '%s' is an HDF5 file (a store?); not overwriting it "
+                "with CSV\n", verb, path);
+        return NULL;
     }
-    f = fopen(path, "w");
+    FILE *f = fopen(path, "w");
     if (!f) fprintf(stderr, "edgespace %s: cannot write '%s': %s\n", verb, path, strerror(errno));
     return f;
 }

@@ -53,6 +53,12 @@ ES_API void es_meshdata_clear(es_ctx *ctx, es_meshdata *md);
  * ES_ETOPOLOGY) with the file name put in front of the message. */
 ES_API es_status es_mesh_read(es_ctx *ctx, const char *path, es_mesh **out);
 
+/* The positions (3 x V) of a mesh file whose face list is that of `mesh`
+ * (a new shape of a study's topology); ES_EMISMATCH naming the file when
+ * it is not, and the errors of es_meshdata_read. */
+ES_API es_status es_mesh_read_positions(es_ctx *ctx, const es_mesh *mesh, const char *path,
+                                        double *xyz);
+
 /* Write positions xyz (3 x V) with mesh's faces. Format from the extension
  * when ES_FORMAT_AUTO (.obj, .ply = binary little endian, .off).
  * xyz: NULL writes the mesh's reference positions (ES_EINVAL if it has none).
