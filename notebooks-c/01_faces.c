@@ -508,7 +508,7 @@ static int embed(notebook *nb, study *s)
         /* The mean neutral face starts from the first stored face (whose
          * pose every output is aligned to); the others start from it. */
         const double *init = p == 0 ? es_mesh_xyz(s->mesh) : s->xyz;
-        rc = es_embed_solve(emb, s->pts + p * s->E, s->pt_scale[p], NULL, init, &eo,
+        rc = es_embed_solve(nb->ctx, emb, s->pts + p * s->E, s->pt_scale[p], NULL, init, &eo,
                             s->xyz + p * V3, &s->rep[p]);
         if (rc != ES_OK) {
             es_embedder_free(emb);

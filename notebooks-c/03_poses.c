@@ -206,7 +206,7 @@ static int interpolate(notebook *nb, study *s)
             goto done;
         /* the frame: embedded from the (shortest-arc) interpolated dihedrals,
          * aligned to the previous frame */
-        rc = es_interp_embed(emb, 2, in, w, k ? s->frames + V3 * (k - 1) : s->xa, NULL,
+        rc = es_interp_embed(nb->ctx, emb, 2, in, w, k ? s->frames + V3 * (k - 1) : s->xa, NULL,
                              s->frames + V3 * k, &r, &info);
         if (rc != ES_OK) goto done;
         if (info.n_wrapped > wrapped) wrapped = info.n_wrapped;

@@ -166,7 +166,7 @@ static int embed_mean(notebook *nb, study *s)
     if (!s->emb) return nb_fail(nb, ES_ENOMEM, "embedding");
     if ((rc = es_embedder_new(nb->ctx, s->mesh, &emb)) != ES_OK)
         return nb_fail(nb, rc, "embedder");
-    rc = es_embed_solve(emb, s->mean_len, s->mean_scale, NULL, s->xyz, &eo, s->emb, &s->rep);
+    rc = es_embed_solve(nb->ctx, emb, s->mean_len, s->mean_scale, NULL, s->xyz, &eo, s->emb, &s->rep);
     es_embedder_free(emb);
     if (rc != ES_OK) return nb_fail(nb, rc, "embedding the mean");
     if ((rc = es_mesh_write(nb->ctx, nb_path(nb, "mean_lengths.obj"), ES_FORMAT_OBJ, s->mesh,

@@ -1,4 +1,4 @@
-/* tools/commands.h — the subcommands, each in tools/cmd_<verb>.c. */
+/* tools/commands.h — the subcommands, each in tools/cmd/<verb>.c. */
 #ifndef EDGESPACE_TOOLS_COMMANDS_H
 #define EDGESPACE_TOOLS_COMMANDS_H
 

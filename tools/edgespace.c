@@ -1,5 +1,5 @@
 /* tools/edgespace.c — the edgespace command: dispatches to subcommands, git
- * style. Each subcommand lives in tools/cmd_<verb>.c and stays thin over the
+ * style. Each subcommand lives in tools/cmd/<verb>.c and stays thin over the
  * library. */
 #include "cli.h"
 #include "commands.h"
@@ -27,7 +27,9 @@ static const command commands[] = {
     {"diff", cmd_diff, "mean paired difference (to - from) with per-edge t statistics"},
     {"project", cmd_project, "scores of rows or mesh files on a stored PCA, with residuals"},
     {"point", cmd_point, "evaluate and store a point expression (mean + 2*pc:1, ...)"},
+#if ES_HAVE_FIGURES
     {"plot-pca", cmd_plot_pca, "PCA score scatter coloured by a label, or scree plot, from a store"},
+#endif
     /* -- procrustes, landmarks, comparison */
     {"gpa", cmd_gpa, "generalized Procrustes analysis of a store's positions"},
     {"compare", cmd_compare, "Procrustes vs edge-length space: distances, Mantel, groups"},
@@ -36,8 +38,10 @@ static const command commands[] = {
     {"embed", cmd_embed, "realize a point of edge-length space as a mesh, with a quality report"},
     {"interp", cmd_interp, "interpolate/extrapolate stored shapes in edge-length space and embed"},
     /* -- plotting, rendering */
+#if ES_HAVE_FIGURES
     {"render", cmd_render, "draw meshes side by side to PNG/SVG/PDF"},
     {"plot", cmd_plot, "scatter, lines, scree, histogram or heat map of a CSV table"},
+#endif
     {NULL, NULL, NULL}
 };
 

@@ -135,7 +135,7 @@ es_status stats_point_lengths(const char *verb, es_ctx *ctx, es_store *store, co
         es_free(ctx, v);
     } else {   /* an expression (es_point.h syntax) */
         es_point_info info;
-        if (!(rc = es_analysis_point(ctx, store, NULL, spec, pca, 0, "edgespace", &v, &info))) {
+        if (!(rc = es_study_point(ctx, store, NULL, spec, pca, 0, "edgespace", &v, &info))) {
             memcpy(lengths, v, (size_t)ne * sizeof *lengths);
             if (isfinite(info.scale) && info.scale > 0) *scale = info.scale;
         }

@@ -5,7 +5,7 @@
 #define EDGESPACE_TOOLS_STATS_CLI_H
 
 #include <edgespace/edgespace.h>
-#include <edgespace/es_analysis.h>
+#include <edgespace/es_study.h>
 #include <edgespace/es_store.h>
 
 #include <stdio.h>

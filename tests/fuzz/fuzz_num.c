@@ -1,7 +1,7 @@
 /* tests/fuzz/fuzz_num.c — differential libFuzzer target: es__parse_double
  * against strtod. Whatever prefix our parser accepts, strtod must accept
  * whole and give the same bits. Built with -Dfuzz=true and clang. */
-#include "mesh_io_internal.h"
+#include "core/text.h"
 
 #include <stdlib.h>
 

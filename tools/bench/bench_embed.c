@@ -45,7 +45,7 @@ static void print_row(const char *dir, const char *what, int64_t nv, double wall
 static int sweep_mode;
 
 /* The midpoint at 0, 1, 2, ... refinement iterations (sweep mode). */
-static void sweep(es_embedder *emb, int64_t nv, const double *const *in, double *out,
+static void sweep(es_ctx *ctx, es_embedder *emb, int64_t nv, const double *const *in, double *out,
                   const char *dir, double setup)
 {
     static const int iters[] = {0, 1, 2, 3, 4, 6, 8, 12, 20, 40};
@@ -57,7 +57,7 @@ static void sweep(es_embedder *emb, int64_t nv, const double *const *in, double 
         double w0 = bench_wall_s(), c0 = bench_process_cpu_s();
         es_embed_opts_init(&o);
         o.refine_max_iter = iters[i];
-        if (es_interp_embed(emb, 2, in, w, NULL, &o, out, &r, NULL)) return;
+        if (es_interp_embed(ctx, emb, 2, in, w, NULL, &o, out, &r, NULL)) return;
         snprintf(what, sizeof what, "refine %d", iters[i]);
         print_row(dir, what, nv, bench_wall_s() - w0, bench_process_cpu_s() - c0, setup, &r, 0);
         fflush(stdout);
@@ -117,14 +117,14 @@ static void run(es_ctx *ctx, const char *dir, const char *a, const char *b, int 
         es_embed_report r;
         es_embed_opts paper;
         if (sweep_mode) {
-            sweep(emb, nv, in, out, dir, tw_new);
+            sweep(ctx, emb, nv, in, out, dir, tw_new);
             free(out), free(len), free(al);
             goto done;
         }
         /* midpoint */
         w0 = bench_wall_s();
         c0 = bench_process_cpu_s();
-        if (es_interp_embed(emb, 2, in, w, NULL, NULL, out, &r, NULL)) goto fail;
+        if (es_interp_embed(ctx, emb, 2, in, w, NULL, NULL, out, &r, NULL)) goto fail;
         print_row(dir, "midpoint t=0.5", nv, bench_wall_s() - w0, bench_process_cpu_s() - c0,
                   tw_new, &r, 0);
         /* the published method's stages on the same midpoint, in the same
@@ -134,7 +134,7 @@ static void run(es_ctx *ctx, const char *dir, const char *a, const char *b, int 
         paper.refine_max_iter = 0;
         w0 = bench_wall_s();
         c0 = bench_process_cpu_s();
-        if (es_interp_embed(emb, 2, in, w, NULL, &paper, out, &r, NULL)) goto fail;
+        if (es_interp_embed(ctx, emb, 2, in, w, NULL, &paper, out, &r, NULL)) goto fail;
         print_row(dir, "paper stages t=0.5", nv, bench_wall_s() - w0, bench_process_cpu_s() - c0,
                   tw_new, &r, 0);
         /* round trip of shape a */
@@ -142,7 +142,7 @@ static void run(es_ctx *ctx, const char *dir, const char *a, const char *b, int 
         es_dihedral_angles(ctx, mesh, xyz, al);
         w0 = bench_wall_s();
         c0 = bench_process_cpu_s();
-        if (es_embed_solve(emb, len, 0, al, NULL, NULL, out, &r)) goto fail;
+        if (es_embed_solve(ctx, emb, len, 0, al, NULL, NULL, out, &r)) goto fail;
         print_row(dir, "round trip (exact)", nv, bench_wall_s() - w0, bench_process_cpu_s() - c0,
                   tw_new, &r, 1);
         fflush(stdout);

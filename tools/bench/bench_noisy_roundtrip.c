@@ -23,7 +23,7 @@
  */
 #include <edgespace/edgespace.h>
 
-#include "es_internal.h"   /* es__rng: the seeded generator the tests use */
+
 
 #include <math.h>
 #include <stdint.h>
@@ -74,12 +74,12 @@ static void run(es_ctx *ctx, const char *file, int closed)
         for (int level = 0; level < 2; level++)
             for (uint64_t seed = 1; seed <= 3; seed++) {
                 double sigma = level ? 0.05 : 0.005, w0;
-                es__rng rng;
-                es__rng_init(&rng, seed);
+                es_rng rng;
+                es_rng_init(&rng, seed);
                 es_dihedral_angles(ctx, mesh, md.xyz, al);
-                for (int64_t e = 0; e < ne; e++) al[e] += sigma * es__rng_normal(&rng);
+                for (int64_t e = 0; e < ne; e++) al[e] += sigma * es_rng_normal(&rng);
                 w0 = bench_wall_s();
-                if (es_embed_solve(emb, len, 0, al, NULL, NULL, out, &r)) goto fail;
+                if (es_embed_solve(ctx, emb, len, 0, al, NULL, NULL, out, &r)) goto fail;
                 w0 = bench_wall_s() - w0;
                 es_kabsch_align(ctx, nv, out, md.xyz, NULL, &rms);
                 print_row(file, nv, sigma, seed, "", &r, rms / diag, w0);
@@ -92,7 +92,7 @@ static void run(es_ctx *ctx, const char *file, int closed)
                     o.refine_rtol = 1e-12;
                     o.refine_tol = 0;
                     w0 = bench_wall_s();
-                    if (es_embed_solve(emb, len, 0, al, NULL, &o, out, &r)) goto fail;
+                    if (es_embed_solve(ctx, emb, len, 0, al, NULL, &o, out, &r)) goto fail;
                     w0 = bench_wall_s() - w0;
                     es_kabsch_align(ctx, nv, out, md.xyz, NULL, &rms);
                     print_row(file, nv, sigma, seed, " long", &r, rms / diag, w0);
@@ -107,11 +107,11 @@ static void run(es_ctx *ctx, const char *file, int closed)
             o.refine_rtol = 1e-15;
             o.refine_tol = 0;
             for (int m = 0; m < 3; m++) {
-                es__rng rng;
-                es__rng_init(&rng, 99);
+                es_rng rng;
+                es_rng_init(&rng, 99);
                 for (int64_t i = 0; i < 3 * nv; i++)
-                    x0[i] = md.xyz[i] + moves[m] * diag * es__rng_normal(&rng);
-                if (es_embed_solve(emb, len, 0, NULL, x0, &o, out, &r)) goto fail;
+                    x0[i] = md.xyz[i] + moves[m] * diag * es_rng_normal(&rng);
+                if (es_embed_solve(ctx, emb, len, 0, NULL, x0, &o, out, &r)) goto fail;
                 es_kabsch_align(ctx, nv, out, md.xyz, NULL, &rms);
                 printf("%-34s %6lld  moved %.0e x diag               %9.2e %9.2e  %9.2e  %3s "
                        "%3lld\n",

@@ -12,7 +12,7 @@
  *
  *   bench_pca [--rows N] [--edges E] [--rank R] [--components K] [--no-numpy]
  */
-#include "es_internal.h"
+
 #include "edgespace/es_stats.h"
 
 #include <cblas.h>
@@ -134,11 +134,11 @@ int main(int argc, char **argv)
     gen g = {E, N, R, NULL, NULL, 12345, 0};
     g.basis = malloc((size_t)(E * R) * sizeof(double));
     g.coef = malloc((size_t)(R * N) * sizeof(double));
-    es__rng rng;
-    es__rng_init(&rng, 777);
-    for (int64_t i = 0; i < E * R; i++) g.basis[i] = 0.02 * es__rng_normal(&rng);
+    es_rng rng;
+    es_rng_init(&rng, 777);
+    for (int64_t i = 0; i < E * R; i++) g.basis[i] = 0.02 * es_rng_normal(&rng);
     for (int64_t j = 0; j < N; j++)
-        for (int64_t k = 0; k < R; k++) g.coef[k + j * R] = es__rng_normal(&rng) / (double)(k + 1);
+        for (int64_t k = 0; k < R; k++) g.coef[k + j * R] = es_rng_normal(&rng) / (double)(k + 1);
     es_source src;
     memset(&src, 0, sizeof src);
     src.nedges = E;

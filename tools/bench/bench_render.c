@@ -12,7 +12,7 @@
 
 #include "bench_clock.h"
 
-#include "../../tests/mesh_gen.h"
+#include "mesh_gen.h"   /* tests/common: the synthetic face grid */
 
 /* Best of `reps` CPU times of one render. */
 static double time_render(es_ctx *ctx, const es_render_spec *spec, const char *out, int reps)

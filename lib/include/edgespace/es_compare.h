@@ -24,7 +24,6 @@
 #define EDGESPACE_ES_COMPARE_H
 
 #include "es_core.h"
-#include "es_store.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -99,6 +98,11 @@ typedef struct es_compare_result {
     double *mean_len, *mean_proc;  /* ngroups x ngroups distances of group means */
     double *p_len, *p_proc;        /* their permutation p-values */
     es_group_stats groups_len, groups_proc;
+    /* Filled by the study on a store (es_study_compare), NULL otherwise: the
+     * row ids (n), each row's group (n) and the group names (ngroups). */
+    char **ids;
+    int64_t *group;
+    char **group_names;
     es_ctx *ctx;
 } es_compare_result;
 
@@ -112,34 +116,11 @@ ES_API es_status es_compare_study(es_ctx *ctx, es_mat lengths, es_mat aligned,
                                   const es_compare_opts *opts, es_compare_result **out);
 ES_API void es_compare_result_free(es_compare_result *res);
 
-/* Write the study to dir (created if missing): distances_lengths.csv and
- * distances_procrustes.csv (n x n with ids), pairs.csv (i, j, ids, both
- * distances, group pair), summary.csv (statistic, value), nearest.csv,
- * disagreement.csv, and with groups group_means.csv (space, group_a,
- * group_b, distance, p). figures = 1 adds heatmap_lengths.svg,
- * heatmap_procrustes.svg and pairs_scatter.svg (distance pairs coloured by
- * group pair) through es_plot. ids: n names (NULL: 1-based numbers);
- * group_names: ngroups names (NULL: numbers). ES_EIO names the file. */
-ES_API es_status es_compare_write(es_ctx *ctx, const es_compare_result *res,
-                                  const char *const *ids, const int64_t *group,
-                                  const char *const *group_names, const char *dir,
-                                  int figures);
+/* "a|b" with the two names in byte order: the label of a pair of groups in
+ * the study's tables and figures. es_free the result (NULL: out of memory). */
+ES_API char *es_compare_pair_label(es_ctx *ctx, const char *a, const char *b);
 
-/* The study on a store: the rows of GPA result /analysis/gpa/<gpa_name>
- * (their aligned configurations) against their stored normalized edge
- * lengths, grouped by label column `by` (NULL: no groups). Writes
- * /analysis/compare/<name> (name NULL: gpa_name) with provenance: datasets
- * d_lengths, d_procrustes (n x n), group_means_lengths/_procrustes and
- * p_lengths/_procrustes (g x g), group_names, attributes spearman_rho,
- * mantel_p, nn_agreement, by, gpa (permutations in @params). out_dir (or NULL) gets
- * es_compare_write's files (figures if `figures`). ES_ENOTFOUND if the GPA
- * result or the column is missing; ES_EINVAL for a store without edges. The
- * store must be open for writing if name is not "" (name "": nothing is
- * written to the store). res (may be NULL) receives the result. */
-ES_API es_status es_compare_store_run(es_ctx *ctx, es_store *store, const char *gpa_name,
-                                      const char *by, const es_compare_opts *opts,
-                                      const char *name, const char *out_dir, int figures,
-                                      const char *command, es_compare_result **res);
+
 
 #ifdef __cplusplus
 }

@@ -108,6 +108,23 @@ ES_API void es_ctx_set_allocator(es_ctx *ctx, const es_allocator *alloc);
  * to the caller (documented per function). NULL: no-op. */
 ES_API void es_free(es_ctx *ctx, void *ptr);
 
+/* The library's deterministic random numbers (xoshiro256**, Blackman &
+ * Vigna 2018, seeded by splitmix64): what randomized PCA, permutation tests
+ * and synthetic data use, from es_ctx_seed. Same seed, same numbers, on
+ * every machine. */
+typedef struct es_rng { uint64_t s[4]; } es_rng;
+ES_API void es_rng_init(es_rng *rng, uint64_t seed);
+ES_API uint64_t es_rng_next(es_rng *rng);
+ES_API double es_rng_uniform(es_rng *rng);   /* [0, 1) with 53 random bits */
+ES_API double es_rng_normal(es_rng *rng);    /* standard normal, Box-Muller */
+/* Uniform integer in [0, n), n > 0, without modulo bias. */
+ES_API uint64_t es_rng_below(es_rng *rng, uint64_t n);
+
+/* One CSV field of free text (ids, labels, names) to f, quoted the RFC 4180
+ * way when it holds a comma, quote or line break; "" for NULL. Every CSV
+ * the library and the command write goes through it. */
+ES_API void es_csv_write_field(FILE *f, const char *s);
+
 #ifdef __cplusplus
 }
 #endif

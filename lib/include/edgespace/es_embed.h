@@ -38,7 +38,6 @@
 
 #include "es_core.h"
 #include "es_mesh.h"
-#include "es_store.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -120,7 +119,8 @@ typedef struct es_embed_report {
 ES_API es_status es_embedder_new(es_ctx *ctx, const es_mesh *mesh, es_embedder **out);
 ES_API void es_embedder_free(es_embedder *emb);
 
-/* Embed target lengths.
+/* Embed target lengths. ctx receives the message of a failure (the
+ * embedder's own context, from es_embedder_new, provides its memory).
  *   target     [in]  E edge lengths (any positive scale).
  *   scale      [in]  > 0: embed at sum of lengths = scale; 0: at the target's own sum.
  *   init_alpha [in]  E dihedral angles to start stage 1 from, or NULL.
@@ -139,8 +139,8 @@ ES_API void es_embedder_free(es_embedder *emb);
  * ES_ENUMERIC if a factorization fails beyond repair. Targets whose faces
  * violate the triangle inequality are embedded as well as possible and
  * counted in the report (realized = 0); the output is always finite. */
-ES_API es_status es_embed_solve(es_embedder *emb, const double *target, double scale,
-                                const double *init_alpha, const double *init_xyz,
+ES_API es_status es_embed_solve(es_ctx *ctx, es_embedder *emb, const double *target,
+                                double scale, const double *init_alpha, const double *init_xyz,
                                 const es_embed_opts *opts, double *xyz,
                                 es_embed_report *report);
 
@@ -181,33 +181,9 @@ ES_API es_status es_kabsch_align_parts(es_ctx *ctx, int64_t nverts, double *xyz,
                                        const double *ref, const double *w, const int64_t *part,
                                        double *rms);
 
-/* ---- with a store (lib/embed_store.c) --------------------------------
- * One-line and multi-line text of a report (for commands and notebooks):
+/* One-line and multi-line text of a report (for commands and notebooks):
  * writes at most n bytes with NUL, returns buf. */
 ES_API const char *es_embed_report_format(const es_embed_report *rep, char *buf, size_t n);
-
-/* The stored row nearest to normalized lengths `target` (E) in Euclidean
- * edge-length distance: the default initialization. rows/nrows restrict the
- * search (NULL: all rows). */
-ES_API es_status es_embed_nearest_row(es_ctx *ctx, es_store *store, const double *target,
-                                      const int64_t *rows, int64_t nrows, int64_t *row,
-                                      double *dist);
-
-/* Circular mean of the dihedrals of stored rows (E): the angle of the mean
- * unit vector per edge (oracle README, failure F). */
-ES_API es_status es_embed_mean_dihedrals(es_ctx *ctx, es_store *store, const es_mesh *mesh,
-                                         const int64_t *rows, int64_t nrows, double *alpha);
-
-/* Store an embedding as /analysis/embed/<name>: datasets positions (V x 3),
- * target_lengths (E, normalized), vertex_closure and vertex_edge_error
- * (V, for heat maps, from the embedder's last solve), and the report as
- * attributes (closure_before, closure_after, rms_ratio, max_rel, p99_rel,
- * n_bad_faces, realized, iterations, seconds per stage, init). Commit is
- * the caller's. */
-ES_API es_status es_embed_store_result(es_ctx *ctx, es_store *store, const char *name,
-                                       const es_provenance *prov, const es_embedder *emb,
-                                       const double *target, const double *xyz,
-                                       const es_embed_report *rep, const char *init);
 
 #ifdef __cplusplus
 }

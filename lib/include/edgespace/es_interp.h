@@ -42,7 +42,7 @@ ES_API es_status es_interp_targets(es_ctx *ctx, const es_mesh *mesh, int64_t nin
 
 /* Interpolate and embed: out (3 x V). align_to: positions to align the
  * output to (NULL: input r). report/info may be NULL. */
-ES_API es_status es_interp_embed(es_embedder *emb, int64_t nin, const double *const *xyz,
+ES_API es_status es_interp_embed(es_ctx *ctx, es_embedder *emb, int64_t nin, const double *const *xyz,
                                  const double *w, const double *align_to,
                                  const es_embed_opts *opts, double *out,
                                  es_embed_report *report, es_interp_info *info);
@@ -51,7 +51,7 @@ ES_API es_status es_interp_embed(es_embedder *emb, int64_t nin, const double *co
  * nsteps = 1 gives t0 only), weights (1 - t, t); t may leave [0, 1]. Frame i
  * is out + 3 V i, aligned to frame i - 1 (frame 0 to a) so that the
  * sequence does not jump. reports: nsteps entries or NULL. */
-ES_API es_status es_interp_sequence(es_embedder *emb, const double *a, const double *b,
+ES_API es_status es_interp_sequence(es_ctx *ctx, es_embedder *emb, const double *a, const double *b,
                                     double t0, double t1, int64_t nsteps,
                                     const es_embed_opts *opts, double *out,
                                     es_embed_report *reports);

@@ -75,10 +75,11 @@ ES_API es_status es_mesh_write(es_ctx *ctx, const char *path, es_mesh_format for
 /* Format guessed from a path's extension (ES_FORMAT_AUTO if unknown). */
 ES_API es_mesh_format es_mesh_format_from_path(const char *path);
 
-/* One CSV field of free text (ids, labels, names) to f, quoted the RFC 4180
- * way when it holds a comma, quote or line break; "" for NULL. Every CSV
- * the library and the command write goes through it. */
-ES_API void es_csv_write_field(FILE *f, const char *s);
+
+/* Normalized edge lengths (E) and scale of a mesh file whose face list is
+ * that of `mesh` (ES_EMISMATCH otherwise, naming the file). */
+ES_API es_status es_lengths_from_file(es_ctx *ctx, const es_mesh *mesh, const char *path,
+                                      double *len, double *scale);
 
 #ifdef __cplusplus
 }

@@ -27,7 +27,6 @@
 #define EDGESPACE_ES_LANDMARKS_H
 
 #include "es_core.h"
-#include "es_store.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -90,7 +89,7 @@ ES_API es_status es_landmarks_read_index_list(es_ctx *ctx, const char *path, int
  * NULL the store holds no faces and no edges (topology kind "none"):
  * positions, ids and labels only, for GPA; length operations on it fail.
  * 2D landmarks are stored with z = 0 in the store's 3 x V positions
- * (es_gpa_store_run analyses such rows in 2D). Labels become label columns;
+ * (es_study_gpa analyses such rows in 2D). Labels become label columns;
  * TPS IMAGE= and SCALE= values are kept as columns "image" and "tps_scale"
  * when present. ES_EEXIST if path exists. All-or-nothing (es_store_commit). */
 ES_API es_status es_landmarks_to_store(es_ctx *ctx, const es_landmarks *lm, int64_t ntri,

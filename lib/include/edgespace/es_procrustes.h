@@ -36,7 +36,6 @@
 #define EDGESPACE_ES_PROCRUSTES_H
 
 #include "es_core.h"
-#include "es_store.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -145,23 +144,6 @@ ES_API es_status es_gpa_pca(es_ctx *ctx, es_mat tan, int64_t npc, double *sdev,
 
 /* ---- GPA of a store's vertex positions ---------------------------------- */
 
-/* GPA of the positions of `rows` (nrows of them; rows NULL with nrows = -1:
- * every row) of an open store, with the PCA of the residual tangent
- * coordinates, written to /analysis/gpa/<name> (replaced if present) with
- * provenance (command; params: scale, allow_reflection, tol, max_iter):
- *   aligned   n x k*d   row j: configuration of input row j (x-, y-, z-block)
- *   mean      k*d       Procrustes mean;  size, rho, scale: n each
- *   rotation  n x d*d   column-major d x d per row;  centroid: n x d
- *   pc_sdev, pc_percent (npc), pc_scores (n x npc), pc_loadings (npc x k*d)
- * and attributes dim, k, iterations, converged, rot_change, scale_change,
- * gss, rmsrho, total_ss. Planar data (z = 0 in every row, e.g. ingested 2D
- * landmarks) are analysed in 2D (dim 2), so that a 3D rotation cannot act
- * as a reflection. npc <= 0: min(10, n - 1). Memory: the positions of the
- * rows (n x 3V doubles) once. The store must be open for writing; the
- * caller commits (es_store_commit / es_store_close). report may be NULL. */
-ES_API es_status es_gpa_store_run(es_ctx *ctx, es_store *store, const char *name,
-                                  const int64_t *rows, int64_t nrows, const es_gpa_opts *opts,
-                                  int64_t npc, const char *command, es_gpa_report *report);
 
 #ifdef __cplusplus
 }

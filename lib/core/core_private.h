@@ -1,0 +1,79 @@
+/* lib/core/core_private.h — what every module of the library shares and
+ * users never see (library-private: lib/README.md explains the three header
+ * tiers).
+ *
+ * ES_FAIL records a message on the context and returns the code; es__alloc
+ * and friends go through the context's allocator and record ES_ENOMEM
+ * themselves; checked size arithmetic; a small deterministic RNG
+ * (xoshiro256**, Blackman & Vigna 2018) seeded from the context. Never
+ * installed.
+ */
+#ifndef EDGESPACE_CORE_PRIVATE_H
+#define EDGESPACE_CORE_PRIVATE_H
+
+#if !defined(ES_BUILDING_LIBRARY) && !defined(ES_TESTING)
+#error "core/core_private.h is private to libedgespace: include <edgespace/edgespace.h>"
+#endif
+
+#include "edgespace/es_core.h"
+
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <string.h>
+
+#if defined(__GNUC__)
+#define ES__PRINTF(a, b) __attribute__((format(printf, a, b)))
+#else
+#define ES__PRINTF(a, b)
+#endif
+
+/* Format the context's message and return code. */
+es_status es__fail(es_ctx *ctx, es_status code, const char *fmt, ...) ES__PRINTF(3, 4);
+#define ES_FAIL(ctx, code, ...) return es__fail((ctx), (code), __VA_ARGS__)
+
+/* Warnings and notes to the log callback (no-op without one). */
+void es__warn(es_ctx *ctx, const char *fmt, ...) ES__PRINTF(2, 3);
+void es__info(es_ctx *ctx, const char *fmt, ...) ES__PRINTF(2, 3);
+
+/* Progress callback (no-op without one). */
+void es__progress(es_ctx *ctx, const char *what, int64_t done, int64_t total);
+
+/* Allocation through the context; on failure they record ES_ENOMEM with a
+ * message and return NULL. es__calloc checks n * size for overflow. */
+void *es__malloc(es_ctx *ctx, size_t size);
+void *es__calloc(es_ctx *ctx, size_t n, size_t size);
+void *es__realloc(es_ctx *ctx, void *ptr, size_t size);
+void es__free(es_ctx *ctx, void *ptr);
+/* n elements of `size` bytes, n an int64 count (negative counts fail). */
+void *es__alloc_array(es_ctx *ctx, int64_t n, size_t size);
+
+/* Replace a file only when its new content is complete (file_replace.c):
+ * begin opens a part file beside path (through a symlink, beside its target;
+ * with the old file's mode); write to w.f; end closes it and renames it over
+ * the file if rc is ES_OK and the writes succeeded, else removes it. end
+ * returns rc or the write error. */
+typedef struct es__file_replace {
+    FILE *f;
+    char *tmp;          /* the part file */
+    char *target;       /* the symlink's resolution, or NULL */
+    const char *path;   /* as given (for messages) */
+} es__file_replace;
+es_status es__replace_begin(es_ctx *ctx, const char *path, es__file_replace *w);
+es_status es__replace_end(es_ctx *ctx, es__file_replace *w, es_status rc);
+char *es__strdup(es_ctx *ctx, const char *s);
+
+/* Checked products; false on overflow. */
+static inline bool es__mul_size(size_t a, size_t b, size_t *out)
+{
+    return !__builtin_mul_overflow(a, b, out);
+}
+static inline bool es__mul_i64(int64_t a, int64_t b, int64_t *out)
+{
+    return !__builtin_mul_overflow(a, b, out);
+}
+
+/* LAPACK's integers are 32-bit on Debian: refuse rather than truncate. */
+es_status es__lapack_int(es_ctx *ctx, int64_t n, int *out);
+
+#endif

@@ -1,0 +1,92 @@
+/* lib/figure/figure_pkg.h — what plot.c, plot_canvas.c and render.c share: an
+ * output canvas (a cairo surface chosen by the file extension), text,
+ * axes with nice ticks, legends and colour bars. Only these files include
+ * cairo.h. Never installed.
+ */
+#ifndef EDGESPACE_FIGURE_PKG_H
+#define EDGESPACE_FIGURE_PKG_H
+
+#ifndef ES_MODULE_FIGURE
+#error "figure/figure_pkg.h is private to lib/figure/ (see lib/README.md)"
+#endif
+
+#include "core/core_private.h"
+#include "edgespace/es_plot.h"
+
+#include <cairo.h>
+
+typedef enum es__canvas_kind { ES__CANVAS_PNG, ES__CANVAS_SVG, ES__CANVAS_PDF } es__canvas_kind;
+
+typedef struct es__canvas {
+    cairo_surface_t *surface;
+    cairo_t *cr;
+    es__canvas_kind kind;
+    const char *path;           /* borrowed from the caller */
+    int width, height;
+} es__canvas;
+
+/* Open a canvas for `path` (format from its extension), size width x height,
+ * painted white, font "sans-serif". On failure nothing is left open. */
+es_status es__canvas_open(es_ctx *ctx, const char *path, int width, int height,
+                          es__canvas *cv);
+/* Write the file (PNG) or finish it (SVG, PDF), then release everything.
+ * Reports drawing or writing errors as ES_EIO naming the path. */
+es_status es__canvas_close(es_ctx *ctx, es__canvas *cv);
+/* Release without reporting (on an error path). NULL members: no-op. */
+void es__canvas_discard(es__canvas *cv);
+
+/* Text anchored at (x, y): ha 0 left, 0.5 centre, 1 right; va 0 top,
+ * 0.5 middle, 1 bottom (of the font's ascent..descent box); rotated by
+ * `angle` radians about the anchor. */
+void es__text(cairo_t *cr, double x, double y, const char *s, double size, double ha,
+              double va, double angle);
+double es__text_width(cairo_t *cr, const char *s, double size);
+
+/* Ticks of one axis. */
+#define ES__MAX_TICKS 64
+typedef struct es__ticks {
+    int n;
+    double v[ES__MAX_TICKS];
+    double lo, hi;              /* axis range (the nice range, or given) */
+    int decimals;               /* digits after the point for labels; -1: %g */
+} es__ticks;
+
+/* Nice ticks enclosing [lo, hi] (Heckbert); integer_only: step >= 1. */
+void es__ticks_nice(double lo, double hi, int target, int integer_only, es__ticks *t);
+/* Decades enclosing [lo, hi] (both > 0) for a log10 axis; values in v are
+ * the exponents and lo/hi are log10 of the range. */
+void es__ticks_log(double lo, double hi, es__ticks *t);
+void es__tick_label(const es__ticks *t, double v, int logy, char *buf, size_t n);
+
+/* Plot area for a frame whose plot has extra room `right_extra` on the
+ * right (legend, colour bar). Fills info->left/top/right/bottom. */
+void es__plot_area(const es_plot_frame *f, double right_extra, double left_extra,
+                   es_plot_info *info);
+/* Frame box, grid, ticks, tick labels, axis labels and title. */
+void es__draw_axes(cairo_t *cr, const es_plot_frame *f, const es_plot_info *info,
+                   const es__ticks *xt, const es__ticks *yt, int grid);
+
+/* Legend of n entries (NULL names skipped) with palette colours, top-left
+ * corner at (x, y). Key styles: 0 filled circle, 1 line segment, 2 square;
+ * styles[i] per entry, or `style` for all when styles is NULL. */
+void es__draw_legend(cairo_t *cr, double x, double y, const char *title,
+                     const char *const *names, int64_t n, int style, const int *styles,
+                     double size);
+double es__legend_width(cairo_t *cr, const char *title, const char *const *names,
+                        int64_t n, double size);
+
+/* Vertical colour bar, vmax at the top; the top device row has exactly the
+ * map's colour at 1, the bottom row at 0. Ticks and label on the right. */
+void es__draw_colorbar(cairo_t *cr, double x, double y, double w, double h,
+                       es_colormap cmap, double vmin, double vmax, const char *label,
+                       double size);
+/* Width taken by a colour bar of bar width w (bar, ticks, label). */
+double es__colorbar_width(cairo_t *cr, double w, double vmin, double vmax,
+                          const char *label, double size);
+
+/* Resolve a colour range: vmin == vmax means the finite range of data
+ * (symmetric about 0 for diverging maps); a degenerate range is widened. */
+void es__color_range(es_colormap cmap, const double *v, int64_t n, double *vmin,
+                     double *vmax);
+
+#endif

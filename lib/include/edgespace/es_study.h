@@ -1,0 +1,189 @@
+/* lib/include/edgespace/es_study.h — lib/study: analyses run on a shape store
+ * (the only module where the numerical modules meet the store). The
+ * statistics of es_stats.h and the points of es_point.h, with their results kept in
+ * the store under /analysis/<kind>/<name> (datasets-spec/analysis-results.md):
+ *
+ *   mean/<name>:  means (G x E: row g = mean of group g), counts (G),
+ *                 groups (G strings), scales (G: mean scale of the group);
+ *                 attrs filter, by
+ *   pca/<name>:   mean (E), components (K x E: row k = unit component k),
+ *                 eigenvalues (K, divisor N-1), explained (K),
+ *                 total_variance (1), scores (N x K), rows (N store rows);
+ *                 attrs method, filter, ncomp
+ *   diff/<name>:  mean, sd, se, t (E each), pair_from, pair_to (P store
+ *                 rows), unpaired (store rows); attrs key, column, from, to
+ *   point/<name>: lengths (E), scale (1); attrs expression, weight, valid,
+ *                 n_bad_faces, n_nonpositive, worst_violation, worst_face
+ * Every result carries the provenance of es_store_result_begin (command,
+ * tool version, time, rows used) and is replaced when written again.
+ */
+#ifndef EDGESPACE_ES_STUDY_H
+#define EDGESPACE_ES_STUDY_H
+
+#include "es_core.h"
+#include "es_mesh.h"
+#include "es_point.h"
+#include "es_stats.h"
+#include "es_store.h"
+#include "es_embed.h"
+#include "es_procrustes.h"
+#include "es_compare.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* A source over store rows: all rows (rows NULL) or rows[0..nrows). Borrows
+ * store and rows. */
+ES_API es_status es_study_source(es_ctx *ctx, es_store *store, const int64_t *rows,
+                                 int64_t nrows, es_source *out);
+
+
+/* ---- means --------------------------------------------------------------- */
+
+typedef struct es_group_result {
+    es_ctx *ctx;
+    int64_t nedges, ngroups;
+    char **names;       /* ngroups group names ("all" without a grouping column) */
+    double *means;      /* E x ngroups, column g */
+    int64_t *counts;    /* rows per group */
+    double *scales;     /* mean scale per group */
+} es_group_result;
+ES_API void es_group_result_free(es_group_result *r);
+
+/* Means of the rows matching `filter` (NULL/"": all), one per value of
+ * label column `by` (NULL: one group "all"), stored as mean/<name> when name
+ * is non-NULL. out may be NULL. */
+ES_API es_status es_study_mean(es_ctx *ctx, es_store *store, const char *name,
+                                  const char *filter, const char *by, const char *command,
+                                  es_group_result **out);
+
+/* ---- PCA ------------------------------------------------------------------ */
+
+/* Fit a PCA of the rows matching `filter` and store it as pca/<name>.
+ * *out (may be NULL) gets the fit, *rows (may be NULL) the store rows
+ * used (es_free), in score order. */
+ES_API es_status es_study_pca(es_ctx *ctx, es_store *store, const char *name,
+                                 const char *filter, const es_pca_opts *opts,
+                                 const char *command, es_pca **out, int64_t **rows,
+                                 int64_t *nrows);
+
+/* Load pca/<name> (NULL: the only PCA in the store, else the one named
+ * "default"). Scores are loaded too (nrows = rows fitted); *rows (may be
+ * NULL) gets the store rows of the scores (es_free). */
+ES_API es_status es_study_pca_load(es_ctx *ctx, es_store *store, const char *name,
+                                      es_pca **out, int64_t **rows, int64_t *nrows);
+
+/* ---- differences ------------------------------------------------------------ */
+
+/* Rows matching `filter` whose label `column` equals `from` or `to` are
+ * paired by label `key` (es_diff_paired's rules); stored as diff/<name>.
+ * Indices in the result are store rows. out may be NULL. */
+ES_API es_status es_study_diff(es_ctx *ctx, es_store *store, const char *name,
+                                  const char *filter, const char *key, const char *column,
+                                  const char *from, const char *to, const char *command,
+                                  es_diff **out);
+
+/* ---- points ----------------------------------------------------------------- */
+
+/* Resolver of point leaves on a store (es_point_resolve_fn with userdata =
+ * an es_study_resolver). pca_name: the PCA of pc:K (NULL: as
+ * es_study_pca_load). mesh: the store's topology, for file: leaves. */
+typedef struct es_study_resolver {
+    es_store *store;
+    const es_mesh *mesh;
+    const char *pca_name;
+    es_pca *pca;        /* loaded on first use; free with es_study_resolver_clear */
+    double *scales;     /* all row scales, loaded on first use */
+} es_study_resolver;
+ES_API es_status es_study_resolve(es_ctx *ctx, void *resolver, es_point_leaf kind,
+                                  const char *arg, int64_t index, double *vec, double *scale);
+ES_API void es_study_resolver_clear(es_ctx *ctx, es_study_resolver *r);
+
+/* Evaluate `expr` on the store (validity against the store's topology) and,
+ * when name is non-NULL, store it as point/<name>. scale > 0 overrides the
+ * scale rule of es_point.h. *vec (may be NULL) gets the lengths (es_free);
+ * info (may be NULL) the report. */
+ES_API es_status es_study_point(es_ctx *ctx, es_store *store, const char *name,
+                                   const char *expr, const char *pca_name, double scale,
+                                   const char *command, double **vec, es_point_info *info);
+
+/* ---- GPA and the comparison of the two spaces ----------------------------- */
+
+/* GPA of the positions of `rows` (nrows of them; rows NULL with nrows = -1:
+ * every row) of an open store, with the PCA of the residual tangent
+ * coordinates, written to /analysis/gpa/<name> (replaced if present) with
+ * provenance (command; params: scale, allow_reflection, tol, max_iter):
+ *   aligned   n x k*d   row j: configuration of input row j (x-, y-, z-block)
+ *   mean      k*d       Procrustes mean;  size, rho, scale: n each
+ *   rotation  n x d*d   column-major d x d per row;  centroid: n x d
+ *   pc_sdev, pc_percent (npc), pc_scores (n x npc), pc_loadings (npc x k*d)
+ * and attributes dim, k, iterations, converged, rot_change, scale_change,
+ * gss, rmsrho, total_ss. Planar data (z = 0 in every row, e.g. ingested 2D
+ * landmarks) are analysed in 2D (dim 2), so that a 3D rotation cannot act
+ * as a reflection. npc <= 0: min(10, n - 1). Memory: the positions of the
+ * rows (n x 3V doubles) once. The store must be open for writing; the
+ * caller commits (es_store_commit / es_store_close). report may be NULL. */
+ES_API es_status es_study_gpa(es_ctx *ctx, es_store *store, const char *name,
+                                  const int64_t *rows, int64_t nrows, const es_gpa_opts *opts,
+                                  int64_t npc, const char *command, es_gpa_report *report);
+
+/* The study on a store: the rows of GPA result /analysis/gpa/<gpa_name>
+ * (their aligned configurations) against their stored normalized edge
+ * lengths, grouped by label column `by` (NULL: no groups). Writes
+ * /analysis/compare/<name> (name NULL: gpa_name) with provenance: datasets
+ * d_lengths, d_procrustes (n x n), group_means_lengths/_procrustes and
+ * p_lengths/_procrustes (g x g), group_names, attributes spearman_rho,
+ * mantel_p, nn_agreement, by, gpa (permutations in @params). out_dir (or
+ * NULL) gets es_study_compare_write's tables (es_figure_compare adds the
+ * figures). The result carries the row ids, groups and group names. ES_ENOTFOUND if the GPA
+ * result or the column is missing; ES_EINVAL for a store without edges. The
+ * store must be open for writing if name is not "" (name "": nothing is
+ * written to the store). res (may be NULL) receives the result. */
+ES_API es_status es_study_compare(es_ctx *ctx, es_store *store, const char *gpa_name,
+                                  const char *by, const es_compare_opts *opts, const char *name,
+                                  const char *out_dir, const char *command,
+                                  es_compare_result **res);
+
+/* Write the study to dir (created if missing): distances_lengths.csv and
+ * distances_procrustes.csv (n x n with ids), pairs.csv (i, j, ids, both
+ * distances, group pair), summary.csv (statistic, value), nearest.csv,
+ * disagreement.csv, and with groups group_means.csv (space, group_a,
+ * group_b, distance, p); each file is replaced only once complete. The
+ * figures are es_figure_compare_write's (es_figure.h). ids: n names (NULL:
+ * 1-based numbers);
+ * group_names: ngroups names (NULL: numbers). ES_EIO names the file. */
+ES_API es_status es_study_compare_write(es_ctx *ctx, const es_compare_result *res,
+                                  const char *const *ids, const int64_t *group,
+                                  const char *const *group_names, const char *dir);
+
+/* ---- embeddings ------------------------------------------------------------- */
+
+/* The stored row nearest to normalized lengths `target` (E) in Euclidean
+ * edge-length distance: the default initialization. rows/nrows restrict the
+ * search (NULL: all rows). */
+ES_API es_status es_study_nearest_row(es_ctx *ctx, es_store *store, const double *target,
+                                      const int64_t *rows, int64_t nrows, int64_t *row,
+                                      double *dist);
+
+/* Circular mean of the dihedrals of stored rows (E): the angle of the mean
+ * unit vector per edge (oracle README, failure F). */
+ES_API es_status es_study_mean_dihedrals(es_ctx *ctx, es_store *store, const es_mesh *mesh,
+                                         const int64_t *rows, int64_t nrows, double *alpha);
+
+/* Store an embedding as /analysis/embed/<name>: datasets positions (V x 3),
+ * target_lengths (E, normalized), vertex_closure and vertex_edge_error
+ * (V, for heat maps, from the embedder's last solve), and the report as
+ * attributes (closure_before, closure_after, rms_ratio, max_rel, p99_rel,
+ * n_bad_faces, realized, iterations, seconds per stage, init). Commit is
+ * the caller's. */
+ES_API es_status es_study_store_embedding(es_ctx *ctx, es_store *store, const char *name,
+                                       const es_provenance *prov, const es_embedder *emb,
+                                       const double *target, const double *xyz,
+                                       const es_embed_report *rep, const char *init);
+
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,692 @@
+/* lib/ingest/ingest.c — meshes (and a manifest's labels) into an HDF5 store.
+ *
+ * All-or-nothing in two phases. Phase 1 reads every input into memory:
+ * the file's bytes (hashed for duplicate detection, then parsed from the
+ * buffer so the file is read once), the check that its vertex count and
+ * face list equal the store's (or the first input's, for a new store), and
+ * its normalized edge lengths (es_edge_lengths, es_lengths_normalize;
+ * Section 4, eq. 12 of Rojas et al.). Any failure returns before the store
+ * is touched. Phase 2 appends all rows in one es_store_append and commits,
+ * which replaces the store by an atomic rename (store.c), so a kill during
+ * phase 2 also leaves the old store intact.
+ */
+#include "core/core_private.h"
+#include "mesh/mesh_private.h"
+#include "edgespace/es_geom.h"
+#include "edgespace/es_ingest.h"
+#include "edgespace/es_io.h"
+#include "edgespace/es_mesh.h"
+#include "edgespace/es_store.h"
+
+#include <errno.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+void es_ingest_opts_init(es_ingest_opts *opts)
+{
+    memset(opts, 0, sizeof *opts);
+    opts->create = 1;
+    opts->format = ES_FORMAT_AUTO;
+}
+
+void es_content_hash(const void *buf, size_t len, char out[25])
+{
+    const unsigned char *p = buf;
+    uint64_t h = 0xcbf29ce484222325ULL;
+    for (size_t i = 0; i < len; i++) {
+        h ^= p[i];
+        h *= 0x100000001b3ULL;
+    }
+    snprintf(out, 25, "fnv1a64:%016llx", (unsigned long long)h);
+}
+
+/* One input: where to read it, its id and (manifest) label row. */
+typedef struct input {
+    const char *id;
+    const char *path;           /* path to open */
+    const char *const *labels;  /* ncols values or NULL */
+} input;
+
+/* Read a whole file into *buf (grown as needed and reused across files, so
+ * that one buffer's pages serve every input). */
+static es_status slurp(es_ctx *ctx, const char *path, char **buf, size_t *cap, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    struct stat st;
+    *len = 0;
+    if (!f)
+        ES_FAIL(ctx, errno == ENOENT ? ES_ENOTFOUND : ES_EIO, "cannot open '%s': %s", path,
+                strerror(errno));
+    if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
+        fclose(f);
+        ES_FAIL(ctx, ES_EIO, "'%s' is not a regular file", path);
+    }
+    if ((size_t)st.st_size + 1 > *cap) {
+        char *p = es__realloc(ctx, *buf, (size_t)st.st_size + 1);
+        if (!p) {
+            fclose(f);
+            return ES_ENOMEM;
+        }
+        *buf = p;
+        *cap = (size_t)st.st_size + 1;
+    }
+    *len = fread(*buf, 1, (size_t)st.st_size, f);
+    if (ferror(f) || *len != (size_t)st.st_size) {
+        fclose(f);
+        ES_FAIL(ctx, ES_EIO, "cannot read '%s'", path);
+    }
+    (*buf)[*len] = '\0';
+    fclose(f);
+    return ES_OK;
+}
+
+/* Everything phase 1 produces, one slot per input (kept or not). */
+typedef struct batch {
+    int64_t cap, V, E;
+    double *xyz, *len, *scale;   /* 3V x cap, E x cap, cap */
+    char (*hash)[25];            /* content hash per slot */
+    uint8_t *skip;               /* 1: already in the store, same content */
+} batch;
+
+static void batch_free(es_ctx *ctx, batch *b)
+{
+    es__free(ctx, b->xyz);
+    es__free(ctx, b->len);
+    es__free(ctx, b->scale);
+    es__free(ctx, b->hash);
+    es__free(ctx, b->skip);
+}
+
+/* Ask for transparent huge pages on the page-aligned middle of a large
+ * buffer: first touch of tens of MB then costs hundreds of page faults
+ * instead of thousands (it dominated the CPU time of this phase on a VM). A
+ * hint only: nothing depends on it. */
+static void hint_huge_pages(void *p, size_t bytes)
+{
+#ifdef MADV_HUGEPAGE
+    long page = sysconf(_SC_PAGESIZE);
+    uintptr_t a = (uintptr_t)p, b = a + bytes;
+    if (!p || page <= 0 || bytes < ((size_t)4 << 20)) return;
+    a = (a + (uintptr_t)page - 1) & ~((uintptr_t)page - 1);
+    b &= ~((uintptr_t)page - 1);
+    if (b > a) madvise((void *)a, b - a, MADV_HUGEPAGE);
+#else
+    (void)p;
+    (void)bytes;
+#endif
+}
+
+/* Uninitialized arrays (every kept slot is written in full): calloc would
+ * touch tens of MB of pages only to overwrite them. */
+static void *alloc_uninit(es_ctx *ctx, int64_t a, int64_t b, size_t elem)
+{
+    int64_t n;
+    size_t bytes;
+    void *p;
+    if (!es__mul_i64(a, b, &n) || n < 0 || !es__mul_size((size_t)n, elem, &bytes)) {
+        es__fail(ctx, ES_ENOMEM, "ingest: %lld x %lld values are too many", (long long)a,
+                 (long long)b);
+        return NULL;
+    }
+    p = es__malloc(ctx, bytes);
+    hint_huge_pages(p, bytes);
+    return p;
+}
+
+static es_status batch_alloc(es_ctx *ctx, batch *b, int64_t cap, int64_t V, int64_t E)
+{
+    b->cap = cap;
+    b->V = V;
+    b->E = E;
+    if (!(b->xyz = alloc_uninit(ctx, 3 * V, cap, sizeof(double))) ||
+        !(b->len = alloc_uninit(ctx, E, cap, sizeof(double))) ||
+        !(b->scale = alloc_uninit(ctx, cap, 1, sizeof(double))) ||
+        !(b->hash = alloc_uninit(ctx, cap, 1, sizeof *b->hash)) ||
+        !(b->skip = es__alloc_array(ctx, cap, 1)))
+        return ES_ENOMEM;
+    return ES_OK;
+}
+
+/* The first face where two face lists differ, or -1. */
+static int64_t first_diff_face(const int64_t *a, const int64_t *b, int64_t nfaces)
+{
+    if (!memcmp(a, b, (size_t)nfaces * 3 * sizeof *a)) return -1;
+    for (int64_t f = 0; f < nfaces; f++)
+        if (a[3 * f] != b[3 * f] || a[3 * f + 1] != b[3 * f + 1] || a[3 * f + 2] != b[3 * f + 2])
+            return f;
+    return -1;
+}
+
+typedef struct ref {
+    es_mesh *mesh;
+    const int64_t *faces;
+    int64_t V, F;
+    char what[600];       /* "the store 's.h5'" or "the first input 'a.obj'" */
+} ref;
+
+static es_status check_topology(es_ctx *ctx, const ref *r, const char *path,
+                                const es_meshdata *md)
+{
+    int64_t f;
+    if (md->nverts != r->V)
+        ES_FAIL(ctx, ES_EMISMATCH, "'%s' has %lld vertices, %s has %lld: not in "
+                "correspondence", path, (long long)md->nverts, r->what, (long long)r->V);
+    if (md->nfaces != r->F)
+        ES_FAIL(ctx, ES_EMISMATCH, "'%s' has %lld faces, %s has %lld: not in correspondence",
+                path, (long long)md->nfaces, r->what, (long long)r->F);
+    if ((f = first_diff_face(md->faces, r->faces, r->F)) >= 0)
+        ES_FAIL(ctx, ES_EMISMATCH, "'%s': connectivity differs from %s at face %lld: "
+                "(%lld %lld %lld) instead of (%lld %lld %lld) (0-based face and vertex "
+                "indices)", path, r->what, (long long)f, (long long)md->faces[3 * f],
+                (long long)md->faces[3 * f + 1], (long long)md->faces[3 * f + 2],
+                (long long)r->faces[3 * f], (long long)r->faces[3 * f + 1],
+                (long long)r->faces[3 * f + 2]);
+    return ES_OK;
+}
+
+/* ---- phase 1, possibly on several threads ------------------------------
+ * Inputs are handed out by an atomic counter. Each worker has its own
+ * context (the main thread's worker uses the caller's), a reused read
+ * buffer, and writes only its inputs' slots of the batch. The store handle
+ * is only read (ids, hashes in memory). An error is kept for the lowest
+ * failing input, so the message is the one a serial run would give;
+ * warnings are collected and replayed in input order on the caller's
+ * context after the join. */
+
+typedef struct note { int64_t index; char *msg; } note;
+
+typedef struct job {
+    const input *in;
+    int64_t n;
+    const ref *r;
+    const es_store *st;
+    const es_ingest_opts *o;
+    batch *b;
+    atomic_llong next, done;
+    pthread_mutex_t mu;
+    int64_t err_index;          /* lowest failing input, n if none */
+    es_status err_rc;
+    char err_msg[1200];
+    note *notes;                /* warnings (malloc'd, main ctx not touched) */
+    int64_t nnotes, capnotes;
+    int64_t bytes_read;
+} job;
+
+typedef struct worker {
+    job *j;
+    es_ctx *ctx;                /* own context, or the caller's (worker 0) */
+    bool main;
+    es_ctx *main_ctx;
+    int64_t current;            /* input being processed, for warnings */
+} worker;
+
+static void on_worker_log(void *ud, es_log_level level, const char *msg)
+{
+    worker *w = ud;
+    job *j = w->j;
+    char *copy = malloc(strlen(msg) + 1);
+    (void)level;
+    if (!copy) return;
+    strcpy(copy, msg);
+    pthread_mutex_lock(&j->mu);
+    if (j->nnotes == j->capnotes) {
+        int64_t cap = j->capnotes ? 2 * j->capnotes : 16;
+        note *p = realloc(j->notes, (size_t)cap * sizeof *p);
+        if (!p) {
+            pthread_mutex_unlock(&j->mu);
+            free(copy);
+            return;
+        }
+        j->notes = p;
+        j->capnotes = cap;
+    }
+    j->notes[j->nnotes].index = w->current;
+    j->notes[j->nnotes].msg = copy;
+    j->nnotes++;
+    pthread_mutex_unlock(&j->mu);
+}
+
+static void record_error(job *j, int64_t i, es_status rc, const char *msg)
+{
+    pthread_mutex_lock(&j->mu);
+    if (i < j->err_index) {
+        j->err_index = i;
+        j->err_rc = rc;
+        snprintf(j->err_msg, sizeof j->err_msg, "%s", msg);
+    }
+    pthread_mutex_unlock(&j->mu);
+}
+
+/* Coincident vertices give edges of length 0: valid in the statistics, but
+ * no mesh realizes a point with a zero length, so embedding such a row (or
+ * a point that keeps the zero) fails later; say so while the file is known. */
+static void warn_zero_edges(es_ctx *ctx, const char *path, const es_mesh *mesh,
+                            const double *len, int64_t ne)
+{
+    const int64_t *ev = es_mesh_edges(mesh);
+    int64_t n = 0, first = -1;
+    for (int64_t e = 0; e < ne; e++)
+        if (len[e] == 0 && n++ == 0) first = e;
+    if (n)
+        es__warn(ctx, "'%s': %lld edge%s of length 0 (first: edge %lld, vertices %lld-%lld); "
+                 "such a shape cannot be embedded", path, (long long)n, n == 1 ? "" : "s",
+                 (long long)first, (long long)ev[2 * first], (long long)ev[2 * first + 1]);
+}
+
+/* One input into slot i. */
+static es_status process_one(worker *w, int64_t i, char **buf, size_t *cap, es_meshdata *md)
+{
+    job *j = w->j;
+    es_ctx *ctx = w->ctx;
+    const char *path = j->in[i].path;
+    batch *b = j->b;
+    size_t len;
+    int64_t row;
+    es_status rc;
+    if ((rc = slurp(ctx, path, buf, cap, &len))) return rc;
+    pthread_mutex_lock(&j->mu);
+    j->bytes_read += (int64_t)len;
+    pthread_mutex_unlock(&j->mu);
+    es_content_hash(*buf, len, b->hash[i]);
+    row = j->st ? es_store_find_row(j->st, j->in[i].id) : -1;
+    if (row >= 0) {
+        if (!strcmp(es_store_content_hash(j->st, row), b->hash[i])) {
+            b->skip[i] = 1;
+            return ES_OK;
+        }
+        ES_FAIL(ctx, ES_EEXIST, "'%s': id '%s' is in the store already with different "
+                "content (ingested from '%s'); give it another id", path, j->in[i].id,
+                es_store_source_path(j->st, row));
+    }
+    if ((rc = es_meshdata_parse(ctx, path, *buf, len, j->o->format, md))) return rc;
+    if (!(rc = check_topology(ctx, j->r, path, md))) {
+        double *li = b->len + i * b->E;
+        if ((rc = es_edge_lengths(ctx, j->r->mesh, md->xyz, li)) ||
+            (rc = es_lengths_normalize(ctx, b->E, li, li, &b->scale[i]))) {
+            char msg[900];
+            snprintf(msg, sizeof msg, "%s", es_ctx_errmsg(ctx));
+            rc = es__fail(ctx, rc, "'%s': %s", path, msg);
+        } else {
+            warn_zero_edges(ctx, path, j->r->mesh, li, b->E);
+            memcpy(b->xyz + i * 3 * b->V, md->xyz, (size_t)(3 * b->V) * sizeof(double));
+        }
+    }
+    es_meshdata_clear(ctx, md);
+    return rc;
+}
+
+static void *work(void *arg)
+{
+    worker *w = arg;
+    job *j = w->j;
+    char *buf = NULL;
+    size_t cap = 0;
+    es_meshdata md;
+    memset(&md, 0, sizeof md);
+    for (;;) {
+        int64_t i = (int64_t)atomic_fetch_add(&j->next, 1);
+        es_status rc;
+        if (i >= j->n) break;
+        pthread_mutex_lock(&j->mu);
+        rc = i > j->err_index ? ES_EINVAL : ES_OK;  /* a lower input failed: stop */
+        pthread_mutex_unlock(&j->mu);
+        if (rc) break;
+        w->current = i;
+        if ((rc = process_one(w, i, &buf, &cap, &md)))
+            record_error(j, i, rc, es_ctx_errmsg(w->ctx));
+        atomic_fetch_add(&j->done, 1);
+        if (w->main) es__progress(w->main_ctx, "reading meshes", (int64_t)atomic_load(&j->done), j->n);
+    }
+    es__free(w->ctx, buf);
+    return NULL;
+}
+
+static int64_t auto_threads(const es_ingest_opts *o, int64_t n)
+{
+    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+    int64_t t = o->threads > 0 ? o->threads : cpus > 0 ? cpus : 1;
+    if (t > 16) t = 16;
+    if (t > n) t = n;
+    return t < 1 ? 1 : t;
+}
+
+/* Inputs [first, n) into their slots. */
+static es_status run_phase1(es_ctx *ctx, job *j, int64_t first)
+{
+    int64_t nt = auto_threads(j->o, j->n - first);
+    worker w[16];
+    pthread_t tid[16];
+    bool started[16] = {false};
+    es_status rc = ES_OK;
+    atomic_store(&j->next, first);
+    atomic_store(&j->done, first);
+    memset(w, 0, sizeof w);
+    for (int64_t t = 0; t < nt; t++) {
+        w[t].j = j;
+        w[t].main = t == 0;
+        w[t].main_ctx = ctx;
+        w[t].ctx = ctx;
+        if (t == 0) continue;
+        if (es_ctx_new(&w[t].ctx) != ES_OK) break;
+        es_ctx_set_log(w[t].ctx, on_worker_log, &w[t]);
+        if (pthread_create(&tid[t], NULL, work, &w[t]) != 0) {
+            es_ctx_free(w[t].ctx);
+            w[t].ctx = NULL;
+            break;
+        }
+        started[t] = true;
+    }
+    work(&w[0]);
+    for (int64_t t = 1; t < nt; t++) {
+        if (!started[t]) continue;
+        pthread_join(tid[t], NULL);
+        es_ctx_free(w[t].ctx);
+    }
+    if (j->err_index < j->n) rc = es__fail(ctx, j->err_rc, "%s", j->err_msg);
+    return rc;
+}
+
+static es_status ingest(es_ctx *ctx, const char *store_path, int64_t n, const input *in,
+                        int64_t ncols, const char *const *colnames, const es_ingest_opts *o,
+                        es_ingest_report *rep)
+{
+    es_store *st = NULL;
+    int64_t *store_faces = NULL, *ref_faces = NULL, first = 0, nkeep = 0;
+    const char **ids = NULL, **labels = NULL;
+    char **sources = NULL;
+    const char **hashes = NULL;
+    es_meshdata md;
+    batch b;
+    ref r;
+    job j;
+    es_status rc = ES_OK;
+    bool exists, mu_init = false;
+    memset(&md, 0, sizeof md);
+    memset(&b, 0, sizeof b);
+    memset(&r, 0, sizeof r);
+    memset(&j, 0, sizeof j);
+    memset(rep, 0, sizeof *rep);
+    if (!store_path || !*store_path) ES_FAIL(ctx, ES_EINVAL, "ingest: no store path");
+    if (n < 1) ES_FAIL(ctx, ES_EINVAL, "ingest: no meshes to ingest");
+    exists = access(store_path, F_OK) == 0;
+    if (!exists && !o->create)
+        ES_FAIL(ctx, ES_ENOTFOUND, "ingest: store '%s' does not exist", store_path);
+    if (exists) {
+        int64_t nf3;
+        if ((rc = es_store_open(ctx, store_path, ES_STORE_WRITE, &st))) return rc;
+        if (es_store_topology_kind(st) != ES_TOPOLOGY_MESH) {
+            rc = es__fail(ctx, ES_EMISMATCH, "ingest: store '%s' holds landmarks without faces "
+                          "(topology kind '%s'): meshes cannot be added to it", store_path,
+                          es_topology_kind_name(es_store_topology_kind(st)));
+            goto done;
+        }
+        r.V = es_store_nverts(st);
+        r.F = es_store_nfaces(st);
+        if (!es__mul_i64(r.F, 3, &nf3) ||
+            !(store_faces = es__alloc_array(ctx, nf3, sizeof(int64_t)))) {
+            rc = ES_ENOMEM;
+            goto done;
+        }
+        /* quiet: vertices in no face were warned about at the store's first ingest */
+        if ((rc = es_store_read_faces(ctx, st, store_faces)) ||
+            (rc = es__mesh_new(ctx, r.V, r.F, store_faces, NULL, 0, &r.mesh)))
+            goto done;
+        r.faces = store_faces;
+        snprintf(r.what, sizeof r.what, "the store '%s'", store_path);
+        if ((rc = batch_alloc(ctx, &b, n, r.V, es_mesh_nedges(r.mesh)))) goto done;
+    }
+    if (pthread_mutex_init(&j.mu, NULL) != 0) {
+        rc = es__fail(ctx, ES_ENOMEM, "ingest: cannot make a mutex");
+        goto done;
+    }
+    mu_init = true;
+    j.in = in;
+    j.n = n;
+    j.r = &r;
+    j.st = st;
+    j.o = o;
+    j.b = &b;
+    j.err_index = n;
+
+    /* ---- phase 1: read and validate everything ---- */
+    if (!st) {
+        /* New store: the first input defines the topology. */
+        char *buf = NULL;
+        size_t cap = 0, len = 0;
+        int64_t nf3;
+        es__progress(ctx, "reading meshes", 0, n);
+        if ((rc = slurp(ctx, in[0].path, &buf, &cap, &len)) ||
+            (rc = es_meshdata_parse(ctx, in[0].path, buf, len, o->format, &md))) {
+            es__free(ctx, buf);
+            goto done;
+        }
+        j.bytes_read += (int64_t)len;
+        r.V = md.nverts;
+        r.F = md.nfaces;
+        if (!es__mul_i64(r.F, 3, &nf3) ||
+            !(ref_faces = es__alloc_array(ctx, nf3, sizeof(int64_t)))) {
+            es__free(ctx, buf);
+            rc = ES_ENOMEM;
+            goto done;
+        }
+        memcpy(ref_faces, md.faces, (size_t)nf3 * sizeof *ref_faces);
+        r.faces = ref_faces;
+        snprintf(r.what, sizeof r.what, "the first input '%s'", in[0].path);
+        if ((rc = es__mesh_new(ctx, r.V, r.F, r.faces, md.xyz, 0, &r.mesh))) {
+            char msg[900];
+            snprintf(msg, sizeof msg, "%s", es_ctx_errmsg(ctx));
+            rc = es__fail(ctx, rc, "'%s': %s", in[0].path, msg);
+            es__free(ctx, buf);
+            goto done;
+        }
+        {
+            es_mesh_summary sum;
+            es_mesh_summarize(r.mesh, &sum);
+            if (sum.n_unreferenced > 0)
+                es__warn(ctx, "'%s': %lld of %lld vertices are in no face (kept, with their "
+                         "positions; they have no edges)", in[0].path,
+                         (long long)sum.n_unreferenced, (long long)r.V);
+        }
+        if ((rc = batch_alloc(ctx, &b, n, r.V, es_mesh_nedges(r.mesh)))) {
+            es__free(ctx, buf);
+            goto done;
+        }
+        es_content_hash(buf, len, b.hash[0]);
+        es__free(ctx, buf);
+        if ((rc = es_edge_lengths(ctx, r.mesh, md.xyz, b.len)) ||
+            (rc = es_lengths_normalize(ctx, b.E, b.len, b.len, &b.scale[0]))) {
+            char msg[900];
+            snprintf(msg, sizeof msg, "%s", es_ctx_errmsg(ctx));
+            rc = es__fail(ctx, rc, "'%s': %s", in[0].path, msg);
+            goto done;
+        }
+        warn_zero_edges(ctx, in[0].path, r.mesh, b.len, b.E);
+        memcpy(b.xyz, md.xyz, (size_t)(3 * b.V) * sizeof(double));
+        es_meshdata_clear(ctx, &md);
+        first = 1;
+    }
+    if (first < n) rc = run_phase1(ctx, &j, first);
+    for (int64_t k = 0; k < j.nnotes; k++)       /* warnings, in input order */
+        for (int64_t q = k + 1; q < j.nnotes; q++)
+            if (j.notes[q].index < j.notes[k].index) {
+                note t = j.notes[k];
+                j.notes[k] = j.notes[q];
+                j.notes[q] = t;
+            }
+    for (int64_t k = 0; k < j.nnotes; k++) es__warn(ctx, "%s", j.notes[k].msg);
+    rep->bytes_read = j.bytes_read;
+    if (rc) goto done;
+    es__progress(ctx, "reading meshes", n, n);
+
+    /* ---- gather the kept rows, in input order ---- */
+    if (!(ids = es__alloc_array(ctx, n, sizeof *ids)) ||
+        !(sources = es__alloc_array(ctx, n, sizeof *sources)) ||
+        !(hashes = es__alloc_array(ctx, n, sizeof *hashes)) ||
+        !(labels = es__alloc_array(ctx, ncols > 0 ? n * ncols : 1, sizeof *labels))) {
+        rc = ES_ENOMEM;
+        goto done;
+    }
+    for (int64_t i = 0; i < n; i++) {
+        char real[PATH_MAX];
+        if (b.skip[i]) {
+            rep->rows_skipped++;
+            continue;
+        }
+        for (int64_t k = 0; st && k < es_store_nrows(st); k++)
+            if (!strcmp(es_store_content_hash(st, k), b.hash[i]))
+                es__warn(ctx, "'%s' has the same content as row '%s' of the store",
+                         in[i].path, es_store_row_id(st, k));
+        for (int64_t k = 0; k < nkeep; k++)
+            if (!strcmp(hashes[k], b.hash[i]))
+                es__warn(ctx, "'%s' has the same content as '%s'", in[i].path, sources[k]);
+        if (nkeep != i) {
+            memmove(b.len + nkeep * b.E, b.len + i * b.E, (size_t)b.E * sizeof(double));
+            memmove(b.xyz + nkeep * 3 * b.V, b.xyz + i * 3 * b.V,
+                    (size_t)(3 * b.V) * sizeof(double));
+            b.scale[nkeep] = b.scale[i];
+        }
+        ids[nkeep] = in[i].id;
+        hashes[nkeep] = b.hash[i];
+        for (int64_t c = 0; c < ncols; c++) labels[nkeep * ncols + c] = in[i].labels[c];
+        if (!(sources[nkeep] = es__strdup(ctx, realpath(in[i].path, real) ? real : in[i].path))) {
+            rc = ES_ENOMEM;
+            goto done;
+        }
+        nkeep++;
+    }
+
+    /* ---- phase 2: write (to a working copy), then commit atomically ---- */
+    if (nkeep > 0) {
+        es_store_rows rows = {nkeep, ids, (const char *const *)sources, hashes, b.len,
+                              b.scale, b.xyz, ncols, colnames, labels};
+        es__progress(ctx, "writing store", 0, 1);
+        if (!st) {
+            if ((rc = es_store_create(ctx, store_path, r.mesh, &st))) goto done;
+            rep->created = 1;
+        }
+        if ((rc = es_store_append(ctx, st, &rows)) || (rc = es_store_commit(ctx, st))) {
+            rep->created = 0;
+            goto done;
+        }
+        es__progress(ctx, "writing store", 1, 1);
+    }
+    rep->rows_added = nkeep;
+    rep->rows_total = es_store_nrows(st);
+done:
+    if (rc != ES_OK) rep->rows_added = 0;
+    if (mu_init) pthread_mutex_destroy(&j.mu);
+    for (int64_t k = 0; k < j.nnotes; k++) free(j.notes[k].msg);
+    free(j.notes);
+    es_meshdata_clear(ctx, &md);
+    if (rc != ES_OK) es_store_abort(st);
+    else es_store_close(st);
+    es_mesh_free(r.mesh);
+    es__free(ctx, store_faces);
+    es__free(ctx, ref_faces);
+    for (int64_t k = 0; sources && k < nkeep; k++) es__free(ctx, sources[k]);
+    es__free(ctx, sources);
+    es__free(ctx, ids);
+    es__free(ctx, hashes);
+    es__free(ctx, labels);
+    batch_free(ctx, &b);
+    return rc;
+}
+
+es_status es_ingest_manifest(es_ctx *ctx, const char *store_path, const char *manifest_path,
+                             const es_ingest_opts *opts, es_ingest_report *report)
+{
+    es_ingest_opts defaults;
+    es_ingest_report dummy;
+    es_manifest *m = NULL;
+    input *in = NULL;
+    char **paths = NULL;
+    es_status rc;
+    if (!opts) {
+        es_ingest_opts_init(&defaults);
+        opts = &defaults;
+    }
+    if (!report) report = &dummy;
+    memset(report, 0, sizeof *report);
+    if ((rc = es_manifest_read(ctx, manifest_path, &m))) return rc;
+    if (m->nrows == 0) {
+        es_manifest_free(ctx, m);
+        ES_FAIL(ctx, ES_EINVAL, "manifest '%s' lists no meshes", manifest_path);
+    }
+    if (!(in = es__alloc_array(ctx, m->nrows, sizeof *in)) ||
+        !(paths = es__alloc_array(ctx, m->nrows, sizeof *paths))) {
+        rc = ES_ENOMEM;
+        goto done;
+    }
+    for (int64_t r = 0; r < m->nrows; r++) {
+        const char *file = m->cells[r * m->ncols + m->file_col];
+        size_t nb = strlen(m->dir) + strlen(file) + 2;
+        if (!(paths[r] = es__malloc(ctx, nb))) { rc = ES_ENOMEM; goto done; }
+        if (file[0] == '/') snprintf(paths[r], nb, "%s", file);
+        else snprintf(paths[r], nb, "%s/%s", m->dir, file);
+        in[r].id = m->ids[r];
+        in[r].path = paths[r];
+        in[r].labels = (const char *const *)(m->cells + r * m->ncols);
+    }
+    rc = ingest(ctx, store_path, m->nrows, in, m->ncols, (const char *const *)m->colnames,
+                opts, report);
+done:
+    for (int64_t r = 0; paths && r < m->nrows; r++) es__free(ctx, paths[r]);
+    es__free(ctx, paths);
+    es__free(ctx, in);
+    es_manifest_free(ctx, m);
+    return rc;
+}
+
+es_status es_ingest_files(es_ctx *ctx, const char *store_path, int64_t nfiles,
+                          const char *const *files, const es_ingest_opts *opts,
+                          es_ingest_report *report)
+{
+    es_ingest_opts defaults;
+    es_ingest_report dummy;
+    input *in = NULL;
+    char **ids = NULL;
+    es_status rc = ES_OK;
+    if (!opts) {
+        es_ingest_opts_init(&defaults);
+        opts = &defaults;
+    }
+    if (!report) report = &dummy;
+    memset(report, 0, sizeof *report);
+    if (nfiles < 1 || !files) ES_FAIL(ctx, ES_EINVAL, "ingest: no files given");
+    if (!(in = es__alloc_array(ctx, nfiles, sizeof *in)) ||
+        !(ids = es__alloc_array(ctx, nfiles, sizeof *ids))) {
+        rc = ES_ENOMEM;
+        goto done;
+    }
+    for (int64_t i = 0; i < nfiles; i++) {
+        char id[1024];
+        es_id_from_path(files[i], id, sizeof id);
+        if (!*id) {
+            rc = es__fail(ctx, ES_EINVAL, "ingest: cannot make an id from '%s'", files[i]);
+            goto done;
+        }
+        for (int64_t k = 0; k < i; k++)
+            if (!strcmp(ids[k], id)) {
+                rc = es__fail(ctx, ES_EINVAL, "ingest: '%s' and '%s' would both get the id "
+                              "'%s'; use a manifest with an 'id' column", files[k], files[i],
+                              id);
+                goto done;
+            }
+        if (!(ids[i] = es__strdup(ctx, id))) { rc = ES_ENOMEM; goto done; }
+        in[i].id = ids[i];
+        in[i].path = files[i];
+        in[i].labels = NULL;
+    }
+    rc = ingest(ctx, store_path, nfiles, in, 0, NULL, opts, report);
+done:
+    for (int64_t i = 0; ids && i < nfiles; i++) es__free(ctx, ids[i]);
+    es__free(ctx, ids);
+    es__free(ctx, in);
+    return rc;
+}

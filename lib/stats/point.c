@@ -1,0 +1,571 @@
+/* lib/stats/point.c — the point syntax: a recursive-descent parser that folds
+ * every expression into a linear combination of leaves, and its evaluation
+ * through a resolver callback.
+ *
+ * Grammar (datasets-spec/point-syntax.md):
+ *     sum     := product (('+' | '-') product)*
+ *     product := unary (('*' | '/') unary)*
+ *     unary   := ('-' | '+') unary | primary
+ *     primary := NUMBER | '(' sum ')' | 'lerp' '(' sum ',' sum ',' sum ')'
+ *              | 'mean' ['[' NAME '=' VALUE (',' NAME '=' VALUE)* ']']
+ *              | 'row:' ID | 'file:' PATH | 'pc:' INTEGER | 'diff:' NAME
+ * Numbers are constants, so each sub-expression is either a number or a
+ * linear form sum c_i leaf_i; the parser checks the types as it goes (a
+ * number cannot be added to a point, two points cannot be multiplied) and
+ * reports the column of the offending token. Parsing is the only place
+ * where expressions are inspected; the evaluator just sums.
+ */
+#include "edgespace/es_point.h"
+#include "core/core_private.h"
+
+#include <ctype.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct term {
+    double coef;
+    es_point_leaf kind;
+    char *arg;
+    int64_t index;
+} term;
+
+struct es_point_expr {
+    es_ctx *ctx;
+    int64_t n, cap;
+    term *t;
+};
+
+/* A parsed sub-expression: a number (is_num) or a linear form held as a
+ * range [t0, t1) of the expression's term array. */
+typedef struct form {
+    int is_num;
+    double num;
+    int64_t t0, t1;
+} form;
+
+typedef struct parser {
+    es_ctx *ctx;
+    const char *s;
+    size_t pos;
+    es_point_expr *x;
+    int depth;
+} parser;
+
+#define MAX_DEPTH 200
+
+static es_status perr(parser *p, size_t at, const char *fmt, ...) ES__PRINTF(3, 4);
+static es_status perr(parser *p, size_t at, const char *fmt, ...)
+{
+    char msg[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    return es__fail(p->ctx, ES_EFORMAT, "point: column %zu: %s", at + 1, msg);
+}
+
+static void skip_ws(parser *p)
+{
+    while (p->s[p->pos] == ' ' || p->s[p->pos] == '\t' || p->s[p->pos] == '\n' ||
+           p->s[p->pos] == '\r')
+        p->pos++;
+}
+
+static int is_id_char(char c)
+{
+    return isalnum((unsigned char)c) || c == '-' || c == '_' || c == '.';
+}
+
+/* What the next token looks like, for messages. */
+static const char *describe(parser *p, char *buf, size_t n)
+{
+    char c = p->s[p->pos];
+    if (!c) return "the end of the expression";
+    snprintf(buf, n, "'%c'", c);
+    return buf;
+}
+
+static es_status add_term(parser *p, double coef, es_point_leaf kind, const char *arg,
+                          size_t arglen, int64_t index, form *f)
+{
+    es_point_expr *x = p->x;
+    if (x->n == x->cap) {
+        int64_t cap = x->cap ? 2 * x->cap : 8;
+        term *t = es__realloc(p->ctx, x->t, (size_t)cap * sizeof *t);
+        if (!t) return ES_ENOMEM;
+        x->t = t;
+        x->cap = cap;
+    }
+    char *a = es__malloc(p->ctx, arglen + 1);
+    if (!a) return ES_ENOMEM;
+    memcpy(a, arg, arglen);
+    a[arglen] = '\0';
+    x->t[x->n] = (term){coef, kind, a, index};
+    f->is_num = 0;
+    f->t0 = x->n;
+    f->t1 = ++x->n;
+    return ES_OK;
+}
+
+static void scale_form(parser *p, form *f, double c)
+{
+    if (f->is_num) f->num *= c;
+    else
+        for (int64_t i = f->t0; i < f->t1; i++) p->x->t[i].coef *= c;
+}
+
+/* A word: a quoted string "..." (any characters but '"') or a run of
+ * characters accepted by `ok`. Sets *w, *len; the quotes are not part of
+ * the word. */
+static es_status word(parser *p, int (*ok)(char), const char *what, const char **w,
+                      size_t *len)
+{
+    size_t at = p->pos;
+    if (p->s[at] == '"') {
+        const char *end = strchr(p->s + at + 1, '"');
+        if (!end) return perr(p, at, "unterminated quoted string (expected %s)", what);
+        *w = p->s + at + 1;
+        *len = (size_t)(end - *w);
+        p->pos = (size_t)(end - p->s) + 1;
+        if (*len == 0) return perr(p, at, "expected %s, found an empty string", what);
+        return ES_OK;
+    }
+    while (p->s[p->pos] && ok(p->s[p->pos])) p->pos++;
+    if (p->pos == at) {
+        char b[8];
+        return perr(p, at, "expected %s, found %s", what, describe(p, b, sizeof b));
+    }
+    *w = p->s + at;
+    *len = p->pos - at;
+    return ES_OK;
+}
+
+static int path_char(char c)
+{
+    return c && c != ' ' && c != '\t' && c != '\n' && c != ',' && c != ')';
+}
+
+static int has_mesh_ext(const char *w, size_t n)
+{
+    static const char *const ext[] = {".obj", ".ply", ".off", ".OBJ", ".PLY", ".OFF"};
+    for (size_t i = 0; i < sizeof ext / sizeof *ext; i++)
+        if (n > 4 && !memcmp(w + n - 4, ext[i], 4)) return 1;
+    return 0;
+}
+
+static es_status parse_sum(parser *p, form *f);
+
+static es_status expect(parser *p, char c)
+{
+    skip_ws(p);
+    if (p->s[p->pos] != c) {
+        char b[8];
+        return perr(p, p->pos, "expected '%c', found %s", c, describe(p, b, sizeof b));
+    }
+    p->pos++;
+    return ES_OK;
+}
+
+static es_status parse_number(parser *p, form *f)
+{
+    size_t at = p->pos, i = at;
+    while (isdigit((unsigned char)p->s[i])) i++;
+    if (p->s[i] == '.') {
+        i++;
+        while (isdigit((unsigned char)p->s[i])) i++;
+    }
+    if (i == at + 1 && p->s[at] == '.') return perr(p, at, "malformed number");
+    if (p->s[i] == 'e' || p->s[i] == 'E') {
+        size_t j = i + 1;
+        if (p->s[j] == '+' || p->s[j] == '-') j++;
+        if (!isdigit((unsigned char)p->s[j])) return perr(p, at, "malformed number");
+        while (isdigit((unsigned char)p->s[j])) j++;
+        i = j;
+    }
+    char buf[64];
+    if (i - at >= sizeof buf) return perr(p, at, "number too long");
+    memcpy(buf, p->s + at, i - at);
+    buf[i - at] = '\0';
+    f->is_num = 1;
+    f->num = strtod(buf, NULL);
+    if (!isfinite(f->num)) return perr(p, at, "number out of range");
+    p->pos = i;
+    if (isalpha((unsigned char)p->s[i]) || p->s[i] == '_')
+        return perr(p, i, "expected an operator after the number, found '%c' (write 2*pc:1)",
+                    p->s[i]);
+    return ES_OK;
+}
+
+/* mean or mean[col=value,...]: the filter is stored as "col=value,col=value",
+ * in es_store_select's syntax. */
+static es_status parse_mean(parser *p, form *f)
+{
+    size_t save = p->pos;
+    skip_ws(p);
+    if (p->s[p->pos] != '[') {
+        p->pos = save;
+        return add_term(p, 1.0, ES_POINT_MEAN, "", 0, 0, f);
+    }
+    size_t open = p->pos++;
+    char *filt = NULL;
+    size_t flen = 0;
+    es_status rc = ES_OK;
+    for (;;) {
+        const char *w = NULL, *v = NULL; /* set by word(); initialized for -O3 */
+        size_t wl = 0, vl = 0;
+        skip_ws(p);
+        size_t wat = p->pos;
+        if ((rc = word(p, is_id_char, "a column name", &w, &wl)) != ES_OK) break;
+        /* es_store_select splits terms at ',' and the name from the value at
+         * the first '=', so a quoted name cannot hold them */
+        if (memchr(w, ',', wl) || memchr(w, '=', wl)) {
+            rc = perr(p, wat, "a column name cannot contain ',' or '='");
+            break;
+        }
+        skip_ws(p);
+        if (p->s[p->pos] != '=') {
+            char b[8];
+            rc = perr(p, p->pos, "expected '=' after the column name, found %s",
+                      describe(p, b, sizeof b));
+            break;
+        }
+        p->pos++;
+        skip_ws(p);
+        if ((rc = word(p, is_id_char, "a value", &v, &vl)) != ES_OK) break;
+        /* a value holding ',' is passed quoted (es_store_select's col="v") */
+        int q = memchr(v, ',', vl) != NULL;
+        char *nf = es__realloc(p->ctx, filt, flen + wl + vl + 5);
+        if (!nf) {
+            rc = ES_ENOMEM;
+            break;
+        }
+        filt = nf;
+        if (flen) filt[flen++] = ',';
+        memcpy(filt + flen, w, wl);
+        flen += wl;
+        filt[flen++] = '=';
+        if (q) filt[flen++] = '"';
+        memcpy(filt + flen, v, vl);
+        flen += vl;
+        if (q) filt[flen++] = '"';
+        filt[flen] = '\0';
+        skip_ws(p);
+        if (p->s[p->pos] == ',') {
+            p->pos++;
+            continue;
+        }
+        if (p->s[p->pos] == ']') {
+            p->pos++;
+            break;
+        }
+        char b[8];
+        rc = !p->s[p->pos] ? perr(p, p->pos, "expected ']' to close the '[' at column %zu",
+                                  open + 1)
+                           : perr(p, p->pos, "expected ',' or ']', found %s",
+                                  describe(p, b, sizeof b));
+        break;
+    }
+    if (rc == ES_OK) rc = add_term(p, 1.0, ES_POINT_MEAN, filt, flen, 0, f);
+    es__free(p->ctx, filt);
+    return rc;
+}
+
+static es_status parse_lerp(parser *p, form *f, size_t at)
+{
+    form a, b, t;
+    es_status rc;
+    size_t pa, pb, pt;
+    if ((rc = expect(p, '(')) != ES_OK) return rc;
+    skip_ws(p);
+    pa = p->pos;
+    if ((rc = parse_sum(p, &a)) != ES_OK || (rc = expect(p, ',')) != ES_OK) return rc;
+    skip_ws(p);
+    pb = p->pos;
+    if ((rc = parse_sum(p, &b)) != ES_OK || (rc = expect(p, ',')) != ES_OK) return rc;
+    skip_ws(p);
+    pt = p->pos;
+    if ((rc = parse_sum(p, &t)) != ES_OK || (rc = expect(p, ')')) != ES_OK) return rc;
+    if (a.is_num) return perr(p, pa, "the first argument of lerp must be a point");
+    if (b.is_num) return perr(p, pb, "the second argument of lerp must be a point");
+    if (!t.is_num) return perr(p, pt, "the third argument of lerp must be a number");
+    (void)at;
+    /* terms of a precede those of b precede those of t (none) */
+    scale_form(p, &a, 1.0 - t.num);
+    scale_form(p, &b, t.num);
+    f->is_num = 0;
+    f->t0 = a.t0;
+    f->t1 = b.t1;
+    return ES_OK;
+}
+
+static es_status parse_primary(parser *p, form *f)
+{
+    skip_ws(p);
+    size_t at = p->pos;
+    char c = p->s[at];
+    if (isdigit((unsigned char)c) || c == '.') return parse_number(p, f);
+    if (c == '(') {
+        p->pos++;
+        es_status rc = parse_sum(p, f);
+        if (rc != ES_OK) return rc;
+        skip_ws(p);
+        if (p->s[p->pos] != ')') {
+            char b[8];
+            return perr(p, p->pos, "expected ')' to close the '(' at column %zu, found %s",
+                        at + 1, describe(p, b, sizeof b));
+        }
+        p->pos++;
+        return ES_OK;
+    }
+    if (!isalpha((unsigned char)c)) {
+        char b[8];
+        return perr(p, at, "expected a point or a number, found %s", describe(p, b, sizeof b));
+    }
+    size_t i = at;
+    while (isalnum((unsigned char)p->s[i]) || p->s[i] == '_') i++;
+    size_t n = i - at;
+    const char *name = p->s + at;
+    p->pos = i;
+#define IS(lit) (n == sizeof(lit) - 1 && !memcmp(name, lit, n))
+    if (IS("mean")) return parse_mean(p, f);
+    if (IS("lerp")) return parse_lerp(p, f, at);
+    if (IS("row") || IS("file") || IS("pc") || IS("diff")) {
+        if (p->s[p->pos] != ':')
+            return perr(p, p->pos, "expected ':' after '%.*s'", (int)n, name);
+        p->pos++;
+        const char *w = NULL;
+        size_t wl = 0, wat = p->pos;
+        es_status rc;
+        if (IS("row")) {
+            if ((rc = word(p, is_id_char, "a row id", &w, &wl)) != ES_OK)
+                return rc;
+            return add_term(p, 1.0, ES_POINT_ROW, w, wl, 0, f);
+        }
+        if (IS("diff")) {
+            if ((rc = word(p, is_id_char, "a difference name", &w, &wl)) != ES_OK)
+                return rc;
+            return add_term(p, 1.0, ES_POINT_DIFF, w, wl, 0, f);
+        }
+        if (IS("file")) {
+            if ((rc = word(p, path_char, "a mesh file path", &w, &wl)) != ES_OK) return rc;
+            if (!has_mesh_ext(w, wl))
+                return perr(p, wat, "expected a mesh file path ending in .obj, .ply or .off, "
+                            "found '%.*s'", (int)wl, w);
+            return add_term(p, 1.0, ES_POINT_FILE, w, wl, 0, f);
+        }
+        /* pc:K */
+        int64_t k = 0;
+        size_t j = p->pos;
+        while (isdigit((unsigned char)p->s[j]) && k < 1000000000) k = 10 * k + (p->s[j++] - '0');
+        if (j == p->pos || k < 1 || isalnum((unsigned char)p->s[j]) || p->s[j] == '_' ||
+            p->s[j] == '.')
+            return perr(p, wat, "expected a component number >= 1 after 'pc:'");
+        p->pos = j;
+        return add_term(p, 1.0, ES_POINT_PC, "", 0, k, f);
+    }
+#undef IS
+    return perr(p, at, "unknown name '%.*s' (expected mean, row:, file:, pc:, diff: or lerp)",
+                (int)n, name);
+}
+
+static es_status parse_unary(parser *p, form *f)
+{
+    skip_ws(p);
+    char c = p->s[p->pos];
+    if (c == '-' || c == '+') {
+        if (++p->depth > MAX_DEPTH) return perr(p, p->pos, "expression nested too deeply");
+        p->pos++;
+        es_status rc = parse_unary(p, f);
+        p->depth--;
+        if (rc == ES_OK && c == '-') scale_form(p, f, -1.0);
+        return rc;
+    }
+    if (++p->depth > MAX_DEPTH) return perr(p, p->pos, "expression nested too deeply");
+    es_status rc = parse_primary(p, f);
+    p->depth--;
+    return rc;
+}
+
+static es_status parse_product(parser *p, form *f)
+{
+    es_status rc = parse_unary(p, f);
+    while (rc == ES_OK) {
+        skip_ws(p);
+        char op = p->s[p->pos];
+        if (op != '*' && op != '/') break;
+        size_t at = p->pos++;
+        form g;
+        skip_ws(p);
+        size_t gat = p->pos;
+        if ((rc = parse_unary(p, &g)) != ES_OK) break;
+        if (op == '/') {
+            if (!g.is_num) return perr(p, gat, "cannot divide by a point");
+            if (g.num == 0) return perr(p, at, "division by zero");
+            scale_form(p, f, 1.0 / g.num);
+        } else if (f->is_num && g.is_num) {
+            f->num *= g.num;
+        } else if (f->is_num) {
+            double c = f->num;
+            *f = g;
+            scale_form(p, f, c);
+        } else if (g.is_num) {
+            scale_form(p, f, g.num);
+        } else {
+            return perr(p, at, "cannot multiply two points");
+        }
+    }
+    return rc;
+}
+
+static es_status parse_sum(parser *p, form *f)
+{
+    es_status rc = parse_product(p, f);
+    while (rc == ES_OK) {
+        skip_ws(p);
+        char op = p->s[p->pos];
+        if (op != '+' && op != '-') break;
+        size_t at = p->pos++;
+        form g;
+        if ((rc = parse_product(p, &g)) != ES_OK) break;
+        if (f->is_num != g.is_num)
+            return perr(p, at, "cannot %s a number and a point", op == '+' ? "add" : "subtract");
+        if (f->is_num) {
+            f->num = op == '+' ? f->num + g.num : f->num - g.num;
+        } else {
+            if (op == '-') scale_form(p, &g, -1.0);
+            f->t1 = g.t1;   /* g's terms follow f's */
+        }
+    }
+    return rc;
+}
+
+void es_point_expr_free(es_point_expr *x)
+{
+    if (!x) return;
+    for (int64_t i = 0; i < x->n; i++) es__free(x->ctx, x->t[i].arg);
+    es__free(x->ctx, x->t);
+    es__free(x->ctx, x);
+}
+
+es_status es_point_parse(es_ctx *ctx, const char *text, es_point_expr **out)
+{
+    *out = NULL;
+    if (!text) ES_FAIL(ctx, ES_EINVAL, "point: no expression");
+    es_point_expr *x = es__calloc(ctx, 1, sizeof *x);
+    if (!x) return ES_ENOMEM;
+    x->ctx = ctx;
+    parser p = {ctx, text, 0, x, 0};
+    form f;
+    es_status rc = parse_sum(&p, &f);
+    if (rc == ES_OK) {
+        skip_ws(&p);
+        if (text[p.pos]) {
+            char b[8];
+            rc = perr(&p, p.pos, "unexpected %s after the end of the expression",
+                      describe(&p, b, sizeof b));
+        } else if (f.is_num) {
+            rc = perr(&p, 0, "the expression is a number, not a point");
+        }
+    }
+    if (rc != ES_OK) {
+        es_point_expr_free(x);
+        return rc;
+    }
+    *out = x;
+    return ES_OK;
+}
+
+int64_t es_point_expr_nterms(const es_point_expr *x) { return x ? x->n : 0; }
+
+void es_point_expr_term(const es_point_expr *x, int64_t i, double *coef, es_point_leaf *kind,
+                        const char **arg, int64_t *index)
+{
+    const term *t = &x->t[i];
+    if (coef) *coef = t->coef;
+    if (kind) *kind = t->kind;
+    if (arg) *arg = t->arg;
+    if (index) *index = t->index;
+}
+
+static const char *leaf_prefix(es_point_leaf k)
+{
+    switch (k) {
+    case ES_POINT_MEAN: return "mean";
+    case ES_POINT_ROW: return "row:";
+    case ES_POINT_FILE: return "file:";
+    case ES_POINT_PC: return "pc:";
+    case ES_POINT_DIFF: return "diff:";
+    }
+    return "?";
+}
+
+es_status es_point_eval(es_ctx *ctx, const es_point_expr *x, int64_t E,
+                        es_point_resolve_fn resolve, void *ud, const es_mesh *mesh, double *vec,
+                        es_point_info *info)
+{
+    if (!x || !resolve || !vec || E < 1)
+        ES_FAIL(ctx, ES_EINVAL, "point: nothing to evaluate");
+    if (mesh && es_mesh_nedges(mesh) != E)
+        ES_FAIL(ctx, ES_EMISMATCH, "point: %lld edges, the mesh has %lld", (long long)E,
+                (long long)es_mesh_nedges(mesh));
+    double *leaf = es__alloc_array(ctx, E, sizeof *leaf);
+    if (!leaf) return ES_ENOMEM;
+    es_point_info in;
+    memset(&in, 0, sizeof in);
+    in.scale = NAN;
+    double wscale = 0;
+    memset(vec, 0, (size_t)E * sizeof *vec);
+    for (int64_t i = 0; i < x->n; i++) {
+        const term *t = &x->t[i];
+        double s = NAN;
+        es_status rc = resolve(ctx, ud, t->kind, t->arg, t->index, leaf, &s);
+        if (rc != ES_OK) {
+            char msg[1024];
+            snprintf(msg, sizeof msg, "%s", es_ctx_errmsg(ctx));
+            es__free(ctx, leaf);
+            if (t->kind == ES_POINT_PC)
+                ES_FAIL(ctx, rc, "point: pc:%lld: %s", (long long)t->index, msg);
+            if (t->kind == ES_POINT_MEAN)
+                ES_FAIL(ctx, rc, "point: mean%s%s%s: %s", *t->arg ? "[" : "", t->arg,
+                        *t->arg ? "]" : "", msg);
+            ES_FAIL(ctx, rc, "point: %s%s: %s", leaf_prefix(t->kind), t->arg, msg);
+        }
+        double c = t->coef;
+        if (t->kind == ES_POINT_PC) {
+            if (!(s >= 0) || !isfinite(s)) {
+                es__free(ctx, leaf);
+                ES_FAIL(ctx, ES_ENUMERIC, "point: pc:%lld: standard deviation is %g",
+                        (long long)t->index, s);
+            }
+            c *= s;
+            in.ndirections++;
+        } else if (t->kind == ES_POINT_DIFF) {
+            in.ndirections++;
+        } else {
+            if (!(s > 0) || !isfinite(s)) {
+                es__free(ctx, leaf);
+                ES_FAIL(ctx, ES_EINVAL, "point: %s%s: scale is %g, not positive",
+                        leaf_prefix(t->kind), t->arg, s);
+            }
+            in.weight += t->coef;
+            wscale += t->coef * s;
+            in.nshapes++;
+        }
+        for (int64_t e = 0; e < E; e++) vec[e] += c * leaf[e];
+    }
+    es__free(ctx, leaf);
+    for (int64_t e = 0; e < E; e++) in.length_sum += vec[e];
+    if (in.weight != 0) in.scale = wscale / in.weight;
+    if (fabs(in.weight - 1.0) > 1e-12)
+        es__warn(ctx, "point: the shapes' weights sum to %g, not 1: the lengths sum to %g",
+                 in.weight, in.length_sum);
+    if (mesh) {
+        es_status rc = es_lengths_check(ctx, mesh, vec, 0.0, &in.validity);
+        if (rc != ES_OK) return rc;
+        in.checked = 1;
+    }
+    if (info) *info = in;
+    return ES_OK;
+}

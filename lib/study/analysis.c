@@ -1,0 +1,602 @@
+/* lib/study/analysis.c — statistics and points on a shape store: the glue between
+ * es_stats.h / es_point.h (which know nothing of storage) and es_store.h.
+ *
+ * Each es_study_* call selects rows with the store's label filter,
+ * streams their lengths through an es_source, computes, and writes one
+ * result group /analysis/<kind>/<name> with provenance (layouts in
+ * es_study.h). Commands (tools/cmd_mean.c, ...) and notebooks call these,
+ * so a result made from C is the same as one made from the command line.
+ */
+#include "edgespace/es_study.h"
+#include "edgespace/es_geom.h"
+#include "edgespace/es_io.h"
+#include "core/core_private.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define PATH_MAX_LEN 512
+
+/* ---- sources and files ------------------------------------------------------ */
+
+static es_status store_read(es_ctx *ctx, const es_source *src, int64_t row0, int64_t n,
+                            es_mat out)
+{
+    es_store *store = src->userdata;
+    if (src->rows) return es_store_read_lengths_rows(ctx, store, src->rows + row0, n, out);
+    return es_store_read_lengths(ctx, store, row0, n, out);
+}
+
+es_status es_study_source(es_ctx *ctx, es_store *store, const int64_t *rows, int64_t nrows,
+                          es_source *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!store) ES_FAIL(ctx, ES_EINVAL, "source: no store");
+    if (rows && nrows < 0) ES_FAIL(ctx, ES_EINVAL, "source: %lld rows", (long long)nrows);
+    out->nedges = es_store_nedges(store);
+    out->nrows = rows ? nrows : es_store_nrows(store);
+    out->read = store_read;
+    out->userdata = store;
+    out->rows = rows;
+    return ES_OK;
+}
+
+/* "<kind>/<name>/<dataset>" */
+static es_status dpath(es_ctx *ctx, char *buf, const char *kind, const char *name,
+                       const char *ds)
+{
+    int n = snprintf(buf, PATH_MAX_LEN, "%s/%s/%s", kind, name, ds);
+    if (n < 0 || n >= PATH_MAX_LEN) ES_FAIL(ctx, ES_ERANGE, "analysis: name '%s' too long", name);
+    return ES_OK;
+}
+
+static int bad_name(const char *name)
+{
+    if (!name || !*name || !strcmp(name, ".") || !strcmp(name, "..")) return 1;
+    for (const char *c = name; *c; c++)
+        if (*c == '/' || (unsigned char)*c < 32) return 1;
+    return 0;
+}
+
+#define CHECK_NAME(ctx, name) do { if ((name) && bad_name(name)) \
+    ES_FAIL(ctx, ES_EINVAL, "analysis: bad result name '%s' (no '/', not empty)", name); \
+    } while (0)
+
+/* Length statistics need edges: a landmarks-only store has none. */
+#define NEED_EDGES(ctx, store) do { if (es_store_nedges(store) < 1) \
+    ES_FAIL(ctx, ES_EINVAL, "analysis: store '%s' has no edges: it holds landmarks only; " \
+            "give --edges or --triangles at ingest", es_store_path(store)); \
+    } while (0)
+
+/* ---- means -------------------------------------------------------------------- */
+
+void es_group_result_free(es_group_result *r)
+{
+    if (!r) return;
+    es_ctx *ctx = r->ctx;
+    for (int64_t g = 0; r->names && g < r->ngroups; g++) es__free(ctx, r->names[g]);
+    es__free(ctx, r->names);
+    es__free(ctx, r->means);
+    es__free(ctx, r->counts);
+    es__free(ctx, r->scales);
+    es__free(ctx, r);
+}
+
+es_status es_study_mean(es_ctx *ctx, es_store *store, const char *name, const char *filter,
+                           const char *by, const char *command, es_group_result **out)
+{
+    es_status rc;
+    int64_t *rows = NULL, nrows = 0, *group = NULL, ng = 0;
+    const char **labels = NULL, **gnames = NULL;
+    double *scales = NULL;
+    es_group_result *r = NULL;
+    if (out) *out = NULL;
+    CHECK_NAME(ctx, name);
+    NEED_EDGES(ctx, store);
+    const int64_t E = es_store_nedges(store), col = by ? es_store_find_column(store, by) : -1;
+    if (by && col < 0) ES_FAIL(ctx, ES_ENOTFOUND, "mean: no label column '%s'", by);
+    if ((rc = es_store_select(ctx, store, filter, &rows, &nrows)) != ES_OK) return rc;
+    if (nrows == 0) {
+        rc = es__fail(ctx, ES_EINVAL, "mean: no rows match '%s'", filter ? filter : "");
+        goto done;
+    }
+    labels = es__alloc_array(ctx, nrows, sizeof *labels);
+    scales = es__alloc_array(ctx, es_store_nrows(store), sizeof *scales);
+    if (!labels || !scales) {
+        rc = ES_ENOMEM;
+        goto done;
+    }
+    for (int64_t i = 0; i < nrows; i++) labels[i] = by ? es_store_label(store, rows[i], col) : "all";
+    if ((rc = es_groups_from_labels(ctx, labels, nrows, &group, &gnames, &ng)) != ES_OK ||
+        (rc = es_store_read_scales(ctx, store, scales)) != ES_OK)
+        goto done;
+    r = es__calloc(ctx, 1, sizeof *r);
+    if (!r) {
+        rc = ES_ENOMEM;
+        goto done;
+    }
+    r->ctx = ctx;
+    r->nedges = E;
+    r->ngroups = ng;
+    r->names = es__calloc(ctx, (size_t)ng, sizeof *r->names);
+    r->means = es__alloc_array(ctx, E * ng, sizeof *r->means);
+    r->counts = es__alloc_array(ctx, ng, sizeof *r->counts);
+    r->scales = es__calloc(ctx, (size_t)ng, sizeof *r->scales);
+    if (!r->names || !r->means || !r->counts || !r->scales) {
+        rc = ES_ENOMEM;
+        goto done;
+    }
+    for (int64_t g = 0; g < ng; g++)
+        if (!(r->names[g] = es__strdup(ctx, gnames[g]))) {
+            rc = ES_ENOMEM;
+            goto done;
+        }
+    es_source src;
+    if ((rc = es_study_source(ctx, store, rows, nrows, &src)) != ES_OK ||
+        (rc = es_group_means(ctx, &src, group, ng, r->means, r->counts)) != ES_OK)
+        goto done;
+    for (int64_t i = 0; i < nrows; i++) r->scales[group[i]] += scales[rows[i]];
+    for (int64_t g = 0; g < ng; g++) r->scales[g] /= (double)r->counts[g];
+    if (name) {
+        char p[PATH_MAX_LEN], params[256];
+        snprintf(params, sizeof params, "filter=%s; by=%s", filter ? filter : "", by ? by : "");
+        es_provenance prov = {command ? command : "es_study_mean", rows, nrows, params};
+        if ((rc = es_store_result_begin(ctx, store, "mean", name, &prov)) != ES_OK) goto done;
+        if ((rc = dpath(ctx, p, "mean", name, "means")) != ES_OK ||
+            (rc = es_store_put_matrix(ctx, store, p, (es_mat){r->means, E, ng, E})) != ES_OK ||
+            (rc = dpath(ctx, p, "mean", name, "counts")) != ES_OK ||
+            (rc = es_store_put_ints(ctx, store, p, r->counts, ng)) != ES_OK ||
+            (rc = dpath(ctx, p, "mean", name, "scales")) != ES_OK ||
+            (rc = es_store_put_vector(ctx, store, p, r->scales, ng)) != ES_OK ||
+            (rc = dpath(ctx, p, "mean", name, "groups")) != ES_OK ||
+            (rc = es_store_put_strings(ctx, store, p, (const char *const *)r->names, ng)) != ES_OK)
+            goto done;
+        snprintf(p, sizeof p, "mean/%s", name);
+        if ((rc = es_store_put_attr(ctx, store, p, "filter", filter ? filter : "")) != ES_OK ||
+            (rc = es_store_put_attr(ctx, store, p, "by", by ? by : "")) != ES_OK)
+            goto done;
+    }
+    if (out) {
+        *out = r;
+        r = NULL;
+    }
+done:
+    es_group_result_free(r);
+    es__free(ctx, rows);
+    es__free(ctx, (void *)labels);
+    es__free(ctx, group);
+    es__free(ctx, (void *)gnames);
+    es__free(ctx, scales);
+    return rc;
+}
+
+/* ---- PCA ------------------------------------------------------------------------ */
+
+static const char *method_name(es_pca_method m)
+{
+    switch (m) {
+    case ES_PCA_GRAM: return "gram";
+    case ES_PCA_COVARIANCE: return "covariance";
+    case ES_PCA_RANDOMIZED: return "randomized";
+    case ES_PCA_AUTO: break;
+    }
+    return "auto";
+}
+
+static es_status save_pca(es_ctx *ctx, es_store *store, const char *name, const es_pca *p,
+                          const int64_t *rows, const char *filter, const char *command)
+{
+    char path[PATH_MAX_LEN], params[512];
+    const int64_t E = p->nedges, N = p->nrows, K = p->ncomp;
+    snprintf(params, sizeof params, "filter=%s; ncomp=%lld; method=%s", filter ? filter : "",
+             (long long)K, method_name(p->method));
+    es_provenance prov = {command ? command : "es_study_pca", rows, N, params};
+    es_status rc = es_store_result_begin(ctx, store, "pca", name, &prov);
+    if (rc != ES_OK) return rc;
+    /* scores as N x K on disk: row i = shape i, so the es_mat is K x N */
+    double *st = es__alloc_array(ctx, N * (K > 0 ? K : 1), sizeof *st);
+    if (!st) return ES_ENOMEM;
+    for (int64_t i = 0; i < N; i++)
+        for (int64_t k = 0; k < K; k++) st[k + i * K] = p->scores[i + k * N];
+    if ((rc = dpath(ctx, path, "pca", name, "mean")) != ES_OK ||
+        (rc = es_store_put_vector(ctx, store, path, p->mean, E)) != ES_OK ||
+        (rc = dpath(ctx, path, "pca", name, "components")) != ES_OK ||
+        (rc = es_store_put_matrix(ctx, store, path, (es_mat){p->components, E, K, E})) != ES_OK ||
+        (rc = dpath(ctx, path, "pca", name, "eigenvalues")) != ES_OK ||
+        (rc = es_store_put_vector(ctx, store, path, p->eigenvalues, K)) != ES_OK ||
+        (rc = dpath(ctx, path, "pca", name, "explained")) != ES_OK ||
+        (rc = es_store_put_vector(ctx, store, path, p->explained, K)) != ES_OK ||
+        (rc = dpath(ctx, path, "pca", name, "total_variance")) != ES_OK ||
+        (rc = es_store_put_vector(ctx, store, path, &p->total_variance, 1)) != ES_OK ||
+        (rc = dpath(ctx, path, "pca", name, "scores")) != ES_OK ||
+        (rc = es_store_put_matrix(ctx, store, path, (es_mat){st, K, N, K > 0 ? K : 1})) != ES_OK ||
+        (rc = dpath(ctx, path, "pca", name, "rows")) != ES_OK ||
+        (rc = es_store_put_ints(ctx, store, path, rows, N)) != ES_OK)
+        goto done;
+    snprintf(path, sizeof path, "pca/%s", name);
+    char ks[32];
+    snprintf(ks, sizeof ks, "%lld", (long long)K);
+    if ((rc = es_store_put_attr(ctx, store, path, "method", method_name(p->method))) != ES_OK ||
+        (rc = es_store_put_attr(ctx, store, path, "filter", filter ? filter : "")) != ES_OK ||
+        (rc = es_store_put_attr(ctx, store, path, "ncomp", ks)) != ES_OK)
+        goto done;
+done:
+    es__free(ctx, st);
+    return rc;
+}
+
+es_status es_study_pca(es_ctx *ctx, es_store *store, const char *name, const char *filter,
+                          const es_pca_opts *opts, const char *command, es_pca **out,
+                          int64_t **rows_out, int64_t *nrows_out)
+{
+    int64_t *rows = NULL, nrows = 0;
+    es_pca *p = NULL;
+    es_source src;
+    if (out) *out = NULL;
+    if (rows_out) *rows_out = NULL;
+    CHECK_NAME(ctx, name);
+    NEED_EDGES(ctx, store);
+    es_status rc = es_store_select(ctx, store, filter, &rows, &nrows);
+    if (rc != ES_OK) return rc;
+    if ((rc = es_study_source(ctx, store, rows, nrows, &src)) != ES_OK ||
+        (rc = es_pca_fit(ctx, &src, opts, &p)) != ES_OK)
+        goto done;
+    if (name && (rc = save_pca(ctx, store, name, p, rows, filter, command)) != ES_OK) goto done;
+    if (out) {
+        *out = p;
+        p = NULL;
+    }
+    if (rows_out) {
+        *rows_out = rows;
+        rows = NULL;
+    }
+    if (nrows_out) *nrows_out = nrows;
+done:
+    es_pca_free(p);
+    es__free(ctx, rows);
+    return rc;
+}
+
+/* The PCA name to use: given, the only one, or "default". Writes into buf. */
+static es_status pick_pca(es_ctx *ctx, es_store *store, const char *name, char *buf, size_t n)
+{
+    if (name) {
+        snprintf(buf, n, "%s", name);
+        return ES_OK;
+    }
+    char **names = NULL;
+    int64_t count = 0;
+    es_status rc = es_store_list_results(ctx, store, "pca", &names, &count);
+    if (rc != ES_OK) return rc;
+    int found = 0;
+    if (count == 1) {
+        snprintf(buf, n, "%s", names[0]);
+        found = 1;
+    }
+    for (int64_t i = 0; i < count; i++) {
+        if (!found && !strcmp(names[i], "default")) {
+            snprintf(buf, n, "default");
+            found = 1;
+        }
+        es_free(ctx, names[i]);
+    }
+    es_free(ctx, names);
+    if (!found)
+        ES_FAIL(ctx, ES_ENOTFOUND, "pca: %s; name one (--pca NAME)",
+                count ? "several PCAs are stored and none is named 'default'"
+                      : "the store holds no PCA (run edgespace pca first)");
+    return ES_OK;
+}
+
+es_status es_study_pca_load(es_ctx *ctx, es_store *store, const char *name, es_pca **out,
+                               int64_t **rows_out, int64_t *nrows_out)
+{
+    char nm[256], path[PATH_MAX_LEN];
+    double *mean = NULL, *eig = NULL, *tv = NULL;
+    int64_t E = 0, K = 0, ntv = 0, *rows = NULL, nrows = 0;
+    es_mat comps = {0}, scores = {0};
+    es_pca *p = NULL;
+    *out = NULL;
+    if (rows_out) *rows_out = NULL;
+    es_status rc = pick_pca(ctx, store, name, nm, sizeof nm);
+    if (rc != ES_OK) return rc;
+    snprintf(path, sizeof path, "pca/%s", nm);
+    if (!es_store_has(store, path)) ES_FAIL(ctx, ES_ENOTFOUND, "pca: no PCA named '%s'", nm);
+    if ((rc = dpath(ctx, path, "pca", nm, "mean")) != ES_OK ||
+        (rc = es_store_get_vector(ctx, store, path, &mean, &E)) != ES_OK ||
+        (rc = dpath(ctx, path, "pca", nm, "eigenvalues")) != ES_OK ||
+        (rc = es_store_get_vector(ctx, store, path, &eig, &K)) != ES_OK ||
+        (rc = dpath(ctx, path, "pca", nm, "total_variance")) != ES_OK ||
+        (rc = es_store_get_vector(ctx, store, path, &tv, &ntv)) != ES_OK ||
+        (rc = dpath(ctx, path, "pca", nm, "components")) != ES_OK ||
+        (rc = es_store_get_matrix(ctx, store, path, &comps)) != ES_OK ||
+        (rc = dpath(ctx, path, "pca", nm, "scores")) != ES_OK ||
+        (rc = es_store_get_matrix(ctx, store, path, &scores)) != ES_OK ||
+        (rc = dpath(ctx, path, "pca", nm, "rows")) != ES_OK ||
+        (rc = es_store_get_ints(ctx, store, path, &rows, &nrows)) != ES_OK)
+        goto done;
+    if (comps.rows != E || comps.cols != K || ntv != 1 || scores.rows != K ||
+        scores.cols != nrows || E != es_store_nedges(store)) {
+        rc = es__fail(ctx, ES_EFORMAT, "pca: '%s' is inconsistent (mean %lld, components "
+                      "%lld x %lld, %lld eigenvalues, scores %lld x %lld, %lld rows)", nm,
+                      (long long)E, (long long)comps.rows, (long long)comps.cols, (long long)K,
+                      (long long)scores.rows, (long long)scores.cols, (long long)nrows);
+        goto done;
+    }
+    if ((rc = es_pca_from_arrays(ctx, E, K, mean, comps.data, eig, tv[0], &p)) != ES_OK) goto done;
+    es__free(ctx, p->scores);
+    p->scores = es__alloc_array(ctx, nrows * (K > 0 ? K : 1), sizeof *p->scores);
+    if (!p->scores) {
+        rc = ES_ENOMEM;
+        goto done;
+    }
+    p->nrows = nrows;
+    for (int64_t i = 0; i < nrows; i++)
+        for (int64_t k = 0; k < K; k++) p->scores[i + k * nrows] = ES_AT(scores, k, i);
+    *out = p;
+    p = NULL;
+    if (rows_out) {
+        *rows_out = rows;
+        rows = NULL;
+    }
+    if (nrows_out) *nrows_out = nrows;
+done:
+    es_pca_free(p);
+    es_free(ctx, mean);
+    es_free(ctx, eig);
+    es_free(ctx, tv);
+    es_free(ctx, comps.data);
+    es_free(ctx, scores.data);
+    es_free(ctx, rows);
+    return rc;
+}
+
+/* ---- differences ------------------------------------------------------------------ */
+
+es_status es_study_diff(es_ctx *ctx, es_store *store, const char *name, const char *filter,
+                           const char *key, const char *column, const char *from, const char *to,
+                           const char *command, es_diff **out)
+{
+    if (out) *out = NULL;
+    CHECK_NAME(ctx, name);
+    NEED_EDGES(ctx, store);
+    if (!key || !column || !from || !to)
+        ES_FAIL(ctx, ES_EINVAL, "diff: a key column, a role column, 'from' and 'to' are needed");
+    if (!strcmp(from, to)) ES_FAIL(ctx, ES_EINVAL, "diff: 'from' and 'to' are both '%s'", from);
+    const int64_t kc = es_store_find_column(store, key), rcol = es_store_find_column(store, column);
+    if (kc < 0) ES_FAIL(ctx, ES_ENOTFOUND, "diff: no label column '%s'", key);
+    if (rcol < 0) ES_FAIL(ctx, ES_ENOTFOUND, "diff: no label column '%s'", column);
+    const int64_t N = es_store_nrows(store);
+    int64_t *sel = NULL, nsel = 0;
+    es_diff *d = NULL;
+    es_status rc = es_store_select(ctx, store, filter, &sel, &nsel);
+    if (rc != ES_OK) return rc;
+    const char **keys = es__alloc_array(ctx, N > 0 ? N : 1, sizeof *keys);
+    const char **ids = es__alloc_array(ctx, N > 0 ? N : 1, sizeof *ids);
+    int *role = es__alloc_array(ctx, N > 0 ? N : 1, sizeof *role);
+    if (!keys || !ids || !role) {
+        rc = ES_ENOMEM;
+        goto done;
+    }
+    for (int64_t i = 0; i < N; i++) {
+        keys[i] = es_store_label(store, i, kc);
+        ids[i] = es_store_row_id(store, i);
+        role[i] = ES_DIFF_NONE;
+    }
+    int64_t nfrom = 0, nto = 0;
+    for (int64_t j = 0; j < nsel; j++) {
+        const char *v = es_store_label(store, sel[j], rcol);
+        if (v && !strcmp(v, from)) role[sel[j]] = ES_DIFF_FROM, nfrom++;
+        else if (v && !strcmp(v, to)) role[sel[j]] = ES_DIFF_TO, nto++;
+    }
+    if (!nfrom || !nto) {
+        rc = es__fail(ctx, ES_ENOTFOUND, "diff: no rows with %s=%s", column, !nfrom ? from : to);
+        goto done;
+    }
+    es_source src;
+    if ((rc = es_study_source(ctx, store, NULL, 0, &src)) != ES_OK ||
+        (rc = es_diff_paired(ctx, &src, keys, role, ids, &d)) != ES_OK)
+        goto done;
+    if (name) {
+        char p[PATH_MAX_LEN], params[512];
+        const int64_t E = d->nedges;
+        snprintf(params, sizeof params, "filter=%s; key=%s; column=%s; from=%s; to=%s",
+                 filter ? filter : "", key, column, from, to);
+        int64_t *used = es__alloc_array(ctx, 2 * d->npairs, sizeof *used);
+        if (!used) {
+            rc = ES_ENOMEM;
+            goto done;
+        }
+        memcpy(used, d->pair_from, (size_t)d->npairs * sizeof *used);
+        memcpy(used + d->npairs, d->pair_to, (size_t)d->npairs * sizeof *used);
+        es_provenance prov = {command ? command : "es_study_diff", used, 2 * d->npairs, params};
+        rc = es_store_result_begin(ctx, store, "diff", name, &prov);
+        es__free(ctx, used);
+        if (rc != ES_OK) goto done;
+        static const char *const vn[4] = {"mean", "sd", "se", "t"};
+        const double *vv[4] = {d->mean, d->sd, d->se, d->t};
+        for (int i = 0; i < 4; i++)
+            if ((rc = dpath(ctx, p, "diff", name, vn[i])) != ES_OK ||
+                (rc = es_store_put_vector(ctx, store, p, vv[i], E)) != ES_OK)
+                goto done;
+        if ((rc = dpath(ctx, p, "diff", name, "pair_from")) != ES_OK ||
+            (rc = es_store_put_ints(ctx, store, p, d->pair_from, d->npairs)) != ES_OK ||
+            (rc = dpath(ctx, p, "diff", name, "pair_to")) != ES_OK ||
+            (rc = es_store_put_ints(ctx, store, p, d->pair_to, d->npairs)) != ES_OK ||
+            (rc = dpath(ctx, p, "diff", name, "unpaired")) != ES_OK ||
+            (rc = es_store_put_ints(ctx, store, p, d->unpaired, d->nunpaired)) != ES_OK)
+            goto done;
+        snprintf(p, sizeof p, "diff/%s", name);
+        if ((rc = es_store_put_attr(ctx, store, p, "key", key)) != ES_OK ||
+            (rc = es_store_put_attr(ctx, store, p, "column", column)) != ES_OK ||
+            (rc = es_store_put_attr(ctx, store, p, "from", from)) != ES_OK ||
+            (rc = es_store_put_attr(ctx, store, p, "to", to)) != ES_OK)
+            goto done;
+    }
+    if (out) {
+        *out = d;
+        d = NULL;
+    }
+done:
+    es_diff_free(d);
+    es__free(ctx, sel);
+    es__free(ctx, (void *)keys);
+    es__free(ctx, (void *)ids);
+    es__free(ctx, role);
+    return rc;
+}
+
+/* ---- points ------------------------------------------------------------------------- */
+
+void es_study_resolver_clear(es_ctx *ctx, es_study_resolver *r)
+{
+    if (!r) return;
+    es_pca_free(r->pca);
+    es__free(ctx, r->scales);
+    r->pca = NULL;
+    r->scales = NULL;
+}
+
+static es_status load_scales(es_ctx *ctx, es_study_resolver *r)
+{
+    if (r->scales) return ES_OK;
+    r->scales = es__alloc_array(ctx, es_store_nrows(r->store) > 0 ? es_store_nrows(r->store) : 1,
+                                sizeof *r->scales);
+    if (!r->scales) return ES_ENOMEM;
+    es_status rc = es_store_read_scales(ctx, r->store, r->scales);
+    if (rc != ES_OK) {
+        es__free(ctx, r->scales);
+        r->scales = NULL;
+    }
+    return rc;
+}
+
+es_status es_study_resolve(es_ctx *ctx, void *ud, es_point_leaf kind, const char *arg,
+                           int64_t index, double *vec, double *scale)
+{
+    es_study_resolver *r = ud;
+    es_store *st = r->store;
+    const int64_t E = es_store_nedges(st);
+    es_status rc;
+    switch (kind) {
+    case ES_POINT_MEAN: {
+        int64_t *rows = NULL, n = 0;
+        if ((rc = es_store_select(ctx, st, arg, &rows, &n)) != ES_OK) return rc;
+        es_source src;
+        if (n == 0) rc = es__fail(ctx, ES_ENOTFOUND, "no rows match '%s'", arg);
+        else if ((rc = load_scales(ctx, r)) == ES_OK &&
+                 (rc = es_study_source(ctx, st, rows, n, &src)) == ES_OK &&
+                 (rc = es_mean(ctx, &src, vec)) == ES_OK) {
+            double s = 0;
+            for (int64_t i = 0; i < n; i++) s += r->scales[rows[i]];
+            *scale = s / (double)n;
+        }
+        es__free(ctx, rows);
+        return rc;
+    }
+    case ES_POINT_ROW: {
+        int64_t row = es_store_find_row(st, arg);
+        if (row < 0) ES_FAIL(ctx, ES_ENOTFOUND, "no row with id '%s'", arg);
+        if ((rc = load_scales(ctx, r)) != ES_OK ||
+            (rc = es_store_read_lengths(ctx, st, row, 1, (es_mat){vec, E, 1, E})) != ES_OK)
+            return rc;
+        *scale = r->scales[row];
+        return ES_OK;
+    }
+    case ES_POINT_FILE:
+        if (!r->mesh)
+            ES_FAIL(ctx, ES_EINVAL, "store '%s' has no faces (a %s store), so mesh files "
+                    "cannot be matched to it", es_store_path(r->store),
+                    es_topology_kind_name(es_store_topology_kind(r->store)));
+        return es_lengths_from_file(ctx, r->mesh, arg, vec, scale);
+    case ES_POINT_PC:
+        if (!r->pca && (rc = es_study_pca_load(ctx, st, r->pca_name, &r->pca, NULL, NULL)) != ES_OK)
+            return rc;
+        if (index < 1 || index > r->pca->ncomp)
+            ES_FAIL(ctx, ES_ENOTFOUND, "the PCA has %lld components", (long long)r->pca->ncomp);
+        memcpy(vec, r->pca->components + (index - 1) * E, (size_t)E * sizeof *vec);
+        *scale = sqrt(r->pca->eigenvalues[index - 1]);
+        return ES_OK;
+    case ES_POINT_DIFF: {
+        char p[PATH_MAX_LEN];
+        double *v = NULL;
+        int64_t n = 0;
+        if (bad_name(arg)) ES_FAIL(ctx, ES_EINVAL, "bad difference name");
+        if ((rc = dpath(ctx, p, "diff", arg, "mean")) != ES_OK) return rc;
+        if (!es_store_has(st, p)) ES_FAIL(ctx, ES_ENOTFOUND, "no difference named '%s'", arg);
+        if ((rc = es_store_get_vector(ctx, st, p, &v, &n)) != ES_OK) return rc;
+        if (n != E) {
+            es_free(ctx, v);
+            ES_FAIL(ctx, ES_EFORMAT, "difference '%s' has %lld values, the store %lld edges", arg,
+                    (long long)n, (long long)E);
+        }
+        memcpy(vec, v, (size_t)E * sizeof *vec);
+        es_free(ctx, v);
+        return ES_OK;
+    }
+    }
+    ES_FAIL(ctx, ES_EINVAL, "unknown leaf kind %d", (int)kind);
+}
+
+es_status es_study_point(es_ctx *ctx, es_store *store, const char *name, const char *expr,
+                            const char *pca_name, double scale, const char *command, double **vec,
+                            es_point_info *info)
+{
+    es_point_expr *x = NULL;
+    es_mesh *mesh = NULL;
+    es_point_info in;
+    es_study_resolver r = {store, NULL, pca_name, NULL, NULL};
+    if (vec) *vec = NULL;
+    CHECK_NAME(ctx, name);
+    NEED_EDGES(ctx, store);
+    const int64_t E = es_store_nedges(store);
+    double *v = es__alloc_array(ctx, E, sizeof *v);
+    if (!v) return ES_ENOMEM;
+    es_status rc;
+    if ((rc = es_point_parse(ctx, expr, &x)) != ES_OK ||
+        (es_store_nfaces(store) > 0 && (rc = es_store_mesh(ctx, store, &mesh)) != ES_OK))
+        goto done;
+    /* A truss store has no faces: the point is not checked (in.checked = 0,
+     * recorded as valid = "unchecked"). A store without edges fails in
+     * es_point_eval's reads with the store's message. */
+    r.mesh = mesh;
+    if ((rc = es_point_eval(ctx, x, E, es_study_resolve, &r, mesh, v, &in)) != ES_OK) goto done;
+    if (scale > 0) in.scale = scale;
+    if (name) {
+        char p[PATH_MAX_LEN], buf[64];
+        es_provenance prov = {command ? command : "es_study_point", NULL, -1, expr};
+        if ((rc = es_store_result_begin(ctx, store, "point", name, &prov)) != ES_OK ||
+            (rc = dpath(ctx, p, "point", name, "lengths")) != ES_OK ||
+            (rc = es_store_put_vector(ctx, store, p, v, E)) != ES_OK ||
+            (rc = dpath(ctx, p, "point", name, "scale")) != ES_OK ||
+            (rc = es_store_put_vector(ctx, store, p, &in.scale, 1)) != ES_OK)
+            goto done;
+        snprintf(p, sizeof p, "point/%s", name);
+        struct { const char *k; char v[64]; } at[6];
+        snprintf(at[0].v, 64, "%.17g", in.weight);
+        if (in.checked) snprintf(at[1].v, 64, "%d", in.validity.valid);
+        else snprintf(at[1].v, 64, "unchecked (no faces)");
+        snprintf(at[2].v, 64, "%lld", (long long)in.validity.n_bad_faces);
+        snprintf(at[3].v, 64, "%lld", (long long)in.validity.n_nonpositive);
+        snprintf(at[4].v, 64, "%.17g", in.validity.worst_violation);
+        snprintf(at[5].v, 64, "%lld", (long long)in.validity.worst_face);
+        at[0].k = "weight", at[1].k = "valid", at[2].k = "n_bad_faces";
+        at[3].k = "n_nonpositive", at[4].k = "worst_violation", at[5].k = "worst_face";
+        (void)buf;
+        if ((rc = es_store_put_attr(ctx, store, p, "expression", expr)) != ES_OK) goto done;
+        for (int i = 0; i < 6; i++)
+            if ((rc = es_store_put_attr(ctx, store, p, at[i].k, at[i].v)) != ES_OK) goto done;
+    }
+    if (info) *info = in;
+    if (vec) {
+        *vec = v;
+        v = NULL;
+    }
+done:
+    es_study_resolver_clear(ctx, &r);
+    es_point_expr_free(x);
+    es_mesh_free(mesh);
+    es__free(ctx, v);
+    return rc;
+}

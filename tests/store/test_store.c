@@ -1,0 +1,463 @@
+/* tests/store/test_store.c — the HDF5 store on small in-memory data: create,
+ * append, reopen, read blocks and row lists, labels and filters, analysis
+ * results with provenance, all-or-nothing writes (abort, failed append,
+ * concurrent writers, stale working copies), bad files, and an
+ * allocation-failure sweep over open. */
+#include "edgespace/es_ingest.h"
+#include "core/core_private.h"
+#include "es_test.h"
+#include "es_test_alloc.h"
+#include "es_test_files.h"
+#define ES_MODULE_STORE   /* the module's own test: its package header too */
+#include "store/store_pkg.h"
+
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+
+/* A tetrahedron: 4 vertices, 4 faces, 6 edges sorted (min, max). */
+static const int64_t faces[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+static const int64_t edges[12] = {0, 1, 0, 2, 0, 3, 1, 2, 1, 3, 2, 3};
+enum { V = 4, F = 4, E = 6 };
+
+/* Row i: tetrahedron scaled/stretched by i; lengths normalized. */
+static void make_row(int i, double *xyz, double *len, double *scale)
+{
+    const double base[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    double sum = 0;
+    for (int k = 0; k < 12; k++) xyz[k] = base[k] * (1.0 + 0.1 * i + (k % 3 == 0 ? 0.05 * i : 0));
+    for (int e = 0; e < E; e++) {
+        const double *a = xyz + 3 * edges[2 * e], *b = xyz + 3 * edges[2 * e + 1];
+        len[e] = sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                      (a[2] - b[2]) * (a[2] - b[2]));
+        sum += len[e];
+    }
+    for (int e = 0; e < E; e++) len[e] /= sum;
+    *scale = sum;
+}
+
+typedef struct batch {
+    int n;
+    char idbuf[8][16], srcbuf[8][32], *ids[8], *srcs[8];
+    double xyz[8 * 12], len[8 * E], scale[8];
+} batch;
+
+static void make_batch(batch *b, int first, int n, const char *prefix)
+{
+    b->n = n;
+    for (int j = 0; j < n; j++) {
+        snprintf(b->idbuf[j], sizeof b->idbuf[j], "%s%02d", prefix, first + j);
+        snprintf(b->srcbuf[j], sizeof b->srcbuf[j], "meshes/%s%02d.obj", prefix, first + j);
+        b->ids[j] = b->idbuf[j];
+        b->srcs[j] = b->srcbuf[j];
+        make_row(first + j, b->xyz + 12 * j, b->len + E * j, &b->scale[j]);
+    }
+}
+
+static es_store_rows rows_of(const batch *b, int64_t ncols, const char *const *cols,
+                             const char *const *labels)
+{
+    es_store_rows r = {b->n, (const char *const *)b->ids, (const char *const *)b->srcs, NULL,
+                       b->len, b->scale, b->xyz, ncols, cols, labels};
+    return r;
+}
+
+
+/* Filters on label values holding ',' (a CSV manifest may quote them):
+ * col="a,b" selects exactly the rows labelled a,b; unquoted, the ',' still
+ * separates terms. */
+static void test_select_quoted(es_ctx *ctx, const char *dir)
+{
+    char path[4200];
+    es_store *s = NULL;
+    batch b;
+    snprintf(path, sizeof path, "%s/quoted.h5", dir);
+    ES_CHECK_OK(ctx, es__store_create_raw(ctx, path, V, F, faces, E, edges, "", &s));
+    if (!s) return;
+    const char *cols[2] = {"grp", "subject"};
+    const char *labels[8] = {"a,b", "s1", "a", "s1", "a,b", "s2", "b", "s2"};
+    make_batch(&b, 0, 4, "q");
+    es_store_rows r = rows_of(&b, 2, cols, labels);
+    ES_CHECK_OK(ctx, es_store_append(ctx, s, &r));
+    static const struct { const char *filter; int64_t n, rows[2]; } ok[] = {
+        {"grp=\"a,b\"", 2, {0, 2}},
+        {"grp=\"a,b\",subject=s2", 1, {2}},
+        {"subject=s1,grp=\"a,b\"", 1, {0}},
+        {"grp=a", 1, {1}},
+        {"grp=\"a\"", 1, {1}},
+        {"grp=\"a,b\",", 2, {0, 2}},
+        {"grp=\"a,\"", 0, {0}},
+    };
+    for (size_t i = 0; i < sizeof ok / sizeof ok[0]; i++) {
+        int64_t *sel = NULL, ns = -1;
+        ES_CHECK_OK(ctx, es_store_select(ctx, s, ok[i].filter, &sel, &ns));
+        ES_CHECK_MSG(ns == ok[i].n, "%s: %lld rows", ok[i].filter, (long long)ns);
+        for (int64_t k = 0; k < ns && k < ok[i].n; k++)
+            ES_CHECK_MSG(sel[k] == ok[i].rows[k], "%s: row %lld is %lld", ok[i].filter,
+                         (long long)k, (long long)sel[k]);
+        es_free(ctx, sel);
+    }
+    static const struct { const char *filter, *msg; } bad[] = {
+        {"grp=a,b", "bad filter term 'b'"},
+        {"grp=\"a,b", "bad quoted value in filter 'grp=\"a,b'"},
+        {"grp=\"a,b\"c", "bad quoted value"},
+        {"=\"a,b\"", "bad filter term"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        int64_t *sel = NULL, ns = -1;
+        ES_CHECK_FAILS(ctx, es_store_select(ctx, s, bad[i].filter, &sel, &ns), ES_EFORMAT,
+                       bad[i].msg);
+        ES_CHECK(sel == NULL && ns == 0);
+    }
+    es_store_abort(s);
+}
+
+/* Two writers on one store: the one whose rows in memory are older than
+ * the file (another writer committed since it opened) is refused at its
+ * first write, and the other's commit survives intact. */
+static void test_stale_writer(es_ctx *ctx, const char *path)
+{
+    es_store *a = NULL, *b = NULL;
+    es_provenance prov = {"test", NULL, -1, NULL};
+    double v[2] = {1, 2};
+    ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_WRITE, &a));
+    ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_WRITE, &b));
+    if (!a || !b) goto done;
+    ES_CHECK_OK(ctx, es_store_result_begin(ctx, b, "mean", "by_b", &prov));
+    ES_CHECK_OK(ctx, es_store_put_vector(ctx, b, "mean/by_b/v", v, 2));
+    ES_CHECK_OK(ctx, es_store_commit(ctx, b));
+    ES_CHECK_FAILS(ctx, es_store_result_begin(ctx, a, "mean", "by_a", &prov), ES_EIO,
+                   "changed by another writer");
+    es_store_abort(a);
+    a = NULL;
+    es_store_close(b);
+    b = NULL;
+    ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_READ, &b));
+    if (b) {
+        ES_CHECK(es_store_has(b, "mean/by_b/v") && !es_store_has(b, "mean/by_a"));
+        /* a handle that committed may write again: its own commit is not
+         * another writer's */
+        es_store_close(b);
+        b = NULL;
+        ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_WRITE, &b));
+        ES_CHECK_OK(ctx, es_store_result_begin(ctx, b, "mean", "again1", &prov));
+        ES_CHECK_OK(ctx, es_store_commit(ctx, b));
+        ES_CHECK_OK(ctx, es_store_result_begin(ctx, b, "mean", "again2", &prov));
+        ES_CHECK_OK(ctx, es_store_commit(ctx, b));
+    }
+done:
+    if (a) es_store_abort(a);
+    if (b) es_store_close(b);
+}
+
+/* An export that fails part way (past a file-size limit) leaves the CSV
+ * that was there before as it was, and no part file beside it. */
+static void test_export_keeps_old_file(es_ctx *ctx, const char *path, const char *dir)
+{
+    char csv[4400];
+    es_store *s = NULL;
+    struct rlimit lim, small;
+    snprintf(csv, sizeof csv, "%s/old.csv", dir);
+    es_test_write_file(csv, "old content\n");
+    ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_READ, &s));
+    if (s && getrlimit(RLIMIT_FSIZE, &lim) == 0) {
+        void (*old)(int) = signal(SIGXFSZ, SIG_IGN);
+        size_t n = 0;
+        char *text;
+        small = lim;
+        small.rlim_cur = 16;
+        ES_CHECK(setrlimit(RLIMIT_FSIZE, &small) == 0);
+        ES_CHECK_FAILS(ctx, es_export_lengths_csv(ctx, s, NULL, -1, 0, csv), ES_EIO, "old.csv");
+        ES_CHECK(setrlimit(RLIMIT_FSIZE, &lim) == 0);
+        signal(SIGXFSZ, old);
+        text = es_test_slurp(csv, &n);
+        ES_CHECK_MSG(text && !strcmp(text, "old content\n"), "the old CSV became '%.40s'",
+                     text ? text : "(gone)");
+        free(text);
+        ES_CHECK(es_test_count_entries(dir, ".part") == 0);
+    }
+    es_store_close(s);
+    remove(csv);
+}
+
+int main(void)
+{
+    es_ctx *ctx = NULL;
+    es_store *s = NULL, *s2 = NULL;
+    char path[4200], other[4200], stale[4400];
+    const char *dir;
+    batch b1, b2;
+    size_t n0;
+    char *before;
+    ES_TEST_BEGIN();
+    ES_CHECK(es_ctx_new(&ctx) == ES_OK);
+    dir = es_test_tmpdir("store");
+    snprintf(path, sizeof path, "%s/t.h5", dir);
+
+    /* ---- create: nothing visible until commit ---- */
+    ES_CHECK_OK(ctx, es__store_create_raw(ctx, path, V, F, faces, E, edges, "0123456789abcdef", &s));
+    ES_CHECK(access(path, F_OK) != 0);
+    ES_CHECK(es_store_nrows(s) == 0 && es_store_nedges(s) == E && es_store_nverts(s) == V);
+    const char *cols[2] = {"subject", "expression"};
+    const char *labels1[6] = {"s1", "neutral", "s1", "happy", "s2", "neutral"};
+    make_batch(&b1, 0, 3, "r");
+    es_store_rows r1 = rows_of(&b1, 2, cols, labels1);
+    ES_CHECK_OK(ctx, es_store_append(ctx, s, &r1));
+    ES_CHECK(es_store_nrows(s) == 3);
+    ES_CHECK(access(path, F_OK) != 0);
+    ES_CHECK_OK(ctx, es_store_commit(ctx, s));
+    ES_CHECK(access(path, F_OK) == 0);
+    ES_CHECK(es_test_count_entries(dir, ".tmp-") == 0);
+    es_store_close(s);
+    s = NULL;
+    ES_CHECK_FAILS(ctx, es__store_create_raw(ctx, path, V, F, faces, E, edges, "", &s),
+                   ES_EEXIST, "exists");
+
+    /* ---- reopen and read back ---- */
+    ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_READ, &s));
+    if (!s) return 1;
+    ES_CHECK(es_store_nrows(s) == 3 && es_store_nfaces(s) == F && es_store_nedges(s) == E);
+    ES_CHECK(!strcmp(es_store_fingerprint(s), "0123456789abcdef"));
+    ES_CHECK(!strcmp(es_store_row_id(s, 1), "r01"));
+    ES_CHECK(!strcmp(es_store_source_path(s, 2), "meshes/r02.obj"));
+    ES_CHECK(!strcmp(es_store_content_hash(s, 2), ""));
+    ES_CHECK(es_store_find_row(s, "r02") == 2 && es_store_find_row(s, "zz") == -1);
+    ES_CHECK(es_store_ncolumns(s) == 2 && es_store_find_column(s, "expression") == 1);
+    ES_CHECK(!strcmp(es_store_label(s, 1, 1), "happy"));
+    ES_CHECK(es_store_label(s, 3, 0) == NULL && es_store_row_id(s, -1) == NULL);
+    {
+        int64_t f[12], ed[12];
+        ES_CHECK_OK(ctx, es_store_read_faces(ctx, s, f));
+        ES_CHECK_OK(ctx, es_store_read_edges(ctx, s, ed));
+        ES_CHECK(!memcmp(f, faces, sizeof f) && !memcmp(ed, edges, sizeof ed));
+    }
+    {
+        /* a block of rows into a matrix with padding (ld > E) */
+        double buf[3 * 9], sc[3], xyz[12];
+        es_mat m = {buf, E, 2, 9};
+        for (int k = 0; k < 27; k++) buf[k] = -1;
+        ES_CHECK_OK(ctx, es_store_read_lengths(ctx, s, 1, 2, m));
+        for (int j = 0; j < 2; j++)
+            for (int e = 0; e < E; e++) ES_CHECK(ES_AT(m, e, j) == b1.len[E * (1 + j) + e]);
+        ES_CHECK(buf[6] == -1 && buf[7] == -1 && buf[8] == -1);
+        int64_t rows[3] = {2, 0, 1};
+        es_mat m3 = {buf, E, 3, 9};
+        ES_CHECK_OK(ctx, es_store_read_lengths_rows(ctx, s, rows, 3, m3));
+        for (int j = 0; j < 3; j++)
+            for (int e = 0; e < E; e++) ES_CHECK(ES_AT(m3, e, j) == b1.len[E * rows[j] + e]);
+        ES_CHECK_FAILS(ctx, es_store_read_lengths(ctx, s, 2, 2, m), ES_ERANGE, "out of range");
+        es_mat bad = {buf, E - 1, 2, 9};
+        ES_CHECK_FAILS(ctx, es_store_read_lengths(ctx, s, 0, 2, bad), ES_EINVAL, "need");
+        ES_CHECK_OK(ctx, es_store_read_scales(ctx, s, sc));
+        for (int j = 0; j < 3; j++) ES_CHECK(sc[j] == b1.scale[j]);
+        ES_CHECK_OK(ctx, es_store_read_positions(ctx, s, 2, xyz));
+        ES_CHECK(!memcmp(xyz, b1.xyz + 24, sizeof xyz));
+        ES_CHECK_FAILS(ctx, es_store_read_positions(ctx, s, 3, xyz), ES_ERANGE, "row 3");
+    }
+    {
+        int64_t *sel = NULL, ns = -1;
+        ES_CHECK_OK(ctx, es_store_select(ctx, s, "expression=neutral", &sel, &ns));
+        ES_CHECK(ns == 2 && sel[0] == 0 && sel[1] == 2);
+        es_free(ctx, sel);
+        ES_CHECK_OK(ctx, es_store_select(ctx, s, "subject=s1,expression=happy", &sel, &ns));
+        ES_CHECK(ns == 1 && sel[0] == 1);
+        es_free(ctx, sel);
+        ES_CHECK_OK(ctx, es_store_select(ctx, s, "", &sel, &ns));
+        ES_CHECK(ns == 3);
+        es_free(ctx, sel);
+        ES_CHECK_OK(ctx, es_store_select(ctx, s, "id=r02", &sel, &ns));
+        ES_CHECK(ns == 1 && sel[0] == 2);
+        es_free(ctx, sel);
+        ES_CHECK_FAILS(ctx, es_store_select(ctx, s, "age=3", &sel, &ns), ES_ENOTFOUND, "age");
+        ES_CHECK_FAILS(ctx, es_store_select(ctx, s, "age", &sel, &ns), ES_EFORMAT, "age");
+    }
+    test_select_quoted(ctx, dir);
+    /* a read-only handle refuses writes */
+    es_provenance prov = {"test", NULL, -1, "k=1"};
+    ES_CHECK_FAILS(ctx, es_store_result_begin(ctx, s, "pca", "all", &prov), ES_EINVAL,
+                   "read-only");
+    es_store_close(s);
+    s = NULL;
+
+    /* ---- failed and aborted writes leave the file byte-for-byte ---- */
+    before = es_test_slurp(path, &n0);
+    ES_CHECK(before != NULL);
+    ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_WRITE, &s));
+    make_batch(&b2, 3, 2, "r");
+    const char *cols2[1] = {"age"};
+    const char *labels2[2] = {"30", "41"};
+    es_store_rows r2 = rows_of(&b2, 1, cols2, labels2);
+    es_store_rows dup = rows_of(&b1, 2, cols, labels1);
+    ES_CHECK_FAILS(ctx, es_store_append(ctx, s, &dup), ES_EEXIST, "r00");
+    b2.len[3] = NAN;
+    ES_CHECK_FAILS(ctx, es_store_append(ctx, s, &r2), ES_EINVAL, "non-finite");
+    make_batch(&b2, 3, 2, "r");
+    ES_CHECK_OK(ctx, es_store_append(ctx, s, &r2));
+    ES_CHECK(es_store_nrows(s) == 5);
+    ES_CHECK(es_test_count_entries(dir, ".tmp-") == 1);
+    es_store_abort(s);
+    s = NULL;
+    ES_CHECK(es_test_same_bytes(path, before, n0));
+    ES_CHECK(es_test_count_entries(dir, ".tmp-") == 0);
+
+    /* ---- append with a new column, commit by close ---- */
+    ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_WRITE, &s));
+    ES_CHECK_OK(ctx, es_store_append(ctx, s, &r2));
+    es_store_close(s);
+    s = NULL;
+    ES_CHECK(!es_test_same_bytes(path, before, n0));
+    ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_READ, &s));
+    if (!s) return 1;
+    ES_CHECK(es_store_nrows(s) == 5 && es_store_ncolumns(s) == 3);
+    ES_CHECK(!strcmp(es_store_column_name(s, 2), "age"));
+    ES_CHECK(!strcmp(es_store_label(s, 0, 2), "") && !strcmp(es_store_label(s, 4, 2), "41"));
+    ES_CHECK(!strcmp(es_store_label(s, 4, 0), "") && !strcmp(es_store_label(s, 1, 0), "s1"));
+    {
+        double buf[5 * E];
+        es_mat m = {buf, E, 5, E};
+        ES_CHECK_OK(ctx, es_store_read_lengths(ctx, s, 0, 5, m));
+        for (int e = 0; e < E; e++) ES_CHECK(buf[4 * E + e] == b2.len[E + e]);
+    }
+    es_store_close(s);
+    s = NULL;
+    free(before);
+
+    /* ---- analysis results: write, read back, replace, provenance ---- */
+    ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_WRITE, &s));
+    {
+        double a[6] = {1, 2, 3, 4, 5, 6}, pad[8] = {1, 2, 3, -9, 4, 5, 6, -9};
+        int64_t iv[3] = {7, 8, 9}, used[2] = {0, 3};
+        const char *sv[2] = {"x", "yé"};
+        es_mat m = {pad, 3, 2, 4};
+        es_provenance p2 = {"edgespace pca --k 2", used, 2, "k=2"};
+        ES_CHECK_FAILS(ctx, es_store_put_vector(ctx, s, "pca/all/mean", a, 6), ES_ENOTFOUND,
+                       "not begun");
+        ES_CHECK_OK(ctx, es_store_result_begin(ctx, s, "pca", "all", &p2));
+        ES_CHECK_OK(ctx, es_store_put_matrix(ctx, s, "pca/all/basis", m));
+        ES_CHECK_OK(ctx, es_store_put_vector(ctx, s, "pca/all/mean", a, 6));
+        ES_CHECK_OK(ctx, es_store_put_ints(ctx, s, "pca/all/idx", iv, 3));
+        ES_CHECK_OK(ctx, es_store_put_strings(ctx, s, "pca/all/names", sv, 2));
+        ES_CHECK_OK(ctx, es_store_put_attr(ctx, s, "pca/all", "note", "hello"));
+        ES_CHECK_OK(ctx, es_store_put_vector(ctx, s, "pca/all/mean", a, 3)); /* replace */
+        ES_CHECK_OK(ctx, es_store_result_begin(ctx, s, "mean", "g1", &prov));
+        ES_CHECK_FAILS(ctx, es_store_result_begin(ctx, s, "pca", "a/b", &prov), ES_EINVAL,
+                       "bad result");
+        ES_CHECK_FAILS(ctx, es_store_put_vector(ctx, s, "pca/../x", a, 1), ES_EINVAL, "bad");
+    }
+    ES_CHECK_OK(ctx, es_store_commit(ctx, s));
+    es_store_close(s);
+    s = NULL;
+    ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_READ, &s));
+    if (!s) return 1;
+    {
+        es_mat m = {0};
+        double *v = NULL;
+        int64_t *iv = NULL, n = 0;
+        char buf[64], **names = NULL;
+        ES_CHECK_OK(ctx, es_store_get_matrix(ctx, s, "pca/all/basis", &m));
+        ES_CHECK(m.rows == 3 && m.cols == 2 && ES_AT(m, 2, 1) == 6 && ES_AT(m, 0, 1) == 4);
+        es_free(ctx, m.data);
+        ES_CHECK_OK(ctx, es_store_get_vector(ctx, s, "pca/all/mean", &v, &n));
+        ES_CHECK(n == 3 && v[2] == 3);
+        es_free(ctx, v);
+        ES_CHECK_OK(ctx, es_store_get_ints(ctx, s, "pca/all/idx", &iv, &n));
+        ES_CHECK(n == 3 && iv[1] == 8);
+        es_free(ctx, iv);
+        ES_CHECK_OK(ctx, es_store_get_ints(ctx, s, "pca/all/input_rows", &iv, &n));
+        ES_CHECK(n == 2 && iv[0] == 0 && iv[1] == 3);
+        es_free(ctx, iv);
+        ES_CHECK_OK(ctx, es_store_get_ints(ctx, s, "mean/g1/input_rows", &iv, &n));
+        ES_CHECK(n == 5 && iv[4] == 4);
+        es_free(ctx, iv);
+        ES_CHECK_OK(ctx, es_store_get_attr(ctx, s, "pca/all", "command", buf, sizeof buf));
+        ES_CHECK(!strcmp(buf, "edgespace pca --k 2"));
+        ES_CHECK_OK(ctx, es_store_get_attr(ctx, s, "pca/all", "note", buf, sizeof buf));
+        ES_CHECK(!strcmp(buf, "hello"));
+        ES_CHECK_OK(ctx, es_store_get_attr(ctx, s, "pca/all", "tool_version", buf, sizeof buf));
+        ES_CHECK(!strncmp(buf, "edgespace ", 10));
+        ES_CHECK_OK(ctx, es_store_get_attr(ctx, s, "pca/all", "time", buf, sizeof buf));
+        ES_CHECK(strlen(buf) == 20 && buf[19] == 'Z');
+        ES_CHECK_OK(ctx, es_store_get_attr(ctx, s, "pca/all", "store_nrows", buf, sizeof buf));
+        ES_CHECK(!strcmp(buf, "5"));
+        ES_CHECK_FAILS(ctx, es_store_get_attr(ctx, s, "pca/all", "nope", buf, sizeof buf),
+                       ES_ENOTFOUND, "nope");
+        ES_CHECK(es_store_has(s, "pca/all") && es_store_has(s, "pca/all/names"));
+        ES_CHECK(!es_store_has(s, "pca/none") && !es_store_has(s, "gpa"));
+        ES_CHECK_OK(ctx, es_store_list_results(ctx, s, "pca", &names, &n));
+        ES_CHECK(n == 1 && !strcmp(names[0], "all"));
+        for (int64_t i = 0; i < n; i++) es_free(ctx, names[i]);
+        es_free(ctx, names);
+        ES_CHECK_OK(ctx, es_store_list_results(ctx, s, "gpa", &names, &n));
+        ES_CHECK(n == 0);
+        ES_CHECK_FAILS(ctx, es_store_get_vector(ctx, s, "pca/all/zzz", &v, &n), ES_ENOTFOUND,
+                       "zzz");
+    }
+    es_store_close(s);
+    s = NULL;
+
+    /* ---- two writers: the second commit is refused, the first kept ---- */
+    ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_WRITE, &s));
+    ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_WRITE, &s2));
+    ES_CHECK_OK(ctx, es_store_result_begin(ctx, s, "mean", "w1", &prov));
+    ES_CHECK_OK(ctx, es_store_result_begin(ctx, s2, "mean", "w2", &prov));
+    ES_CHECK_OK(ctx, es_store_commit(ctx, s));
+    ES_CHECK_FAILS(ctx, es_store_commit(ctx, s2), ES_EIO, "another writer");
+    es_store_abort(s2);
+    es_store_close(s);
+    s = s2 = NULL;
+    ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_READ, &s));
+    ES_CHECK(s && es_store_has(s, "mean/w1") && !es_store_has(s, "mean/w2"));
+    es_store_close(s);
+    s = NULL;
+    ES_CHECK(es_test_count_entries(dir, ".tmp-") == 0);
+
+    /* ---- a stale working copy of a dead process is removed ---- */
+    {
+        pid_t pid = fork();
+        if (pid == 0) _exit(0);
+        waitpid(pid, NULL, 0);
+        snprintf(stale, sizeof stale, "%s/.t.h5.tmp-%ld-0", dir, (long)pid);
+        es_test_write_file(stale, "junk");
+        ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_WRITE, &s));
+        ES_CHECK_OK(ctx, es_store_result_begin(ctx, s, "mean", "w3", &prov));
+        ES_CHECK(access(stale, F_OK) != 0);
+        es_store_close(s);
+        s = NULL;
+    }
+
+    /* ---- bad files ---- */
+    snprintf(other, sizeof other, "%s/missing.h5", dir);
+    ES_CHECK_FAILS(ctx, es_store_open(ctx, other, ES_STORE_READ, &s), ES_ENOTFOUND, "missing.h5");
+    snprintf(other, sizeof other, "%s/text.h5", dir);
+    es_test_write_file(other, "not hdf5\n");
+    ES_CHECK_FAILS(ctx, es_store_open(ctx, other, ES_STORE_READ, &s), ES_EFORMAT,
+                   "not an HDF5 file");
+    ES_CHECK(s == NULL);
+
+    /* ---- allocation failures in open: ES_ENOMEM, then success ---- */
+    {
+        failing_alloc fa = {0, 0, 0};
+        es_allocator a = {fa_malloc, fa_realloc, fa_free, &fa};
+        es_status rc;
+        int64_t k = 1;
+        for (;; k++) {
+            fa.count = 0;
+            fa.fail_at = k;
+            es_ctx_set_allocator(ctx, &a);
+            rc = es_store_open(ctx, path, ES_STORE_READ, &s);
+            es_ctx_set_allocator(ctx, NULL);
+            if (rc == ES_OK) break;
+            ES_CHECK_MSG(rc == ES_ENOMEM, "k=%lld rc=%d %s", (long long)k, (int)rc,
+                         es_ctx_errmsg(ctx));
+            ES_CHECK(s == NULL);
+            if (k > 10000) break;
+        }
+        ES_CHECK(rc == ES_OK && k > 5);
+        es_store_close(s);
+        s = NULL;
+    }
+    test_stale_writer(ctx, path);
+    test_export_keeps_old_file(ctx, path, dir);
+    es_ctx_free(ctx);
+    ES_TEST_END();
+}

@@ -1,0 +1,114 @@
+/* tools/cmd/gpa.c — edgespace gpa: generalized Procrustes analysis of a
+ * store's vertex positions (es_study_gpa), results in the store. */
+#include "cli.h"
+#include "commands.h"
+
+#include <getopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char usage[] =
+    "usage: edgespace gpa STORE --name NAME [options]\n"
+    "\n"
+    "Generalized Procrustes analysis of the vertex positions (or landmarks) of the\n"
+    "rows of STORE, with the PCA of the tangent coordinates; conventions of R's\n"
+    "shapes::procGPA. Results go to /analysis/gpa/NAME in the store (aligned\n"
+    "configurations, mean, centroid sizes, rho, rotations, scales, PCs) with the\n"
+    "options and convergence. Planar data (z = 0) are analysed in 2D.\n"
+    "\n"
+    "  -n, --name NAME         result name (required)\n"
+    "      --no-scale          partial GPA: rotation and translation only\n"
+    "      --allow-reflection  allow reflections in the rotations\n"
+    "  -w, --where FILTER      rows whose labels match col=value[,col=value...]\n"
+    "                          (quote a value holding ',': col=\"a,b\")\n"
+    "      --tol T             convergence tolerance (default 1e-10)\n"
+    "      --max-iter N        iteration limit (default 1000)\n"
+    "      --pcs N             principal components stored (default min(10, n-1))\n"
+    "  -q, --quiet             print nothing on success\n"
+    "  -h, --help              show this help\n"
+    "\n"
+    "Exit status: 0 ok, 1 failure, 2 usage error.\n";
+
+int cmd_gpa(int argc, char **argv)
+{
+    enum { O_NOSCALE = 256, O_REFLECT, O_TOL, O_MAXIT, O_PCS };
+    static const struct option longopts[] = {
+        {"name", required_argument, NULL, 'n'},   {"no-scale", no_argument, NULL, O_NOSCALE},
+        {"allow-reflection", no_argument, NULL, O_REFLECT},
+        {"where", required_argument, NULL, 'w'},  {"tol", required_argument, NULL, O_TOL},
+        {"max-iter", required_argument, NULL, O_MAXIT},
+        {"pcs", required_argument, NULL, O_PCS},  {"quiet", no_argument, NULL, 'q'},
+        {"help", no_argument, NULL, 'h'},         {NULL, 0, NULL, 0}};
+    const char *name = NULL, *where = NULL;
+    es_gpa_opts o;
+    int64_t npc = 0;
+    int c, quiet = 0;
+    es_gpa_opts_init(&o);
+    optind = 1;
+    while ((c = getopt_long(argc, argv, "n:w:qh", longopts, NULL)) != -1) {
+        switch (c) {
+        case 'n': name = optarg; break;
+        case 'w': where = optarg; break;
+        case O_NOSCALE: o.scale = 0; break;
+        case O_REFLECT: o.allow_reflection = 1; break;
+        case O_TOL:
+            if (cli_parse_double(optarg, &o.tol) || !(o.tol >= 0))
+                return cli_usage_error("gpa", "bad --tol '%s'", optarg);
+            break;
+        case O_MAXIT:
+            if (cli_parse_i64(optarg, &o.max_iter) || o.max_iter < 1)
+                return cli_usage_error("gpa", "bad --max-iter '%s'", optarg);
+            break;
+        case O_PCS:
+            if (cli_parse_i64(optarg, &npc) || npc < 1)
+                return cli_usage_error("gpa", "bad --pcs '%s'", optarg);
+            break;
+        case 'q': quiet = 1; break;
+        case 'h': fputs(usage, stdout); return CLI_OK;
+        default: return cli_usage_error("gpa", "bad option");
+        }
+    }
+    if (optind != argc - 1) return cli_usage_error("gpa", "give exactly one STORE");
+    if (!name || !*name) return cli_usage_error("gpa", "missing --name");
+    es_ctx *ctx = cli_ctx_new("gpa");
+    if (!ctx) return CLI_FAIL;
+    es_store *s = NULL;
+    int64_t *rows = NULL, nrows = -1;
+    es_gpa_report rep;
+    char *cmd = cli_command_line(argc, argv);
+    es_status rc = es_store_open(ctx, argv[optind], ES_STORE_WRITE, &s);
+    if (rc == ES_OK && where && *where) rc = es_store_select(ctx, s, where, &rows, &nrows);
+    if (rc == ES_OK) rc = es_study_gpa(ctx, s, name, rows, nrows, &o, npc, cmd, &rep);
+    if (rc == ES_OK) rc = es_store_commit(ctx, s);
+    if (rc != ES_OK) {
+        cli_fail("gpa", ctx, rc);
+        es_store_abort(s);
+    } else {
+        if (!quiet) {
+            char buf[64] = "";
+            char path[512];
+            snprintf(path, sizeof path, "gpa/%s", name);
+            es_store_get_attr(ctx, s, path, "dim", buf, sizeof buf);
+            printf("gpa '%s': %lld rows, %sD, %s GPA%s: %lld iterations (%s), rmsrho %.6g, "
+                   "GSS %.6g\n", name, (long long)(nrows < 0 ? es_store_nrows(s) : nrows), buf,
+                   o.scale ? "full" : "partial", o.allow_reflection ? " with reflection" : "",
+                   (long long)rep.iterations, rep.converged ? "converged" : "NOT converged",
+                   rep.rmsrho, rep.gss);
+            double *pct = NULL;
+            int64_t np = 0;
+            snprintf(path, sizeof path, "gpa/%s/pc_percent", name);
+            if (es_store_get_vector(ctx, s, path, &pct, &np) == ES_OK) {
+                printf("PC variance (%%):");
+                for (int64_t i = 0; i < np; i++) printf(" %.2f", pct[i]);
+                printf("\n");
+                es_free(ctx, pct);
+            }
+        }
+        es_store_close(s);
+    }
+    es_free(ctx, rows);
+    free(cmd);
+    es_ctx_free(ctx);
+    return rc == ES_OK ? CLI_OK : CLI_FAIL;
+}

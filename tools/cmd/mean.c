@@ -1,0 +1,94 @@
+/* tools/cmd/mean.c — edgespace mean: means of the normalized edge lengths
+ * of all rows, of the rows matching a filter, or per value of a label
+ * column; stored as /analysis/mean/NAME and exported as CSV. */
+#include "cli.h"
+#include "commands.h"
+#include "stats_cli.h"
+
+#include <getopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char usage[] =
+    "usage: edgespace mean STORE [--by COLUMN] [--where FILTER] [--name NAME] [--csv PATH]\n"
+    "                            [--no-store]\n"
+    "\n"
+    "Mean scale-normalized edge lengths of the rows of STORE: of all rows, of\n"
+    "the rows matching FILTER (\"col=value[,col=value...]\", all must hold; a\n"
+    "value holding ',' is quoted: col=\"a,b\"), or one mean per value of label\n"
+    "COLUMN. The means, row counts and mean scales are stored as\n"
+    "/analysis/mean/NAME (default NAME: COLUMN, FILTER, COLUMN[FILTER], or\n"
+    "\"all\").\n"
+    "\n"
+    "  -b, --by COLUMN    one mean per value of this label column\n"
+    "  -w, --where FILTER only rows matching FILTER\n"
+    "  -n, --name NAME    result name in the store\n"
+    "      --no-store     compute and export only; leave the store unchanged\n"
+    "  -o, --csv PATH     write edge,v0,v1,<group>... (one column per group; - for stdout)\n"
+    "  -h, --help         show this help\n"
+    "\n"
+    "Exit status: 0 ok, 1 failure, 2 usage error.\n";
+
+int cmd_mean(int argc, char **argv)
+{
+    static const struct option lo[] = {
+        {"by", required_argument, NULL, 'b'}, {"where", required_argument, NULL, 'w'},
+        {"name", required_argument, NULL, 'n'}, {"csv", required_argument, NULL, 'o'},
+        {"no-store", no_argument, NULL, 'N'}, {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0}};
+    const char *by = NULL, *where = NULL, *name = NULL, *csv = NULL;
+    int c, nostore = 0;
+    optind = 1;
+    while ((c = getopt_long(argc, argv, "b:w:n:o:h", lo, NULL)) != -1) {
+        switch (c) {
+        case 'b': by = optarg; break;
+        case 'w': where = optarg; break;
+        case 'n': name = optarg; break;
+        case 'o': csv = optarg; break;
+        case 'N': nostore = 1; break;
+        case 'h': fputs(usage, stdout); return CLI_OK;
+        default: return cli_usage_error("mean", "bad option");
+        }
+    }
+    if (optind != argc - 1) return cli_usage_error("mean", "give exactly one STORE");
+    char defname[512];
+    if (!name && !nostore) {
+        /* by, the filter, both as "by[filter]", or "all" */
+        if (by && where) snprintf(defname, sizeof defname, "%s[%s]", by, where);
+        else snprintf(defname, sizeof defname, "%s", by ? by : where ? where : "all");
+        name = defname;
+    }
+    if (nostore) name = NULL;
+    es_ctx *ctx = cli_ctx_new("mean");
+    if (!ctx) return CLI_FAIL;
+    char *cmdline = cli_command_line(argc, argv);
+    es_store *st = NULL;
+    es_group_result *r = NULL;
+    int ret = CLI_FAIL;
+    es_status rc = es_store_open(ctx, argv[optind], name ? ES_STORE_WRITE : ES_STORE_READ, &st);
+    if (rc == ES_OK) rc = es_study_mean(ctx, st, name, where, by, cmdline, &r);
+    if (rc != ES_OK) {
+        cli_fail("mean", ctx, rc);
+        goto done;
+    }
+    printf("%-20s %8s %14s\n", by ? by : "group", "rows", "mean scale");
+    for (int64_t g = 0; g < r->ngroups; g++)
+        printf("%-20s %8lld %14.6g\n", r->names[g], (long long)r->counts[g], r->scales[g]);
+    if ((rc = es_store_commit(ctx, st)) != ES_OK) {
+        cli_fail("mean", ctx, rc);
+        goto done;
+    }
+    if (name) printf("stored as /analysis/mean/%s\n", name);
+    ret = CLI_OK;
+    if (csv)
+        ret = stats_write_edge_csv("mean", ctx, st, csv, r->ngroups,
+                                   (const char *const *)r->names, r->means);
+done:
+    es_group_result_free(r);
+    if (ret == CLI_OK) es_store_close(st);
+    else es_store_abort(st);   /* leave the store as it was */
+    free(cmdline);
+    es_ctx_free(ctx);
+    return ret;
+}
