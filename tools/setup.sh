@@ -21,7 +21,7 @@ build_dir=${BUILD_DIR:-build}
 packages=(
   build-essential meson ninja-build pkg-config python3
   libopenblas-dev liblapacke-dev libsuitesparse-dev libhdf5-dev hdf5-tools libcsv-dev
-  liblbfgs-dev libcairo2-dev
+  libcairo2-dev libcjson-dev
   clang libclang-rt-14-dev   # libFuzzer targets for the parsers
 )
 

@@ -127,6 +127,11 @@ es_status es__mkdir_p(es_ctx *ctx, const char *dir)
     return ES_OK;
 }
 
+es_status es_make_dirs(es_ctx *ctx, const char *dir)
+{
+    return es__mkdir_p(ctx, dir);
+}
+
 const char *es__path_base(const char *path)
 {
     const char *s = strrchr(path, '/');

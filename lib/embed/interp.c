@@ -14,8 +14,8 @@ es_status es_interp_targets(es_ctx *ctx, const es_mesh *mesh, int64_t nin,
                             double *alpha, es_interp_info *info)
 {
     int64_t ne, nv, r = 0;
-    double wsum = 0, scale = 0, *lk = NULL, *ak = NULL, *ar = NULL, mean = 0;
-    es_interp_info inf = {0, 0, 0, 0};
+    double wsum = 0, scale = 0, *lk = NULL, *ak = NULL, *ar = NULL;
+    es_interp_info inf = {0, 0, 0};
     es_status rc = ES_OK;
     if (!mesh || !xyz || !w) ES_FAIL(ctx, ES_EINVAL, "interp: NULL argument");
     if (nin < 1) ES_FAIL(ctx, ES_EINVAL, "interp: need at least one input (got %lld)",
@@ -81,23 +81,19 @@ es_status es_interp_targets(es_ctx *ctx, const es_mesh *mesh, int64_t nin,
         rc = es__fail(ctx, ES_EINVAL, "interp: the weighted scale is %g (not positive)", scale);
         goto done;
     }
-    if (len) {
+    if (len)
         for (int64_t e = 0; e < ne; e++) {
             len[e] /= wsum;
-            mean += len[e];
-        }
-        mean /= (double)ne;
-        for (int64_t e = 0; e < ne; e++) {
-            if (!(len[e] > 1e-3 * mean)) {
-                len[e] = 1e-3 * mean;
-                inf.n_clamped++;
+            /* past the positive orthant (extrapolated too far) no mesh
+             * realizes the target: refuse rather than invent a length */
+            if (!(len[e] > 0)) {
+                rc = es__fail(ctx, ES_EINVAL, "interp: edge %lld has length %g at these "
+                              "weights: outside edge-length space (extrapolated too far)",
+                              (long long)e, len[e] * scale);
+                goto done;
             }
             len[e] *= scale;
         }
-        if (inf.n_clamped)
-            es__warn(ctx, "interp: %lld target lengths were <= 0 (extrapolation too far) and "
-                     "were clamped", (long long)inf.n_clamped);
-    }
     inf.scale = scale;
     if (info) *info = inf;
 done:

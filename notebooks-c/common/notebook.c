@@ -4,6 +4,8 @@
  * only library calls are es_ctx_* and es_version.
  */
 #include "notebook.h"
+
+#include <cjson/cJSON.h>
 #include "nb_version.h"
 
 #include <errno.h>
@@ -32,23 +34,6 @@ static int is_dir(const char *path)
     return stat(path, &st) == 0 && S_ISDIR(st.st_mode);
 }
 
-/* mkdir -p */
-static int make_dirs(const char *path)
-{
-    char buf[4096];
-    size_t n = strlen(path);
-    if (n == 0 || n >= sizeof buf) return -1;
-    memcpy(buf, path, n + 1);
-    for (size_t i = 1; i <= n; i++) {
-        if (buf[i] == '/' || buf[i] == '\0') {
-            char c = buf[i];
-            buf[i] = '\0';
-            if (mkdir(buf, 0777) != 0 && errno != EEXIST) return -1;
-            buf[i] = c;
-        }
-    }
-    return is_dir(path) ? 0 : -1;
-}
 
 static void log_to_stderr(void *userdata, es_log_level level, const char *msg)
 {
@@ -136,20 +121,18 @@ int nb_open(notebook *n, const char *name, const char *title, int argc, char **a
         set_datadir(n, NB_SHARED_DIR, "/data");
     }
 
-    if (make_dirs(n->outdir) != 0) {
-        fprintf(stderr, "%s: cannot create output directory '%s': %s\n", name, n->outdir,
-                strerror(errno));
+    if (es_ctx_new(&n->ctx) != ES_OK) {
+        fprintf(stderr, "%s: out of memory\n", name);
+        return 1;
+    }
+    if (es_make_dirs(n->ctx, n->outdir) != ES_OK) {
+        fprintf(stderr, "%s: cannot create output directory: %s\n", name, es_ctx_errmsg(n->ctx));
         return 1;
     }
     n->report = fopen(nb_path(n, "report.md"), "w");
     if (!n->report) {
         fprintf(stderr, "%s: cannot write '%s': %s\n", name, nb_path(n, "report.md"),
                 strerror(errno));
-        return 1;
-    }
-    if (es_ctx_new(&n->ctx) != ES_OK) {
-        fprintf(stderr, "%s: out of memory\n", name);
-        fclose(n->report);
         return 1;
     }
     es_ctx_set_seed(n->ctx, n->seed);
@@ -359,79 +342,67 @@ int nb_check(notebook *n, const char *name, double metric, const char *op, doubl
     return pass;
 }
 
-static void json_str(FILE *f, const char *s)
+/* A number, or null where JSON has none (NaN, infinities). */
+static cJSON *json_number(double v)
 {
-    fputc('"', f);
-    for (; *s; s++) {
-        unsigned char ch = (unsigned char)*s;
-        if (ch == '"' || ch == '\\') fprintf(f, "\\%c", ch);
-        else if (ch == '\n') fputs("\\n", f);
-        else if (ch < 0x20) fprintf(f, "\\u%04x", ch);
-        else fputc(ch, f);
+    return isfinite(v) ? cJSON_CreateNumber(v) : cJSON_CreateNull();
+}
+
+static cJSON *run_json(const notebook *n, double total)
+{
+    cJSON *root = cJSON_CreateObject(), *inputs, *steps, *checks, *outputs;
+    if (!root) return NULL;
+    cJSON_AddStringToObject(root, "notebook", n->name);
+    cJSON_AddStringToObject(root, "version", es_version());
+    cJSON_AddStringToObject(root, "git_describe", NB_GIT_DESCRIBE);
+    cJSON_AddNumberToObject(root, "seed", (double)n->seed);
+    cJSON_AddBoolToObject(root, "small", n->small);
+    cJSON_AddBoolToObject(root, "synthetic_requested", n->synthetic);
+    cJSON_AddStringToObject(root, "data_dir", n->datadir);
+    inputs = cJSON_AddObjectToObject(root, "inputs");
+    for (int i = 0; inputs && i < n->ninputs; i++)
+        cJSON_AddStringToObject(inputs, n->inputs[i][0], n->inputs[i][1]);
+    steps = cJSON_AddArrayToObject(root, "steps");
+    for (int i = 0; steps && i < n->nsteps; i++) {
+        cJSON *st = cJSON_CreateObject();
+        cJSON_AddStringToObject(st, "name", n->steps[i]);
+        cJSON_AddItemToObject(st, "seconds", json_number(n->step_seconds[i]));
+        cJSON_AddItemToArray(steps, st);
     }
-    fputc('"', f);
+    cJSON_AddItemToObject(root, "total_seconds", json_number(total));
+    checks = cJSON_AddArrayToObject(root, "checks");
+    for (int i = 0; checks && i < n->nchecks; i++) {
+        const nb_checkrec *c = &n->checks[i];
+        cJSON *ck = cJSON_CreateObject();
+        cJSON_AddStringToObject(ck, "name", c->name);
+        cJSON_AddItemToObject(ck, "metric", json_number(c->metric));
+        cJSON_AddStringToObject(ck, "op", c->op);
+        cJSON_AddItemToObject(ck, "bound", json_number(c->bound));
+        cJSON_AddBoolToObject(ck, "pass", c->pass);
+        cJSON_AddItemToArray(checks, ck);
+    }
+    outputs = cJSON_AddArrayToObject(root, "outputs");
+    for (int i = 0; outputs && i < n->noutputs; i++)
+        cJSON_AddItemToArray(outputs, cJSON_CreateString(n->outputs[i]));
+    cJSON_AddBoolToObject(root, "failed", n->failed);
+    return root;
 }
 
-static void json_num(FILE *f, double v)
-{
-    if (isfinite(v)) fprintf(f, "%.9g", v);
-    else fputs("null", f);
-}
-
+/* run.json (cJSON): inputs, seed, timings and checks of this run. */
 static int write_run_json(notebook *n, double total)
 {
-    FILE *f = fopen(nb_path(n, "run.json"), "w");
-    int bad;
-    if (!f) return 1;
-    fputs("{\n  \"notebook\": ", f);
-    json_str(f, n->name);
-    fputs(",\n  \"version\": ", f);
-    json_str(f, es_version());
-    fputs(",\n  \"git_describe\": ", f);
-    json_str(f, NB_GIT_DESCRIBE);
-    fprintf(f, ",\n  \"seed\": %llu,\n  \"small\": %s,\n  \"synthetic_requested\": %s,\n",
-            (unsigned long long)n->seed, n->small ? "true" : "false",
-            n->synthetic ? "true" : "false");
-    fputs("  \"data_dir\": ", f);
-    json_str(f, n->datadir);
-    fputs(",\n  \"inputs\": {", f);
-    for (int i = 0; i < n->ninputs; i++) {
-        fputs(i ? ",\n    " : "\n    ", f);
-        json_str(f, n->inputs[i][0]);
-        fputs(": ", f);
-        json_str(f, n->inputs[i][1]);
+    cJSON *root = run_json(n, total);
+    char *text = root ? cJSON_Print(root) : NULL;
+    FILE *f = text ? fopen(nb_path(n, "run.json"), "w") : NULL;
+    int bad = !f;
+    if (f) {
+        fputs(text, f);
+        fputc('\n', f);
+        bad = ferror(f);
+        bad |= fclose(f) != 0;
     }
-    fputs(n->ninputs ? "\n  },\n  \"steps\": [" : "},\n  \"steps\": [", f);
-    for (int i = 0; i < n->nsteps; i++) {
-        fputs(i ? ",\n    {\"name\": " : "\n    {\"name\": ", f);
-        json_str(f, n->steps[i]);
-        fputs(", \"seconds\": ", f);
-        json_num(f, n->step_seconds[i]);
-        fputc('}', f);
-    }
-    fputs("\n  ],\n  \"total_seconds\": ", f);
-    json_num(f, total);
-    fputs(",\n  \"checks\": [", f);
-    for (int i = 0; i < n->nchecks; i++) {
-        const nb_checkrec *c = &n->checks[i];
-        fputs(i ? ",\n    {\"name\": " : "\n    {\"name\": ", f);
-        json_str(f, c->name);
-        fputs(", \"metric\": ", f);
-        json_num(f, c->metric);
-        fputs(", \"op\": ", f);
-        json_str(f, c->op);
-        fputs(", \"bound\": ", f);
-        json_num(f, c->bound);
-        fprintf(f, ", \"pass\": %s}", c->pass ? "true" : "false");
-    }
-    fputs("\n  ],\n  \"outputs\": [", f);
-    for (int i = 0; i < n->noutputs; i++) {
-        fputs(i ? ", " : "", f);
-        json_str(f, n->outputs[i]);
-    }
-    fprintf(f, "],\n  \"failed\": %s\n}\n", n->failed ? "true" : "false");
-    bad = ferror(f);
-    bad |= fclose(f) != 0;
+    cJSON_free(text);
+    cJSON_Delete(root);
     return bad;
 }
 

@@ -4,7 +4,6 @@
  * and t statistic; stored as /analysis/diff/NAME. */
 #include "cli.h"
 #include "commands.h"
-#include "stats_cli.h"
 
 #include <getopt.h>
 #include <math.h>
@@ -125,22 +124,8 @@ int cmd_diff(int argc, char **argv)
     }
     printf("stored as /analysis/diff/%s\n", name);
     ret = CLI_OK;
-    if (csv) {
-        const int64_t E = d->nedges;
-        double *vals = malloc((size_t)(4 * E) * sizeof *vals);
-        static const char *const names[4] = {"mean", "sd", "se", "t"};
-        if (!vals) {
-            fprintf(stderr, "edgespace diff: out of memory\n");
-            ret = CLI_FAIL;
-            goto done;
-        }
-        memcpy(vals, d->mean, (size_t)E * sizeof *vals);
-        memcpy(vals + E, d->sd, (size_t)E * sizeof *vals);
-        memcpy(vals + 2 * E, d->se, (size_t)E * sizeof *vals);
-        memcpy(vals + 3 * E, d->t, (size_t)E * sizeof *vals);
-        ret = stats_write_edge_csv("diff", ctx, st, csv, 4, names, vals);
-        free(vals);
-    }
+    if (csv && (rc = es_study_write_diff_table(ctx, st, d, csv)) != ES_OK)
+        ret = cli_fail("diff", ctx, rc);
 done:
     es_diff_free(d);
     if (ret == CLI_OK) es_store_close(st);

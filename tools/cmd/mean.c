@@ -3,7 +3,6 @@
  * column; stored as /analysis/mean/NAME and exported as CSV. */
 #include "cli.h"
 #include "commands.h"
-#include "stats_cli.h"
 
 #include <getopt.h>
 #include <stdio.h>
@@ -81,9 +80,8 @@ int cmd_mean(int argc, char **argv)
     }
     if (name) printf("stored as /analysis/mean/%s\n", name);
     ret = CLI_OK;
-    if (csv)
-        ret = stats_write_edge_csv("mean", ctx, st, csv, r->ngroups,
-                                   (const char *const *)r->names, r->means);
+    if (csv && (rc = es_study_write_mean_table(ctx, st, r, csv)) != ES_OK)
+        ret = cli_fail("mean", ctx, rc);
 done:
     es_group_result_free(r);
     if (ret == CLI_OK) es_store_close(st);

@@ -4,7 +4,6 @@
  * components. */
 #include "cli.h"
 #include "commands.h"
-#include "stats_cli.h"
 
 #include <getopt.h>
 #include <stdio.h>
@@ -35,72 +34,6 @@ static const char usage[] =
     "  -h, --help             show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
-
-static int write_csvs(es_ctx *ctx, es_store *st, const es_pca *p, const int64_t *rows,
-                      const char *prefix)
-{
-    size_t n = strlen(prefix) + 32;
-    char *path = malloc(n);
-    int ret = CLI_FAIL;
-    if (!path) return CLI_FAIL;
-    const int64_t N = p->nrows, K = p->ncomp, ncols = es_store_ncolumns(st);
-    /* scores */
-    snprintf(path, n, "%s_scores.csv", prefix);
-    FILE *f = stats_csv_open("pca", path);
-    if (!f) goto done;
-    stats_csv_field(f, "id", 1);
-    for (int64_t c = 0; c < ncols; c++) stats_csv_field(f, es_store_column_name(st, c), 0);
-    for (int64_t k = 0; k < K; k++) fprintf(f, ",PC%lld", (long long)(k + 1));
-    fputc('\n', f);
-    for (int64_t i = 0; i < N; i++) {
-        stats_csv_field(f, es_store_row_id(st, rows[i]), 1);
-        for (int64_t c = 0; c < ncols; c++) stats_csv_field(f, es_store_label(st, rows[i], c), 0);
-        for (int64_t k = 0; k < K; k++) stats_csv_number(f, p->scores[i + k * N]);
-        fputc('\n', f);
-    }
-    if (stats_csv_close("pca", f, path)) goto done;
-    /* eigenvalues */
-    snprintf(path, n, "%s_eigenvalues.csv", prefix);
-    if (!(f = stats_csv_open("pca", path))) goto done;
-    fputs("component,eigenvalue,explained,cumulative\n", f);
-    double cum = 0;
-    for (int64_t k = 0; k < K; k++) {
-        cum += p->explained[k];
-        fprintf(f, "%lld", (long long)(k + 1));
-        stats_csv_number(f, p->eigenvalues[k]);
-        stats_csv_number(f, p->explained[k]);
-        stats_csv_number(f, cum);
-        fputc('\n', f);
-    }
-    if (stats_csv_close("pca", f, path)) goto done;
-    /* components: mean then PC1..PCK per edge */
-    snprintf(path, n, "%s_components.csv", prefix);
-    {
-        const int64_t E = p->nedges;
-        double *vals = malloc((size_t)(E * (K + 1)) * sizeof *vals);
-        char **names = calloc((size_t)K + 1, sizeof *names);
-        if (!vals || !names) {
-            free(vals);
-            free(names);
-            fprintf(stderr, "edgespace pca: out of memory\n");
-            goto done;
-        }
-        memcpy(vals, p->mean, (size_t)E * sizeof *vals);
-        memcpy(vals + E, p->components, (size_t)(E * K) * sizeof *vals);
-        names[0] = strdup("mean");
-        for (int64_t k = 0; k < K; k++) {
-            names[k + 1] = malloc(24);
-            if (names[k + 1]) snprintf(names[k + 1], 24, "PC%lld", (long long)(k + 1));
-        }
-        ret = stats_write_edge_csv("pca", ctx, st, path, K + 1, (const char *const *)names, vals);
-        for (int64_t k = 0; k <= K; k++) free(names[k]);
-        free(names);
-        free(vals);
-    }
-done:
-    free(path);
-    return ret;
-}
 
 int cmd_pca(int argc, char **argv)
 {
@@ -181,7 +114,9 @@ int cmd_pca(int argc, char **argv)
         goto done;
     }
     printf("stored as /analysis/pca/%s\n", name);
-    ret = csv ? write_csvs(ctx, st, p, rows, csv) : CLI_OK;
+    ret = CLI_OK;
+    if (csv && (rc = es_study_write_pca_tables(ctx, st, p, rows, csv)) != ES_OK)
+        ret = cli_fail("pca", ctx, rc);
 done:
     es_pca_free(p);
     es_free(ctx, rows);

@@ -3,7 +3,6 @@
  * scree plot; PNG, SVG or PDF by the output's extension. */
 #include "cli.h"
 #include "commands.h"
-#include "stats_cli.h"
 
 #include <getopt.h>
 #include <stdio.h>

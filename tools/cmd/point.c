@@ -3,7 +3,6 @@
  * and store it as /analysis/point/NAME for embedding. */
 #include "cli.h"
 #include "commands.h"
-#include "stats_cli.h"
 
 #include <getopt.h>
 #include <math.h>
@@ -97,7 +96,8 @@ int cmd_point(int argc, char **argv)
     ret = CLI_OK;
     if (csv) {
         static const char *const names[1] = {"length"};
-        ret = stats_write_edge_csv("point", ctx, st, csv, 1, names, vec);
+        if ((rc = es_study_write_edge_table(ctx, st, csv, 1, names, vec)) != ES_OK)
+            ret = cli_fail("point", ctx, rc);
     }
 done:
     es_free(ctx, vec);

@@ -120,6 +120,10 @@ ES_API double es_rng_normal(es_rng *rng);    /* standard normal, Box-Muller */
 /* Uniform integer in [0, n), n > 0, without modulo bias. */
 ES_API uint64_t es_rng_below(es_rng *rng, uint64_t n);
 
+/* mkdir -p: make directory dir and every missing parent (ES_EIO naming the
+ * component that cannot be made, or dir if it is not a directory). */
+ES_API es_status es_make_dirs(es_ctx *ctx, const char *dir);
+
 /* One CSV field of free text (ids, labels, names) to f, quoted the RFC 4180
  * way when it holds a comma, quote or line break; "" for NULL. Every CSV
  * the library and the command write goes through it. */

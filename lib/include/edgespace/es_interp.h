@@ -27,15 +27,15 @@ typedef struct es_interp_info {
     int64_t reference;      /* input r (largest weight) */
     int64_t n_wrapped;      /* edges whose dihedrals differ by more than pi between
                                input r and some other input (shortest arc taken) */
-    int64_t n_clamped;      /* target lengths <= 0 (extrapolation) clamped to
-                               1e-3 x the mean length */
     double scale;           /* sum of target lengths */
 } es_interp_info;
 
 /* Target lengths (E) and initial dihedrals (E) for weights w (nin) of
  * inputs xyz[k] (3 x V each). Either output may be NULL. Fails with
  * ES_EINVAL on nin < 1, non-finite weights or positions, weights summing to
- * 0, an input with a zero-length edge. */
+ * 0, an input with a zero-length edge, and a target length <= 0 (weights
+ * that extrapolate too far: no mesh realizes it; the message names the
+ * edge). */
 ES_API es_status es_interp_targets(es_ctx *ctx, const es_mesh *mesh, int64_t nin,
                                    const double *const *xyz, const double *w, double *len,
                                    double *alpha, es_interp_info *info);

@@ -26,6 +26,7 @@
 #include "es_stats.h"
 #include "es_store.h"
 #include "es_embed.h"
+#include "es_interp.h"
 #include "es_procrustes.h"
 #include "es_compare.h"
 
@@ -108,6 +109,58 @@ ES_API es_status es_study_point(es_ctx *ctx, es_store *store, const char *name,
                                    const char *expr, const char *pca_name, double scale,
                                    const char *command, double **vec, es_point_info *info);
 
+/* The E scale-normalized lengths of a point as a command line names it:
+ * "row:ID", the name of a stored point (/analysis/point/NAME), or an
+ * expression (datasets-spec/point-syntax.md; pca_name: the PCA of pc:K,
+ * NULL for the only or the 'default' one). *scale gets the point's own
+ * scale, else the mean scale of the store's rows. A length that is not
+ * positive (extrapolated too far) is ES_EINVAL naming the edge: no mesh
+ * realizes the point. */
+ES_API es_status es_study_point_lengths(es_ctx *ctx, es_store *store, const char *spec,
+                                        const char *pca_name, double *lengths, double *scale);
+
+/* ---- tables -----------------------------------------------------------------
+ * CSV files of results, with the labels a reader needs; every file is
+ * replaced only once written whole, and path "-" writes to standard output. */
+
+/* "edge,v0,v1,<names...>": one row per edge of the store's topology (its end
+ * vertices), ncol value columns (column c = values + c * E). */
+ES_API es_status es_study_write_edge_table(es_ctx *ctx, es_store *store, const char *path,
+                                           int64_t ncol, const char *const *names,
+                                           const double *values);
+/* Per-edge tables of a mean result (one column per group), a paired
+ * difference (mean, sd, se, t) and a point (length). */
+ES_API es_status es_study_write_mean_table(es_ctx *ctx, es_store *store,
+                                           const es_group_result *r, const char *path);
+ES_API es_status es_study_write_diff_table(es_ctx *ctx, es_store *store, const es_diff *d,
+                                           const char *path);
+/* PREFIX_scores.csv (id, every label column, PC1..PCK of the fitted rows
+ * `rows`), PREFIX_eigenvalues.csv (component, eigenvalue, explained,
+ * cumulative) and PREFIX_components.csv (the edge table of the mean and
+ * the components). */
+ES_API es_status es_study_write_pca_tables(es_ctx *ctx, es_store *store, const es_pca *p,
+                                           const int64_t *rows, const char *prefix);
+
+/* Scores of inputs on a stored PCA: each input is a row id or a mesh file
+ * of the store's topology (.obj, .ply, .off), then the rows matching
+ * `where` (NULL: none). The result holds n names (borrowed from the inputs
+ * or the store), scores (n x K, column k = PC k+1) and the residual norm of
+ * each; es_study_projection_free releases it. */
+typedef struct es_study_projection {
+    es_ctx *ctx;
+    int64_t n, ncomp;
+    const char **names;
+    double *scores;
+    double *residuals;
+} es_study_projection;
+ES_API es_status es_study_project(es_ctx *ctx, es_store *store, const char *pca_name,
+                                  int64_t ninputs, const char *const *inputs,
+                                  const char *where, es_study_projection **out);
+ES_API void es_study_projection_free(es_study_projection *p);
+/* "name,PC1..PCK,residual". */
+ES_API es_status es_study_write_projection_table(es_ctx *ctx, const es_study_projection *p,
+                                                 const char *path);
+
 /* ---- GPA and the comparison of the two spaces ----------------------------- */
 
 /* GPA of the positions of `rows` (nrows of them; rows NULL with nrows = -1:
@@ -182,6 +235,78 @@ ES_API es_status es_study_store_embedding(es_ctx *ctx, es_store *store, const ch
                                        const double *target, const double *xyz,
                                        const es_embed_report *rep, const char *init);
 
+/* What es_study_embed does: embed one point of the store's space. */
+typedef struct es_study_embed_opts {
+    const char *point;      /* as es_study_point_lengths reads it (required) */
+    const char *pca_name;   /* the PCA of pc:K in the point (NULL: the only one) */
+    const char *init;       /* "nearest" (NULL: the stored row nearest in edge-length
+                               distance), "row:ID", "mean[:FILTER]" (circular mean of
+                               the rows' dihedrals) or "mesh:FILE" (a mesh of this
+                               topology; the output is aligned to it) */
+    double scale;           /* > 0: embed at this sum of lengths (0: the point's) */
+    const char *output;     /* mesh file to write (OBJ/PLY/OFF by extension), or NULL */
+    const char *residuals;  /* CSV of per-vertex closure and edge error, or NULL */
+    const char *name;       /* store as /analysis/embed/<name> and commit (NULL: no) */
+    const char *command;    /* provenance of the stored result */
+    es_embed_opts embed;    /* solver options (es_embed_opts_init) */
+} es_study_embed_opts;
+ES_API void es_study_embed_opts_init(es_study_embed_opts *opts);
+
+typedef struct es_study_embed_result {
+    es_embed_report report;
+    double scale;           /* the sum of lengths embedded at */
+    char init[512];         /* what the embedding started from, in words */
+} es_study_embed_result;
+
+/* Embed a point: resolve it, initialize, solve, write the mesh and the
+ * residuals, store the result with its provenance. The store must be open
+ * for writing when opts->name is given. xyz (3 x V, may be NULL) receives
+ * the positions. Nothing is stored when a step fails. */
+ES_API es_status es_study_embed(es_ctx *ctx, es_store *store, const es_study_embed_opts *opts,
+                                double *xyz, es_study_embed_result *res);
+
+/* Called for each frame es_study_interp has written: frame i of n, its
+ * mesh file, a heading ("t = 0.5 (3 dihedrals wrapped)") and its report. */
+typedef void (*es_study_frame_fn)(void *userdata, int64_t i, int64_t n, const char *path,
+                                  const char *heading, const es_embed_report *report);
+
+/* What es_study_interp does: a walk between two points, or one weighted
+ * combination of rows. */
+typedef struct es_study_interp_opts {
+    const char *from, *to;  /* end points (t = 0 and 1) as es_study_point_lengths reads
+                               them; two rows ("row:A", "row:B") interpolate their
+                               meshes (dihedrals averaged on the circle) */
+    const char *weights;    /* instead: "w1*row:a + w2*row:b + ..." (two or more rows),
+                               one frame */
+    const char *pca_name;   /* the PCA of pc:K in from/to */
+    double t0, t1;          /* range of t (0, 1) */
+    int64_t steps;          /* frames from t0 to t1 inclusive (9) */
+    const char *output;     /* mesh file; with several frames a printf pattern with one
+                               integer conversion ("cat_%02d.obj"; %% is a literal %) */
+    const char *name;       /* results /analysis/embed/<name>[_<i>] (NULL: the output's
+                               base name without the conversion) */
+    const char *command;    /* provenance; NULL: store nothing */
+    es_embed_opts embed;
+    es_study_frame_fn frame;   /* called after each frame (may be NULL) */
+    void *userdata;
+} es_study_interp_opts;
+ES_API void es_study_interp_opts_init(es_study_interp_opts *opts);
+
+/* Interpolate (or extrapolate: t or weights outside [0, 1]) and embed each
+ * frame; frames are aligned frame to frame so the sequence does not jump.
+ * Every frame is checked before the first is written: a walk that leaves
+ * edge-length space (a length <= 0 at some t) is refused naming t and the
+ * edge, and nothing is written. With opts->command the frames are stored
+ * and committed (the store open for writing). */
+ES_API es_status es_study_interp(es_ctx *ctx, es_store *store, const es_study_interp_opts *opts);
+
+/* The file of frame i: pattern with its one %d, %Nd or %0Nd conversion
+ * expanded (%% is a literal %). 0, or -1 if the pattern is malformed or
+ * the result does not fit in n bytes. */
+ES_API int es_study_frame_path(const char *pattern, int64_t i, char *out, size_t n);
+/* Where es_study_interp stores its frames, for messages: "NAME", or
+ * "NAME_NN" for a sequence. Returns buf. */
+ES_API const char *es_study_interp_name(const es_study_interp_opts *opts, char *buf, size_t n);
 
 #ifdef __cplusplus
 }

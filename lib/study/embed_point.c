@@ -1,0 +1,128 @@
+/* lib/study/embed_point.c — one point of a store's space embedded as a
+ * mesh: the point resolved, the start chosen (the nearest row, a named row,
+ * the circular mean of rows' dihedrals, or a given mesh), the solve, the
+ * mesh and residual files, and the stored result with its provenance. */
+#include "study/study_pkg.h"
+#include "edgespace/es_io.h"
+
+#include <stdio.h>
+
+void es_study_embed_opts_init(es_study_embed_opts *o)
+{
+    memset(o, 0, sizeof *o);
+    o->init = "nearest";
+    es_embed_opts_init(&o->embed);
+}
+
+/* The start: rows whose positions (and, for "mean", dihedrals) start the
+ * solve, or a mesh file's positions. *init_row >= 0 names the row whose
+ * positions start it; *sel and *nsel the rows of a "mean" start. */
+static es_status choose_start(es_ctx *ctx, es_store *s, const es_mesh *mesh, const char *init,
+                              const double *target, double *init_xyz, double *alpha,
+                              int64_t *init_row, int64_t **sel, int64_t *nsel, char *desc,
+                              size_t ndesc)
+{
+    es_status rc;
+    *init_row = -1;
+    if (!init || !strcmp(init, "nearest")) {
+        double d;
+        if ((rc = es_study_nearest_row(ctx, s, target, NULL, 0, init_row, &d)) != ES_OK)
+            return rc;
+        snprintf(desc, ndesc, "nearest row %s (edge-length distance %.3g)",
+                 es_store_row_id(s, *init_row), d);
+    } else if (!strncmp(init, "row:", 4)) {
+        if ((*init_row = es_store_find_row(s, init + 4)) < 0)
+            ES_FAIL(ctx, ES_ENOTFOUND, "no row '%s' in the store", init + 4);
+        snprintf(desc, ndesc, "row %s", init + 4);
+    } else if (!strncmp(init, "mean", 4) && (init[4] == 0 || init[4] == ':')) {
+        if ((rc = es_store_select(ctx, s, init[4] ? init + 5 : NULL, sel, nsel)) != ES_OK)
+            return rc;
+        if (*nsel == 0) ES_FAIL(ctx, ES_ENOTFOUND, "--init %s selects no rows", init);
+        if ((rc = es_study_mean_dihedrals(ctx, s, mesh, *sel, *nsel, alpha)) != ES_OK)
+            return rc;
+        *init_row = (*sel)[0];
+        snprintf(desc, ndesc, "circular mean of dihedrals of %lld rows (%s)", (long long)*nsel,
+                 init);
+    } else if (!strncmp(init, "mesh:", 5)) {
+        if ((rc = es_mesh_read_positions(ctx, mesh, init + 5, init_xyz)) != ES_OK) return rc;
+        snprintf(desc, ndesc, "mesh %s", init + 5);
+    } else {
+        ES_FAIL(ctx, ES_EINVAL, "--init wants nearest, row:ID, mean[:FILTER] or mesh:FILE "
+                "(got '%s')", init);
+    }
+    if (*init_row >= 0) return es_store_read_positions(ctx, s, *init_row, init_xyz);
+    return ES_OK;
+}
+
+/* Per vertex of the output, its vertex-figure closure energy and the mean
+ * relative error of its edges; the closure comes first because render
+ * --scalars colours by the first column. */
+static es_status write_residuals(es_ctx *ctx, const char *path, const es_embedder *emb,
+                                 int64_t nv)
+{
+    const double *closure = es_embedder_vertex_closure(emb);
+    const double *edge_error = es_embedder_vertex_edge_error(emb);
+    es__table_out t;
+    es_status rc = es__table_begin(ctx, path, &t);
+    if (rc != ES_OK) return rc;
+    fputs("closure,edge_error\n", t.f);
+    for (int64_t v = 0; v < nv; v++) fprintf(t.f, "%.17g,%.17g\n", closure[v], edge_error[v]);
+    return es__table_end(ctx, &t, ES_OK);
+}
+
+es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o, double *xyz_out,
+                         es_study_embed_result *res)
+{
+    es_mesh *mesh = NULL;
+    es_embedder *emb = NULL;
+    double *target = NULL, *xyz = NULL, *init_xyz = NULL, *alpha = NULL, own;
+    int64_t init_row = -1, *sel = NULL, nsel = 0, ne, nv;
+    es_status rc;
+    memset(res, 0, sizeof *res);
+    if (!o || !o->point) ES_FAIL(ctx, ES_EINVAL, "embed: no point given");
+    if ((rc = es_store_mesh(ctx, s, &mesh)) != ES_OK) return rc;
+    ne = es_mesh_nedges(mesh);
+    nv = es_mesh_nverts(mesh);
+    target = es__alloc_array(ctx, ne, sizeof *target);
+    xyz = xyz_out ? xyz_out : es__alloc_array(ctx, 3 * nv, sizeof *xyz);
+    init_xyz = es__alloc_array(ctx, 3 * nv, sizeof *init_xyz);
+    alpha = es__alloc_array(ctx, ne, sizeof *alpha);
+    if (!target || !xyz || !init_xyz || !alpha) {
+        rc = ES_ENOMEM;
+        goto done;
+    }
+    /* the target: at the point's own scale unless opts->scale gives one */
+    if ((rc = es_study_point_lengths(ctx, s, o->point, o->pca_name, target, &own)) != ES_OK)
+        goto done;
+    res->scale = o->scale > 0 ? o->scale : own;
+    if ((rc = choose_start(ctx, s, mesh, o->init, target, init_xyz, alpha, &init_row, &sel,
+                           &nsel, res->init, sizeof res->init)) != ES_OK ||
+        (rc = es_embedder_new(ctx, mesh, &emb)) != ES_OK ||
+        (rc = es_embed_solve(ctx, emb, target, res->scale, sel ? alpha : NULL, init_xyz,
+                             &o->embed, xyz, &res->report)) != ES_OK ||
+        (o->output && (rc = es_mesh_write(ctx, o->output, ES_FORMAT_AUTO, mesh, xyz, NULL))) ||
+        (o->residuals && (rc = write_residuals(ctx, o->residuals, emb, nv)) != ES_OK))
+        goto done;
+    if (o->name) {
+        /* the rows whose positions started the embedding (none for a mesh:
+         * rows non-NULL with 0, as NULL would record every row) */
+        char params[1024];
+        es_provenance prov = {o->command ? o->command : "es_study_embed",
+                              sel ? sel : &init_row, sel ? nsel : init_row >= 0 ? 1 : 0,
+                              params};
+        snprintf(params, sizeof params, "point=%s; scale=%.17g", o->point, res->scale);
+        if ((rc = es_study_store_embedding(ctx, s, o->name, &prov, emb, target, xyz,
+                                           &res->report, res->init)) != ES_OK ||
+            (rc = es_store_commit(ctx, s)) != ES_OK)
+            goto done;
+    }
+done:
+    es_embedder_free(emb);
+    es_mesh_free(mesh);
+    es__free(ctx, sel);
+    es__free(ctx, target);
+    if (xyz != xyz_out) es__free(ctx, xyz);
+    es__free(ctx, init_xyz);
+    es__free(ctx, alpha);
+    return rc;
+}

@@ -1,0 +1,96 @@
+/* lib/study/point_lengths.c — a point as a command line names it (a row, a
+ * stored point, an expression) turned into lengths and a scale: what embed,
+ * interp and every other consumer of a point share. */
+#include "core/core_private.h"
+#include "edgespace/es_study.h"
+
+#include <math.h>
+#include <stdio.h>
+
+/* The mean scale of the store's rows: the scale of a point without one. */
+static es_status mean_row_scale(es_ctx *ctx, es_store *store, double *scale)
+{
+    int64_t n = es_store_nrows(store);
+    double *scales = es__alloc_array(ctx, n > 0 ? n : 1, sizeof *scales);
+    es_status rc;
+    if (!scales) return ES_ENOMEM;
+    *scale = 0;
+    if ((rc = es_store_read_scales(ctx, store, scales)) == ES_OK)
+        for (int64_t i = 0; i < n; i++) *scale += scales[i] / (double)n;
+    es__free(ctx, scales);
+    return rc;
+}
+
+static es_status row_point(es_ctx *ctx, es_store *store, const char *id, double *lengths,
+                           double *scale)
+{
+    int64_t r = es_store_find_row(store, id), ne = es_store_nedges(store);
+    double *scales;
+    es_status rc;
+    if (r < 0) ES_FAIL(ctx, ES_ENOTFOUND, "no row '%s' in the store", id);
+    if (!(scales = es__alloc_array(ctx, es_store_nrows(store), sizeof *scales)))
+        return ES_ENOMEM;
+    if ((rc = es_store_read_lengths(ctx, store, r, 1, (es_mat){lengths, ne, 1, ne})) == ES_OK &&
+        (rc = es_store_read_scales(ctx, store, scales)) == ES_OK)
+        *scale = scales[r];
+    es__free(ctx, scales);
+    return rc;
+}
+
+static es_status stored_point(es_ctx *ctx, es_store *store, const char *name, double *lengths,
+                              double *scale)
+{
+    char path[512];
+    double *v = NULL;
+    int64_t n = 0, ne = es_store_nedges(store);
+    es_status rc;
+    snprintf(path, sizeof path, "point/%s/lengths", name);
+    if ((rc = es_store_get_vector(ctx, store, path, &v, &n)) != ES_OK) return rc;
+    if (n != ne) {
+        es__free(ctx, v);
+        ES_FAIL(ctx, ES_EMISMATCH, "point '%s' has %lld lengths, the store's topology %lld "
+                "edges", name, (long long)n, (long long)ne);
+    }
+    memcpy(lengths, v, (size_t)ne * sizeof *lengths);
+    es__free(ctx, v);
+    v = NULL;
+    snprintf(path, sizeof path, "point/%s/scale", name);
+    if (es_store_has(store, path) && (rc = es_store_get_vector(ctx, store, path, &v, &n)) == ES_OK &&
+        n >= 1 && v[0] > 0)
+        *scale = v[0];
+    es__free(ctx, v);
+    return rc;
+}
+
+es_status es_study_point_lengths(es_ctx *ctx, es_store *store, const char *spec,
+                                 const char *pca_name, double *lengths, double *scale)
+{
+    char path[512];
+    int64_t ne = es_store_nedges(store);
+    es_status rc;
+    *scale = 0;
+    if (!spec || !*spec) ES_FAIL(ctx, ES_EINVAL, "no point given");
+    snprintf(path, sizeof path, "point/%s/lengths", spec);
+    if (!strncmp(spec, "row:", 4)) {
+        rc = row_point(ctx, store, spec + 4, lengths, scale);
+    } else if (es_store_has(store, path)) {
+        rc = stored_point(ctx, store, spec, lengths, scale);
+    } else {   /* an expression (es_point.h syntax) */
+        es_point_info info;
+        double *v = NULL;
+        if ((rc = es_study_point(ctx, store, NULL, spec, pca_name, 0, "edgespace", &v,
+                                 &info)) == ES_OK) {
+            memcpy(lengths, v, (size_t)ne * sizeof *lengths);
+            if (isfinite(info.scale) && info.scale > 0) *scale = info.scale;
+        }
+        es_free(ctx, v);
+    }
+    if (rc == ES_OK && *scale == 0) rc = mean_row_scale(ctx, store, scale);
+    if (rc != ES_OK) return rc;
+    /* beyond the positive orthant (extrapolation) no mesh realizes the point */
+    for (int64_t e = 0; e < ne; e++)
+        if (!(lengths[e] > 0))
+            ES_FAIL(ctx, ES_EINVAL, "the point has length %g at edge %lld: it is outside "
+                    "edge-length space (not realizable)", lengths[e], (long long)e);
+    return ES_OK;
+}

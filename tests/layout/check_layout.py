@@ -1,0 +1,225 @@
+#!/usr/bin/env python3
+"""tests/layout/check_layout.py — the layout's contract (lib/README.md), checked
+from the sources on every test run:
+
+  1. lib/<module>/ includes only modules at or below its own place in the data
+     flow (core < mesh < meshio < store < ingest < stats < procrustes < embed <
+     study < figure, synth), whether through their library-private headers or
+     their public headers; siblings (figure, synth) do not include each other;
+     the numerical modules (stats, procrustes, embed) take arrays and row
+     callbacks and do not include the store at all;
+  2. a package header (<module>/<module>_pkg.h) is included only by its own
+     module (and carries the #error guard that enforces it at compile time);
+  3. the include graph has no circles;
+  4. no file in lib/ is over 800 lines, no command file (tools/cmd/) over 250;
+  5. hdf5.h only under lib/store, cholmod.h only under lib/embed, cairo.h only
+     under lib/figure (among lib/, tools/ and notebooks-c/);
+  6. tools/ and notebooks-c/ include no private header of the library.
+
+Usage: check_layout.py SOURCE_ROOT. Prints every violation; exit 1 if any.
+"""
+import os
+import re
+import sys
+
+ORDER = ["core", "mesh", "meshio", "store", "ingest", "stats", "procrustes", "embed",
+         "study", "figure", "synth"]
+LEVEL = {m: i for i, m in enumerate(ORDER)}
+LEVEL["synth"] = LEVEL["figure"]          # beside figure, above study
+PUBLIC = {
+    "es_core.h": "core", "es_mesh.h": "mesh", "es_geom.h": "mesh", "es_io.h": "meshio",
+    "es_store.h": "store", "es_ingest.h": "ingest", "es_landmarks.h": "ingest",
+    "es_stats.h": "stats", "es_point.h": "stats", "es_procrustes.h": "procrustes",
+    "es_compare.h": "procrustes", "es_embed.h": "embed", "es_interp.h": "embed",
+    "es_study.h": "study", "es_plot.h": "figure", "es_render.h": "figure",
+    "es_figure.h": "figure", "es_synth.h": "synth",
+}
+FOREIGN = {  # header pattern -> the only module that may include it
+    re.compile(r"^(hdf5|H5[A-Za-z]*)\.h$"): "store",
+    re.compile(r"^cholmod[a-z_]*\.h$"): "embed",
+    re.compile(r"^cairo[a-z-]*\.h$"): "figure",
+}
+INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]', re.M)
+LIB_MAX, CMD_MAX = 800, 250
+
+
+def includes(path):
+    with open(path, encoding="utf-8", errors="replace") as f:
+        return INCLUDE.findall(f.read())
+
+
+def nlines(path):
+    with open(path, encoding="utf-8", errors="replace") as f:
+        return sum(1 for _ in f)
+
+
+NUMERIC = {"stats", "procrustes", "embed"}
+
+
+def may_include(own, target):
+    """own module may include target module (a level at or below, not a sibling)."""
+    if own == target:
+        return True
+    if own in NUMERIC and target == "store":
+        return False
+    return LEVEL[target] < LEVEL[own]
+
+
+def main(root):
+    errors = []
+    lib = os.path.join(root, "lib")
+    graph = {}   # file -> files it includes (inside the tree)
+
+    def resolve(inc, src):
+        for base in (os.path.dirname(src), lib, os.path.join(lib, "include")):
+            p = os.path.normpath(os.path.join(base, inc))
+            if os.path.isfile(p):
+                return p
+        return None
+
+    # lib/<module>/ and the public headers
+    for dirpath, _, files in os.walk(lib):
+        rel = os.path.relpath(dirpath, lib)
+        for name in sorted(files):
+            if not name.endswith((".c", ".h")):
+                continue
+            path = os.path.join(dirpath, name)
+            shown = os.path.relpath(path, root)
+            n = nlines(path)
+            if n > LIB_MAX:
+                errors.append(f"{shown}: {n} lines (lib/ files stay at or under {LIB_MAX})")
+            if rel.startswith("include"):
+                own = PUBLIC.get(name)          # None for edgespace.h: may include all
+            else:
+                own = rel.split(os.sep)[0]
+                if own not in LEVEL:
+                    errors.append(f"{shown}: lib/{own}/ is not a module of the data flow")
+                    continue
+                if name.endswith("_pkg.h"):
+                    guard = f"ES_MODULE_{own.upper()}"
+                    with open(path) as f:
+                        text = f.read()
+                    if f"#ifndef {guard}" not in text or "#error" not in text:
+                        errors.append(f"{shown}: package header without its #ifndef {guard} "
+                                      f"#error guard")
+            graph[path] = []
+            for kind, inc in includes(path):
+                base = os.path.basename(inc)
+                for pat, mod in FOREIGN.items():
+                    if kind == "<" and pat.match(base) and own != mod:
+                        errors.append(f"{shown}: includes <{inc}>, which only lib/{mod}/ may")
+                if kind != '"':
+                    continue
+                target_path = resolve(inc, path)
+                if target_path:
+                    graph[path].append(target_path)
+                if own is None:
+                    continue
+                if inc.startswith("edgespace/") or (rel.startswith("include") and
+                                                     inc.startswith("es_")):
+                    tmod = PUBLIC.get(base)
+                    if base in ("edgespace.h",):
+                        errors.append(f"{shown}: includes the umbrella header {inc}")
+                    elif tmod and not may_include(own, tmod):
+                        errors.append(f"{shown}: ({own}) includes {inc} of {tmod}, above it")
+                elif "/" in inc:
+                    tmod = inc.split("/")[0]
+                    if tmod not in LEVEL:
+                        continue
+                    if not may_include(own, tmod):
+                        errors.append(f"{shown}: ({own}) includes {inc} of {tmod}, above it")
+                    if base.endswith("_pkg.h") and tmod != own:
+                        errors.append(f"{shown}: includes {inc}, private to lib/{tmod}/")
+
+    # tools/ and notebooks-c/: public API only
+    for top in ("tools", "notebooks-c"):
+        for dirpath, _, files in os.walk(os.path.join(root, top)):
+            for name in sorted(files):
+                if not name.endswith((".c", ".h")):
+                    continue
+                path = os.path.join(dirpath, name)
+                shown = os.path.relpath(path, root)
+                if top == "tools" and os.path.basename(dirpath) == "cmd":
+                    n = nlines(path)
+                    if n > CMD_MAX:
+                        errors.append(f"{shown}: {n} lines (commands stay at or under "
+                                      f"{CMD_MAX} and thin)")
+                for kind, inc in includes(path):
+                    base = os.path.basename(inc)
+                    for pat, mod in FOREIGN.items():
+                        if pat.match(base):
+                            errors.append(f"{shown}: includes {inc}; only lib/{mod}/ may")
+                    if kind == '"' and inc.split("/")[0] in LEVEL:
+                        errors.append(f"{shown}: includes the library's private {inc}")
+                    if re.search(r"(_private|_pkg|core_private)\.h$", base) and \
+                            not base.startswith("test"):
+                        errors.append(f"{shown}: includes the private header {inc}")
+
+    # no circles in the include graph (depth-first search)
+    state = {}
+
+    def visit(node, stack):
+        state[node] = 1
+        stack.append(node)
+        for nxt in graph.get(node, []):
+            if state.get(nxt) == 1:
+                cyc = stack[stack.index(nxt):] + [nxt]
+                errors.append("include circle: " +
+                              " -> ".join(os.path.relpath(p, root) for p in cyc))
+            elif nxt in graph and not state.get(nxt):
+                visit(nxt, stack)
+        stack.pop()
+        state[node] = 2
+
+    for node in sorted(graph):
+        if not state.get(node):
+            visit(node, [])
+
+    for e in errors:
+        print(e)
+    print(f"layout: {len(graph)} files in lib/ checked, {len(errors)} problems")
+    return 1 if errors else 0
+
+
+def self_test():
+    """The checker finds each kind of violation in a small made-up tree."""
+    import tempfile
+    with tempfile.TemporaryDirectory() as d:
+        def put(rel, text):
+            p = os.path.join(d, rel)
+            os.makedirs(os.path.dirname(p), exist_ok=True)
+            with open(p, "w") as f:
+                f.write(text)
+        put("lib/include/edgespace/es_core.h", "")
+        put("lib/include/edgespace/es_study.h", '#include "es_core.h"\n')
+        put("lib/include/edgespace/es_stats.h", '#include "es_study.h"\n')     # upward
+        put("lib/core/a.c", '#include "embed/embed_pkg.h"\n#include <cairo.h>\n')
+        put("lib/embed/embed_pkg.h", "/* no guard */\n")
+        put("lib/stats/s.c", '#include "edgespace/es_store.h"\n')             # numeric
+        put("lib/mesh/x.h", '#include "mesh/y.h"\n')
+        put("lib/mesh/y.h", '#include "mesh/x.h"\n')                          # circle
+        put("lib/mesh/big.c", "x\n" * (LIB_MAX + 1))
+        put("tools/cmd/c.c", '#include "core/core_private.h"\n' + "x\n" * CMD_MAX)
+        import io
+        import contextlib
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            rc = main(d)
+        text = out.getvalue()
+        want = ["es_study.h of study, above it", "embed/embed_pkg.h of embed, above it",
+                "private to lib/embed/", "<cairo.h>", "without its #ifndef ES_MODULE_EMBED",
+                "es_store.h of store", "include circle", "big.c: 801 lines",
+                "private core/core_private.h", "c.c: 251 lines"]
+        missing = [w for w in want if w not in text]
+        if rc != 1 or missing:
+            print(text)
+            print("self-test: the checker missed", missing)
+            return 1
+    return 0
+
+
+if __name__ == "__main__":
+    if self_test():
+        sys.exit(1)
+    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else
+                  os.path.join(os.path.dirname(__file__), "..", "..")))
