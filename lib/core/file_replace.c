@@ -1,6 +1,6 @@
 /* lib/core/file_replace.c — write a file so that it replaces the old one only
  * when the new content is complete: a failed or killed write leaves a file
- * that was there before as it was (es_internal.h). */
+ * that was there before as it was (core/core_private.h). */
 #include "core/core_private.h"
 
 #include <errno.h>

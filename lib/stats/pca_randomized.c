@@ -16,7 +16,7 @@
  * sigma_{K+1} times a factor that decays like (sigma_{K+p+1}/sigma_K)^(2q+1)
  * times a modest constant; eigenvalues are never overestimated. Measured
  * (max relative error of the top 5 eigenvalues, 300 edges x 80 shapes,
- * p = 10; tests/test_pca.c checks the same cases):
+ * p = 10; tests/stats/test_pca.c checks the same cases):
  *     spectrum                        q=0      q=1      q=2      q=4
  *     rank 5 + noise (clear gap)      2e-3     1e-9     1e-15    2e-15
  *     rank 40, sigma_k ~ 1/k          0.2      8e-4     5e-6     2e-10

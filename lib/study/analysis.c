@@ -4,7 +4,7 @@
  * Each es_study_* call selects rows with the store's label filter,
  * streams their lengths through an es_source, computes, and writes one
  * result group /analysis/<kind>/<name> with provenance (layouts in
- * es_study.h). Commands (tools/cmd_mean.c, ...) and notebooks call these,
+ * es_study.h). Commands (tools/cmd/mean.c, ...) and notebooks call these,
  * so a result made from C is the same as one made from the command line.
  */
 #include "edgespace/es_study.h"

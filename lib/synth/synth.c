@@ -9,13 +9,12 @@
  * is built just to write files.
  */
 #include "synth/synth_pkg.h"
+#include "core/files.h"
 #include "edgespace/es_io.h"
 #include "edgespace/es_mesh.h"
 #include "meshio/meshio_private.h"
 
-#include <errno.h>
 #include <stdio.h>
-#include <sys/stat.h>
 
 static const char *const family_names[] = {NULL, "barbell", "tube", "tube-closed", "face"};
 
@@ -215,34 +214,13 @@ es_status es_synth_subdivide(es_ctx *ctx, es_synth_set *s, int levels)
 
 /* ---- output ---- */
 
-/* mkdir -p: create each missing component of dir. */
-static es_status make_dirs(es_ctx *ctx, const char *dir)
-{
-    char path[4096];
-    struct stat st;
-    size_t n = strlen(dir);
-    if (n >= sizeof path) ES_FAIL(ctx, ES_ERANGE, "synth: directory name too long");
-    memcpy(path, dir, n + 1);
-    for (size_t i = 1; i <= n; i++) {
-        if (path[i] != '/' && path[i] != '\0') continue;
-        char keep = path[i];
-        path[i] = '\0';
-        if (mkdir(path, 0777) != 0 && errno != EEXIST)
-            ES_FAIL(ctx, ES_EIO, "synth: cannot create directory '%s': %s", path,
-                    strerror(errno));
-        path[i] = keep;
-    }
-    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
-        ES_FAIL(ctx, ES_EIO, "synth: '%s' is not a directory", dir);
-    return ES_OK;
-}
-
 es_status es_synth_write(es_ctx *ctx, const es_synth_set *s, const char *dir)
 {
     char path[4096];
     es_status rc;
     if (!dir || !*dir) ES_FAIL(ctx, ES_EINVAL, "synth: no output directory");
-    if ((rc = make_dirs(ctx, dir)) != ES_OK) return rc;
+    if ((rc = es__mkdir_p(ctx, dir)) != ES_OK)
+        return es__fail(ctx, rc, "synth: %s", es_ctx_errmsg(ctx));
     for (int64_t i = 0; i < s->nmembers; i++) {
         if (snprintf(path, sizeof path, "%s/%s.obj", dir, s->names[i]) >= (int)sizeof path)
             ES_FAIL(ctx, ES_ERANGE, "synth: path too long in '%s'", dir);
@@ -253,24 +231,25 @@ es_status es_synth_write(es_ctx *ctx, const es_synth_set *s, const char *dir)
     }
     if (snprintf(path, sizeof path, "%s/manifest.csv", dir) >= (int)sizeof path)
         ES_FAIL(ctx, ES_ERANGE, "synth: path too long in '%s'", dir);
-    FILE *fp = fopen(path, "w");
-    if (!fp) ES_FAIL(ctx, ES_EIO, "synth: cannot create '%s': %s", path, strerror(errno));
-    fputs("file", fp);
+    /* the manifest replaces an old one only once complete */
+    es__file_replace w;
+    if ((rc = es__replace_begin(ctx, path, &w)) != ES_OK)
+        return es__fail(ctx, rc, "synth: %s", es_ctx_errmsg(ctx));
+    fputs("file", w.f);
     for (int64_t j = 0; j < s->nlabels; j++) {
-        fputc(',', fp);
-        es_csv_write_field(fp, s->label_names[j]);
+        fputc(',', w.f);
+        es_csv_write_field(w.f, s->label_names[j]);
     }
-    fputc('\n', fp);
+    fputc('\n', w.f);
     for (int64_t i = 0; i < s->nmembers; i++) {
-        fprintf(fp, "%s.obj", s->names[i]);
+        fprintf(w.f, "%s.obj", s->names[i]);
         for (int64_t j = 0; j < s->nlabels; j++) {
-            fputc(',', fp);
-            es_csv_write_field(fp, s->labels[i * s->nlabels + j]);
+            fputc(',', w.f);
+            es_csv_write_field(w.f, s->labels[i * s->nlabels + j]);
         }
-        fputc('\n', fp);
+        fputc('\n', w.f);
     }
-    int bad = ferror(fp);
-    if (fclose(fp) != 0 || bad)
-        ES_FAIL(ctx, ES_EIO, "synth: cannot write '%s': %s", path, strerror(errno));
+    if ((rc = es__replace_end(ctx, &w, ES_OK)) != ES_OK)
+        return es__fail(ctx, rc, "synth: %s", es_ctx_errmsg(ctx));
     return ES_OK;
 }

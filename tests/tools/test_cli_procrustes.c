@@ -92,7 +92,7 @@ int main(void)
     f = fopen(tri, "w");
     fputs("# fan around landmark 1\n1 2 3\n1 3 4\n1,4,5\n", f);
     fclose(f);
-    /* no topology: a landmarks-only store (tests/test_cli_landmarks.c has more) */
+    /* no topology: a landmarks-only store (tests/tools/test_cli_landmarks.c has more) */
     ES_RUN(&r, dir, "ingest-landmarks", lstore, "--csv", lm, "--specimens", spec);
     ES_CHECK_MSG(r.status == 0 && strstr(r.out, "(landmarks only)"), "%s%s", r.out, r.err);
     unlink(lstore);

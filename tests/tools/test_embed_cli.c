@@ -176,6 +176,23 @@ int main(void)
     ES_CHECK_MSG(r.status == 0 && access(out, F_OK) == 0, "weights: %s", r.err);
     ES_RUN(&r, dir, "interp", store, "--weights", "0.5*row:mesh-0 +* row:mesh-1", "-o", out);
     ES_CHECK(r.status == 2);
+    /* a walk between rows that extrapolates out of edge-length space is
+     * refused naming t and the edge, as between points (rows used to clamp
+     * the lengths), and writes no frame */
+    {
+        char far[4300], first[4300];
+        snprintf(far, sizeof far, "%s/far_%%02d.obj", dir);
+        snprintf(first, sizeof first, "%s/far_00.obj", dir);
+        ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-1", "--t1",
+               "1e6", "--steps", "3", "-o", far, "--no-store");
+        ES_CHECK_MSG(r.status == 1 && strstr(r.err, "outside edge-length space") &&
+                     strstr(r.err, "t = ") && access(first, F_OK) != 0,
+                     "rows far out: %d %s", r.status, r.err);
+        ES_RUN(&r, dir, "interp", store, "--weights", "-1e6*row:mesh-0 + 1000001*row:mesh-1",
+               "-o", out, "--no-store");
+        ES_CHECK_MSG(r.status == 1 && strstr(r.err, "outside edge-length space"),
+                     "weights far out: %d %s", r.status, r.err);
+    }
     ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:nope", "-o", pat);
     ES_CHECK(r.status == 1 && strstr(r.err, "nope"));
     ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-1", "-o", out);

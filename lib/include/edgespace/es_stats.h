@@ -121,8 +121,8 @@ typedef struct es_pca {
  * passes): eigenvalues are never overestimated; with the defaults p = 10,
  * q = 4 the top eigenvalues are exact to rounding when the spectrum has a
  * gap after K + p, within ~1e-10 relative on a decaying spectrum and a few
- * 1e-4 on a nearly flat one (table in lib/pca_randomized.c, checked by
- * tests/test_pca.c).
+ * 1e-4 on a nearly flat one (table in lib/stats/pca_randomized.c, checked by
+ * tests/stats/test_pca.c).
  *
  * Components whose eigenvalue is below max(N, E) * eps * (largest) are
  * numerically zero and are not returned, so ncomp may be less than asked.
