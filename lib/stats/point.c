@@ -505,13 +505,25 @@ es_status es_point_eval(es_ctx *ctx, const es_point_expr *x, int64_t E,
                         es_point_resolve_fn resolve, void *ud, const es_mesh *mesh, double *vec,
                         es_point_info *info)
 {
+    return es_point_eval_rows(ctx, x, E, 0, resolve, ud, mesh, vec, NULL, info);
+}
+
+es_status es_point_eval_rows(es_ctx *ctx, const es_point_expr *x, int64_t E, int64_t nrows,
+                             es_point_resolve_fn resolve, void *ud, const es_mesh *mesh,
+                             double *vec, double *weights, es_point_info *info)
+{
     if (!x || !resolve || !vec || E < 1)
         ES_FAIL(ctx, ES_EINVAL, "point: nothing to evaluate");
+    if (weights && nrows < 1) ES_FAIL(ctx, ES_EINVAL, "point: row weights of %lld rows",
+                                      (long long)nrows);
+    if (!weights) nrows = 0;
     if (mesh && es_mesh_nedges(mesh) != E)
         ES_FAIL(ctx, ES_EMISMATCH, "point: %lld edges, the mesh has %lld", (long long)E,
                 (long long)es_mesh_nedges(mesh));
-    double *leaf = es__alloc_array(ctx, E, sizeof *leaf);
+    double *leaf = es__alloc_array(ctx, E + nrows, sizeof *leaf);
+    double *lw = weights ? leaf + E : NULL;   /* the leaf's row weights */
     if (!leaf) return ES_ENOMEM;
+    if (weights) memset(weights, 0, (size_t)nrows * sizeof *weights);
     es_point_info in;
     memset(&in, 0, sizeof in);
     in.scale = NAN;
@@ -520,7 +532,8 @@ es_status es_point_eval(es_ctx *ctx, const es_point_expr *x, int64_t E,
     for (int64_t i = 0; i < x->n; i++) {
         const term *t = &x->t[i];
         double s = NAN;
-        es_status rc = resolve(ctx, ud, t->kind, t->arg, t->index, leaf, &s);
+        if (lw) memset(lw, 0, (size_t)nrows * sizeof *lw);
+        es_status rc = resolve(ctx, ud, t->kind, t->arg, t->index, leaf, &s, lw);
         if (rc != ES_OK) {
             char msg[1024];
             snprintf(msg, sizeof msg, "%s", es_ctx_errmsg(ctx));
@@ -554,6 +567,7 @@ es_status es_point_eval(es_ctx *ctx, const es_point_expr *x, int64_t E,
             in.nshapes++;
         }
         for (int64_t e = 0; e < E; e++) vec[e] += c * leaf[e];
+        for (int64_t r = 0; r < nrows; r++) weights[r] += c * lw[r];
     }
     es__free(ctx, leaf);
     for (int64_t e = 0; e < E; e++) in.length_sum += vec[e];

@@ -453,9 +453,12 @@ void es_study_resolver_clear(es_ctx *ctx, es_study_resolver *r)
 {
     if (!r) return;
     es_pca_free(r->pca);
+    es_pca_free(r->all_rows);
     es__free(ctx, r->scales);
-    r->pca = NULL;
+    es__free(ctx, r->pca_rows);
+    r->pca = r->all_rows = NULL;
     r->scales = NULL;
+    r->pca_rows = NULL;
 }
 
 static es_status load_scales(es_ctx *ctx, es_study_resolver *r)
@@ -472,8 +475,91 @@ static es_status load_scales(es_ctx *ctx, es_study_resolver *r)
     return rc;
 }
 
+/* Row weights of a mesh file: ridge regression on every row (es_pca_row_weights
+ * on a PCA of all rows, fitted once per resolver). */
+static es_status file_weights(es_ctx *ctx, es_study_resolver *r, const double *len, double *w)
+{
+    es_status rc;
+    if (!r->all_rows) {
+        es_source src;
+        es_pca_opts o;
+        es_pca_opts_init(&o);
+        if ((rc = es_study_source(ctx, r->store, NULL, 0, &src)) != ES_OK ||
+            (rc = es_pca_fit(ctx, &src, &o, &r->all_rows)) != ES_OK)
+            return rc;
+    }
+    return es_pca_row_weights(ctx, r->all_rows, len, ES_RIDGE_REL, w);
+}
+
+static es_status resolve_pc(es_ctx *ctx, es_study_resolver *r, int64_t index, double *vec,
+                            double *scale, double *w)
+{
+    const int64_t E = es_store_nedges(r->store);
+    es_status rc;
+    int64_t n;
+    if (!r->pca &&
+        (rc = es_study_pca_load(ctx, r->store, r->pca_name, &r->pca, &r->pca_rows, &n)) != ES_OK)
+        return rc;
+    const es_pca *p = r->pca;
+    if (index < 1 || index > p->ncomp)
+        ES_FAIL(ctx, ES_ENOTFOUND, "the PCA has %lld components", (long long)p->ncomp);
+    memcpy(vec, p->components + (index - 1) * E, (size_t)E * sizeof *vec);
+    *scale = sqrt(p->eigenvalues[index - 1]);
+    /* u_k = X_c v_k / s_k = sum_i z_ik x_i / ((N - 1) lambda_k): the scores
+     * sum to 0, so the weights do too (a direction) */
+    if (w && p->nrows > 1 && p->eigenvalues[index - 1] > 0)
+        for (int64_t i = 0; i < p->nrows; i++)
+            w[r->pca_rows[i]] += p->scores[i + (index - 1) * p->nrows] /
+                                 ((double)(p->nrows - 1) * p->eigenvalues[index - 1]);
+    return ES_OK;
+}
+
+static es_status resolve_diff(es_ctx *ctx, es_study_resolver *r, const char *arg, double *vec,
+                              double *w)
+{
+    const int64_t E = es_store_nedges(r->store);
+    char p[PATH_MAX_LEN];
+    double *v = NULL;
+    int64_t n = 0, *from = NULL, *to = NULL, nf = 0, nt = 0;
+    es_status rc;
+    if (bad_name(arg)) ES_FAIL(ctx, ES_EINVAL, "bad difference name");
+    if ((rc = dpath(ctx, p, "diff", arg, "mean")) != ES_OK) return rc;
+    if (!es_store_has(r->store, p)) ES_FAIL(ctx, ES_ENOTFOUND, "no difference named '%s'", arg);
+    if ((rc = es_store_get_vector(ctx, r->store, p, &v, &n)) != ES_OK) return rc;
+    if (n != E) {
+        es_free(ctx, v);
+        ES_FAIL(ctx, ES_EFORMAT, "difference '%s' has %lld values, the store %lld edges", arg,
+                (long long)n, (long long)E);
+    }
+    memcpy(vec, v, (size_t)E * sizeof *vec);
+    es_free(ctx, v);
+    if (!w) return ES_OK;
+    /* the mean over pairs of (to - from) */
+    if ((rc = dpath(ctx, p, "diff", arg, "pair_from")) == ES_OK &&
+        (rc = es_store_get_ints(ctx, r->store, p, &from, &nf)) == ES_OK &&
+        (rc = dpath(ctx, p, "diff", arg, "pair_to")) == ES_OK &&
+        (rc = es_store_get_ints(ctx, r->store, p, &to, &nt)) == ES_OK) {
+        const int64_t N = es_store_nrows(r->store);
+        if (nf != nt || nf < 1) rc = es__fail(ctx, ES_EFORMAT, "difference '%s' has %lld "
+                                              "'from' and %lld 'to' rows", arg, (long long)nf,
+                                              (long long)nt);
+        for (int64_t k = 0; rc == ES_OK && k < nf; k++) {
+            if (from[k] < 0 || from[k] >= N || to[k] < 0 || to[k] >= N) {
+                rc = es__fail(ctx, ES_EFORMAT, "difference '%s' names a row outside the "
+                              "store", arg);
+                break;
+            }
+            w[to[k]] += 1.0 / (double)nf;
+            w[from[k]] -= 1.0 / (double)nf;
+        }
+    }
+    es_free(ctx, from);
+    es_free(ctx, to);
+    return rc;
+}
+
 es_status es_study_resolve(es_ctx *ctx, void *ud, es_point_leaf kind, const char *arg,
-                           int64_t index, double *vec, double *scale)
+                           int64_t index, double *vec, double *scale, double *w)
 {
     es_study_resolver *r = ud;
     es_store *st = r->store;
@@ -491,6 +577,7 @@ es_status es_study_resolve(es_ctx *ctx, void *ud, es_point_leaf kind, const char
             double s = 0;
             for (int64_t i = 0; i < n; i++) s += r->scales[rows[i]];
             *scale = s / (double)n;
+            for (int64_t i = 0; w && i < n; i++) w[rows[i]] += 1.0 / (double)n;
         }
         es__free(ctx, rows);
         return rc;
@@ -502,6 +589,7 @@ es_status es_study_resolve(es_ctx *ctx, void *ud, es_point_leaf kind, const char
             (rc = es_store_read_lengths(ctx, st, row, 1, (es_mat){vec, E, 1, E})) != ES_OK)
             return rc;
         *scale = r->scales[row];
+        if (w) w[row] += 1;
         return ES_OK;
     }
     case ES_POINT_FILE:
@@ -509,49 +597,32 @@ es_status es_study_resolve(es_ctx *ctx, void *ud, es_point_leaf kind, const char
             ES_FAIL(ctx, ES_EINVAL, "store '%s' has no faces (a %s store), so mesh files "
                     "cannot be matched to it", es_store_path(r->store),
                     es_topology_kind_name(es_store_topology_kind(r->store)));
-        return es_lengths_from_file(ctx, r->mesh, arg, vec, scale);
+        if ((rc = es_lengths_from_file(ctx, r->mesh, arg, vec, scale)) != ES_OK) return rc;
+        return w ? file_weights(ctx, r, vec, w) : ES_OK;
     case ES_POINT_PC:
-        if (!r->pca && (rc = es_study_pca_load(ctx, st, r->pca_name, &r->pca, NULL, NULL)) != ES_OK)
-            return rc;
-        if (index < 1 || index > r->pca->ncomp)
-            ES_FAIL(ctx, ES_ENOTFOUND, "the PCA has %lld components", (long long)r->pca->ncomp);
-        memcpy(vec, r->pca->components + (index - 1) * E, (size_t)E * sizeof *vec);
-        *scale = sqrt(r->pca->eigenvalues[index - 1]);
-        return ES_OK;
-    case ES_POINT_DIFF: {
-        char p[PATH_MAX_LEN];
-        double *v = NULL;
-        int64_t n = 0;
-        if (bad_name(arg)) ES_FAIL(ctx, ES_EINVAL, "bad difference name");
-        if ((rc = dpath(ctx, p, "diff", arg, "mean")) != ES_OK) return rc;
-        if (!es_store_has(st, p)) ES_FAIL(ctx, ES_ENOTFOUND, "no difference named '%s'", arg);
-        if ((rc = es_store_get_vector(ctx, st, p, &v, &n)) != ES_OK) return rc;
-        if (n != E) {
-            es_free(ctx, v);
-            ES_FAIL(ctx, ES_EFORMAT, "difference '%s' has %lld values, the store %lld edges", arg,
-                    (long long)n, (long long)E);
-        }
-        memcpy(vec, v, (size_t)E * sizeof *vec);
-        es_free(ctx, v);
-        return ES_OK;
-    }
+        return resolve_pc(ctx, r, index, vec, scale, w);
+    case ES_POINT_DIFF:
+        return resolve_diff(ctx, r, arg, vec, w);
     }
     ES_FAIL(ctx, ES_EINVAL, "unknown leaf kind %d", (int)kind);
 }
 
 es_status es_study_point(es_ctx *ctx, es_store *store, const char *name, const char *expr,
-                            const char *pca_name, double scale, const char *command, double **vec,
-                            es_point_info *info)
+                         const char *pca_name, double scale, const char *command, double **vec,
+                         double *weights, es_point_info *info)
 {
     es_point_expr *x = NULL;
     es_mesh *mesh = NULL;
     es_point_info in;
-    es_study_resolver r = {store, NULL, pca_name, NULL, NULL};
+    es_study_resolver r = {store, NULL, pca_name, NULL, NULL, NULL, NULL};
     if (vec) *vec = NULL;
     CHECK_NAME(ctx, name);
     NEED_EDGES(ctx, store);
-    const int64_t E = es_store_nedges(store);
-    double *v = es__alloc_array(ctx, E, sizeof *v);
+    const int64_t E = es_store_nedges(store), N = es_store_nrows(store);
+    /* the row weights are stored with a named point */
+    const int want_w = weights || name;
+    double *v = es__alloc_array(ctx, E + (want_w ? N : 0), sizeof *v);
+    double *w = want_w ? v + E : NULL;
     if (!v) return ES_ENOMEM;
     es_status rc;
     if ((rc = es_point_parse(ctx, expr, &x)) != ES_OK ||
@@ -561,7 +632,9 @@ es_status es_study_point(es_ctx *ctx, es_store *store, const char *name, const c
      * recorded as valid = "unchecked"). A store without edges fails in
      * es_point_eval's reads with the store's message. */
     r.mesh = mesh;
-    if ((rc = es_point_eval(ctx, x, E, es_study_resolve, &r, mesh, v, &in)) != ES_OK) goto done;
+    if ((rc = es_point_eval_rows(ctx, x, E, w ? N : 0, es_study_resolve, &r, mesh, v, w,
+                                 &in)) != ES_OK)
+        goto done;
     if (scale > 0) in.scale = scale;
     if (name) {
         char p[PATH_MAX_LEN], buf[64];
@@ -570,7 +643,9 @@ es_status es_study_point(es_ctx *ctx, es_store *store, const char *name, const c
             (rc = dpath(ctx, p, "point", name, "lengths")) != ES_OK ||
             (rc = es_store_put_vector(ctx, store, p, v, E)) != ES_OK ||
             (rc = dpath(ctx, p, "point", name, "scale")) != ES_OK ||
-            (rc = es_store_put_vector(ctx, store, p, &in.scale, 1)) != ES_OK)
+            (rc = es_store_put_vector(ctx, store, p, &in.scale, 1)) != ES_OK ||
+            (rc = dpath(ctx, p, "point", name, "row_weights")) != ES_OK ||
+            (rc = es_store_put_vector(ctx, store, p, w, N)) != ES_OK)
             goto done;
         snprintf(p, sizeof p, "point/%s", name);
         struct { const char *k; char v[64]; } at[6];
@@ -589,9 +664,16 @@ es_status es_study_point(es_ctx *ctx, es_store *store, const char *name, const c
             if ((rc = es_store_put_attr(ctx, store, p, at[i].k, at[i].v)) != ES_OK) goto done;
     }
     if (info) *info = in;
+    if (weights) memcpy(weights, w, (size_t)N * sizeof *weights);
     if (vec) {
-        *vec = v;
-        v = NULL;
+        /* the caller owns the lengths: a block of its own, not the weights' */
+        double *out = es__alloc_array(ctx, E, sizeof *out);
+        if (!out) {
+            rc = ES_ENOMEM;
+            goto done;
+        }
+        memcpy(out, v, (size_t)E * sizeof *out);
+        *vec = out;
     }
 done:
     es_study_resolver_clear(ctx, &r);

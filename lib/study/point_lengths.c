@@ -22,7 +22,7 @@ static es_status mean_row_scale(es_ctx *ctx, es_store *store, double *scale)
 }
 
 static es_status row_point(es_ctx *ctx, es_store *store, const char *id, double *lengths,
-                           double *scale)
+                           double *scale, double *w)
 {
     int64_t r = es_store_find_row(store, id), ne = es_store_nedges(store);
     double *scales;
@@ -34,11 +34,42 @@ static es_status row_point(es_ctx *ctx, es_store *store, const char *id, double 
         (rc = es_store_read_scales(ctx, store, scales)) == ES_OK)
         *scale = scales[r];
     es__free(ctx, scales);
+    if (w) w[r] = 1;
+    return rc;
+}
+
+/* A stored point's row weights, or (stored before points kept them) ridge
+ * regression on the rows. */
+static es_status stored_weights(es_ctx *ctx, es_store *store, const char *name,
+                                const double *lengths, double *w)
+{
+    char path[512];
+    double *v = NULL;
+    int64_t n = 0, N = es_store_nrows(store);
+    es_status rc;
+    snprintf(path, sizeof path, "point/%s/row_weights", name);
+    if (!es_store_has(store, path)) {
+        es_study_resolver r = {store, NULL, NULL, NULL, NULL, NULL, NULL};
+        es_source src;
+        es_pca_opts o;
+        es_pca_opts_init(&o);
+        if ((rc = es_study_source(ctx, store, NULL, 0, &src)) == ES_OK &&
+            (rc = es_pca_fit(ctx, &src, &o, &r.all_rows)) == ES_OK)
+            rc = es_pca_row_weights(ctx, r.all_rows, lengths, ES_RIDGE_REL, w);
+        es_study_resolver_clear(ctx, &r);
+        return rc;
+    }
+    if ((rc = es_store_get_vector(ctx, store, path, &v, &n)) != ES_OK) return rc;
+    if (n != N) rc = es__fail(ctx, ES_EMISMATCH, "point '%s' has weights for %lld rows, the "
+                              "store has %lld (rows were added since it was stored)", name,
+                              (long long)n, (long long)N);
+    else memcpy(w, v, (size_t)N * sizeof *w);
+    es__free(ctx, v);
     return rc;
 }
 
 static es_status stored_point(es_ctx *ctx, es_store *store, const char *name, double *lengths,
-                              double *scale)
+                              double *scale, double *w)
 {
     char path[512];
     double *v = NULL;
@@ -59,26 +90,35 @@ static es_status stored_point(es_ctx *ctx, es_store *store, const char *name, do
         n >= 1 && v[0] > 0)
         *scale = v[0];
     es__free(ctx, v);
+    if (rc == ES_OK && w) rc = stored_weights(ctx, store, name, lengths, w);
     return rc;
 }
 
 es_status es_study_point_lengths(es_ctx *ctx, es_store *store, const char *spec,
                                  const char *pca_name, double *lengths, double *scale)
 {
+    return es_study_point_weights(ctx, store, spec, pca_name, lengths, scale, NULL);
+}
+
+es_status es_study_point_weights(es_ctx *ctx, es_store *store, const char *spec,
+                                 const char *pca_name, double *lengths, double *scale,
+                                 double *w)
+{
     char path[512];
     int64_t ne = es_store_nedges(store);
     es_status rc;
     *scale = 0;
     if (!spec || !*spec) ES_FAIL(ctx, ES_EINVAL, "no point given");
+    if (w) memset(w, 0, (size_t)es_store_nrows(store) * sizeof *w);
     snprintf(path, sizeof path, "point/%s/lengths", spec);
     if (!strncmp(spec, "row:", 4)) {
-        rc = row_point(ctx, store, spec + 4, lengths, scale);
+        rc = row_point(ctx, store, spec + 4, lengths, scale, w);
     } else if (es_store_has(store, path)) {
-        rc = stored_point(ctx, store, spec, lengths, scale);
+        rc = stored_point(ctx, store, spec, lengths, scale, w);
     } else {   /* an expression (es_point.h syntax) */
         es_point_info info;
         double *v = NULL;
-        if ((rc = es_study_point(ctx, store, NULL, spec, pca_name, 0, "edgespace", &v,
+        if ((rc = es_study_point(ctx, store, NULL, spec, pca_name, 0, "edgespace", &v, w,
                                  &info)) == ES_OK) {
             memcpy(lengths, v, (size_t)ne * sizeof *lengths);
             if (isfinite(info.scale) && info.scale > 0) *scale = info.scale;

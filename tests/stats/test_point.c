@@ -9,36 +9,44 @@
 enum { E = 4 };
 
 /* A resolver without a store: rows a (scale 10), b (scale 20), mean (scale
- * 15, or 12 for mean[g=x]), pc:k = unit vector k with sd 0.5 k, diff:d. */
+ * 15, or 12 for mean[g=x]), pc:k = unit vector k with sd 0.5 k, diff:d.
+ * Row weights over three rows: a = row 0, b = row 1, mean = all three,
+ * pc:k = k (1, -1, 0), diff = row 1 - row 0, file = (0.2, 0.3, 0.5). */
 static es_status resolve(es_ctx *ctx, void *ud, es_point_leaf kind, const char *arg,
-                         int64_t index, double *v, double *scale)
+                         int64_t index, double *v, double *scale, double *w)
 {
     int *calls = ud;
+    double dummy[3];
     (*calls)++;
     memset(v, 0, E * sizeof *v);
+    if (!w) w = dummy;
     switch (kind) {
     case ES_POINT_MEAN:
         for (int e = 0; e < E; e++) v[e] = 0.25;
         *scale = 15;
+        w[0] = w[1] = w[2] = 1.0 / 3;
         if (!strcmp(arg, "g=x,h=y-1")) v[0] = 0.4, v[1] = 0.1, *scale = 12;
         else if (*arg) ES_FAIL(ctx, ES_ENOTFOUND, "no rows match '%s'", arg);
         return ES_OK;
     case ES_POINT_ROW:
-        if (!strcmp(arg, "a")) { v[0] = 0.1; v[1] = 0.2; v[2] = 0.3; v[3] = 0.4; *scale = 10; return ES_OK; }
-        if (!strcmp(arg, "s-1.b_2")) { v[0] = 0.4; v[1] = 0.3; v[2] = 0.2; v[3] = 0.1; *scale = 20; return ES_OK; }
+        if (!strcmp(arg, "a")) { v[0] = 0.1; v[1] = 0.2; v[2] = 0.3; v[3] = 0.4; *scale = 10; w[0] = 1; return ES_OK; }
+        if (!strcmp(arg, "s-1.b_2")) { v[0] = 0.4; v[1] = 0.3; v[2] = 0.2; v[3] = 0.1; *scale = 20; w[1] = 1; return ES_OK; }
         ES_FAIL(ctx, ES_ENOTFOUND, "no such row");
     case ES_POINT_FILE:
         for (int e = 0; e < E; e++) v[e] = 0.25;
         *scale = 30;
+        w[0] = 0.2, w[1] = 0.3, w[2] = 0.5;
         return ES_OK;
     case ES_POINT_PC:
         if (index > E) ES_FAIL(ctx, ES_ENOTFOUND, "only %d components", E);
         v[index - 1] = 1;
         *scale = 0.5 * (double)index;
+        w[0] = (double)index, w[1] = -(double)index;
         return ES_OK;
     case ES_POINT_DIFF:
         v[0] = 0.01;
         v[1] = -0.01;
+        w[0] = -1, w[1] = 1;
         return ES_OK;
     }
     return ES_EINVAL;
@@ -208,12 +216,39 @@ static void test_errors(es_ctx *ctx)
     ES_CHECK_FAILS(ctx, es_point_parse(ctx, deep, &x), ES_EFORMAT, "nested too deeply");
 }
 
+/* Row weights follow the combination: each leaf's weights times its
+ * coefficient (and a component's standard deviation), so the weights of a
+ * point are those of the same expression over the rows. */
+static void test_row_weights(es_ctx *ctx)
+{
+    static const struct { const char *text; double w[3]; } cases[] = {
+        {"row:a", {1, 0, 0}},
+        {"lerp(row:a, row:s-1.b_2, 0.25)", {0.75, 0.25, 0}},
+        {"mean + 2*pc:1", {1.0 / 3 + 1, 1.0 / 3 - 1, 1.0 / 3}},   /* 2 x sd 0.5 x (1, -1, 0) */
+        {"mean - pc:2", {1.0 / 3 - 2, 1.0 / 3 + 2, 1.0 / 3}},      /* sd 1 x 2 (1, -1, 0) */
+        {"row:a + 0.5*diff:d", {0.5, 0.5, 0}},
+        {"0.5*file:x.obj + 0.5*mean", {0.1 + 1.0 / 6, 0.15 + 1.0 / 6, 0.25 + 1.0 / 6}},
+    };
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        es_point_expr *x = NULL;
+        int calls = 0;
+        double v[E], w[3] = {9, 9, 9};
+        ES_CHECK_OK(ctx, es_point_parse(ctx, cases[c].text, &x));
+        if (!x) continue;
+        ES_CHECK_OK(ctx, es_point_eval_rows(ctx, x, E, 3, resolve, &calls, NULL, v, w, NULL));
+        for (int i = 0; i < 3; i++)
+            ES_CHECK_MSG(fabs(w[i] - cases[c].w[i]) < 1e-14, "%s: w[%d] = %.17g, want %.17g",
+                         cases[c].text, i, w[i], cases[c].w[i]);
+        es_point_expr_free(x);
+    }
+}
+
 /* Validity: on one triangle, interpolating two valid rows stays valid,
  * extrapolating far enough breaks the triangle inequality. */
 static es_status resolve_tri(es_ctx *ctx, void *ud, es_point_leaf kind, const char *arg,
-                             int64_t index, double *v, double *scale)
+                             int64_t index, double *v, double *scale, double *w)
 {
-    (void)ud, (void)index;
+    (void)ud, (void)index, (void)w;
     if (kind != ES_POINT_ROW) ES_FAIL(ctx, ES_EINVAL, "rows only");
     const double eq[3] = {1.0 / 3, 1.0 / 3, 1.0 / 3}, flat[3] = {0.25, 0.25, 0.5};
     memcpy(v, !strcmp(arg, "eq") ? eq : flat, sizeof eq);
@@ -282,6 +317,7 @@ int main(void)
     test_eval(ctx);
     test_errors(ctx);
     test_validity(ctx);
+    test_row_weights(ctx);
     test_alloc_failures(ctx);
     es_ctx_free(ctx);
     ES_TEST_END();

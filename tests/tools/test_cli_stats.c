@@ -233,11 +233,11 @@ int main(void)
                        ES_ENOTFOUND, "no PCA named 'missing'");
         ES_CHECK_FAILS(ctx, es_study_pca_load(ctx, st, NULL, &pp, NULL, NULL), ES_ENOTFOUND,
                        "several PCAs");
-        ES_CHECK_FAILS(ctx, es_study_point(ctx, st, NULL, "mean + pc:1", NULL, 0, NULL, NULL,
+        ES_CHECK_FAILS(ctx, es_study_point(ctx, st, NULL, "mean + pc:1", NULL, 0, NULL, NULL, NULL,
                                               NULL), ES_ENOTFOUND, "point: pc:1: pca: several");
-        ES_CHECK_FAILS(ctx, es_study_point(ctx, st, NULL, "mean + pc:99", "p", 0, NULL, NULL,
+        ES_CHECK_FAILS(ctx, es_study_point(ctx, st, NULL, "mean + pc:99", "p", 0, NULL, NULL, NULL,
                                               NULL), ES_ENOTFOUND, "the PCA has 12 components");
-        ES_CHECK_FAILS(ctx, es_study_point(ctx, st, NULL, "diff:frown", NULL, 0, NULL, NULL,
+        ES_CHECK_FAILS(ctx, es_study_point(ctx, st, NULL, "diff:frown", NULL, 0, NULL, NULL, NULL,
                                               NULL), ES_ENOTFOUND, "no difference named 'frown'");
         snprintf(path, sizeof path, "%s/other.obj", dir);
         FILE *o = fopen(path, "w");
@@ -247,7 +247,7 @@ int main(void)
         }
         char expr[600];
         snprintf(expr, sizeof expr, "file:%s", path);
-        ES_CHECK_FAILS(ctx, es_study_point(ctx, st, NULL, expr, NULL, 0, NULL, NULL, NULL),
+        ES_CHECK_FAILS(ctx, es_study_point(ctx, st, NULL, expr, NULL, 0, NULL, NULL, NULL, NULL),
                        ES_EMISMATCH, "do not match the store's topology");
         snprintf(path, sizeof path, "%s/study.h5", dir);
         es_free(ctx, pt);

@@ -63,7 +63,8 @@ int cmd_point(int argc, char **argv)
     int ret = CLI_FAIL;
     es_status rc = es_store_open(ctx, argv[optind], name ? ES_STORE_WRITE : ES_STORE_READ, &st);
     if (rc == ES_OK)
-        rc = es_study_point(ctx, st, name, argv[optind + 1], pca, scale, cmdline, &vec, &info);
+        rc = es_study_point(ctx, st, name, argv[optind + 1], pca, scale, cmdline, &vec, NULL,
+                            &info);
     if (rc != ES_OK) {
         cli_fail("point", ctx, rc);
         goto done;

@@ -64,10 +64,17 @@ ES_API void es_point_expr_term(const es_point_expr *expr, int64_t i, double *coe
  *  PC: the unit component K, and *scale = its standard deviation
  *    (sqrt of the eigenvalue), by which the evaluator multiplies it;
  *  DIFF: the difference vector; *scale is ignored.
+ * weights: NULL, or the nrows entries given to es_point_eval_rows, zero on
+ *    entry: the leaf as a combination of the stored rows it comes from,
+ *    vec ~ sum_i weights[i] row_i (normalized lengths), exactly for means,
+ *    rows, components and differences, by ridge regression for a file. A
+ *    shape's weights sum to 1, a direction's to 0. Evaluating them costs
+ *    nothing extra for most leaves, so the embedding can apply the same
+ *    weights to the rows' dihedrals and positions (its prior).
  * Return ES_OK or a status with a message on ctx (e.g. ES_ENOTFOUND). */
 typedef es_status (*es_point_resolve_fn)(es_ctx *ctx, void *userdata, es_point_leaf kind,
                                          const char *arg, int64_t index, double *vec,
-                                         double *scale);
+                                         double *scale, double *weights);
 
 typedef struct es_point_info {
     double weight;        /* sum of the coefficients of the shape leaves */
@@ -88,6 +95,15 @@ typedef struct es_point_info {
 ES_API es_status es_point_eval(es_ctx *ctx, const es_point_expr *expr, int64_t nedges,
                                es_point_resolve_fn resolve, void *userdata,
                                const es_mesh *mesh, double *vec, es_point_info *info);
+
+/* The same, carrying the leaves' row weights through the combination:
+ * weights (nrows) = sum_i c_i weights(leaf_i), with each pc:K's standard
+ * deviation applied as to its vector. nrows 0 and weights NULL: as
+ * es_point_eval. */
+ES_API es_status es_point_eval_rows(es_ctx *ctx, const es_point_expr *expr, int64_t nedges,
+                                    int64_t nrows, es_point_resolve_fn resolve,
+                                    void *userdata, const es_mesh *mesh, double *vec,
+                                    double *weights, es_point_info *info);
 
 #ifdef __cplusplus
 }

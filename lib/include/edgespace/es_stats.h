@@ -147,6 +147,21 @@ ES_API es_status es_pca_from_arrays(es_ctx *ctx, int64_t nedges, int64_t ncomp,
 ES_API es_status es_pca_project(es_ctx *ctx, const es_pca *pca, es_mat X, double *scores,
                                 double *residual);
 
+/* Row weights w (N, the rows the PCA was fitted on) that reproduce x from
+ * those rows: w = 1/N + sum_k z_k (u_k . (x - mean)) / ((N - 1) lambda_k +
+ * ridge), z_k the scores of component k. With every component kept and
+ * ridge 0 this is the least-squares combination sum_i w_i x_i = x for x in
+ * the rows' affine span (minimum norm, sum w = 1); ridge > 0 shrinks the
+ * weights of components with little variance (ridge regression on the
+ * rows, Hoerl & Kennard 1970), which keeps a point outside the span (a new
+ * mesh) from getting wild weights. ridge_rel sets ridge = ridge_rel x
+ * (N - 1) x total_variance / N, a fraction of the mean eigenvalue's
+ * weight; ES_RIDGE_REL is the default the study uses. x NULL: the mean
+ * (w = 1/N). */
+#define ES_RIDGE_REL 1e-3
+ES_API es_status es_pca_row_weights(es_ctx *ctx, const es_pca *pca, const double *x,
+                                    double ridge_rel, double *w);
+
 /* ---- paired differences -------------------------------------------------- */
 
 /* Roles of rows in a paired difference. */

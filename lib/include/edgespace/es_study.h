@@ -89,25 +89,36 @@ ES_API es_status es_study_diff(es_ctx *ctx, es_store *store, const char *name,
 
 /* Resolver of point leaves on a store (es_point_resolve_fn with userdata =
  * an es_study_resolver). pca_name: the PCA of pc:K (NULL: as
- * es_study_pca_load). mesh: the store's topology, for file: leaves. */
+ * es_study_pca_load). mesh: the store's topology, for file: leaves. Row
+ * weights (es_point_eval_rows, nrows = es_store_nrows) are: 1/n on the rows
+ * of a mean, 1 on a row, z_k / ((N - 1) lambda_k) on the PCA's rows for
+ * pc:K (its standard deviation applied by the evaluator), +-1/P on the pairs
+ * of a difference, and for a file ridge regression on every row
+ * (es_pca_row_weights with ES_RIDGE_REL, on a PCA of all rows fitted once
+ * per resolver). */
 typedef struct es_study_resolver {
     es_store *store;
     const es_mesh *mesh;
     const char *pca_name;
     es_pca *pca;        /* loaded on first use; free with es_study_resolver_clear */
     double *scales;     /* all row scales, loaded on first use */
+    int64_t *pca_rows;  /* the store rows of pca's scores */
+    es_pca *all_rows;   /* a PCA of every row, for the weights of file: leaves */
 } es_study_resolver;
 ES_API es_status es_study_resolve(es_ctx *ctx, void *resolver, es_point_leaf kind,
-                                  const char *arg, int64_t index, double *vec, double *scale);
+                                  const char *arg, int64_t index, double *vec, double *scale,
+                                  double *weights);
 ES_API void es_study_resolver_clear(es_ctx *ctx, es_study_resolver *r);
 
 /* Evaluate `expr` on the store (validity against the store's topology) and,
- * when name is non-NULL, store it as point/<name>. scale > 0 overrides the
- * scale rule of es_point.h. *vec (may be NULL) gets the lengths (es_free);
- * info (may be NULL) the report. */
+ * when name is non-NULL, store it as point/<name> (its lengths, scale and
+ * row weights). scale > 0 overrides the scale rule of es_point.h. *vec (may
+ * be NULL) gets the lengths (es_free); weights (may be NULL) the row weights
+ * (es_store_nrows entries); info (may be NULL) the report. */
 ES_API es_status es_study_point(es_ctx *ctx, es_store *store, const char *name,
-                                   const char *expr, const char *pca_name, double scale,
-                                   const char *command, double **vec, es_point_info *info);
+                                const char *expr, const char *pca_name, double scale,
+                                const char *command, double **vec, double *weights,
+                                es_point_info *info);
 
 /* The E scale-normalized lengths of a point as a command line names it:
  * "row:ID", the name of a stored point (/analysis/point/NAME), or an
@@ -118,6 +129,12 @@ ES_API es_status es_study_point(es_ctx *ctx, es_store *store, const char *name,
  * realizes the point. */
 ES_API es_status es_study_point_lengths(es_ctx *ctx, es_store *store, const char *spec,
                                         const char *pca_name, double *lengths, double *scale);
+/* The same with the point's row weights (es_store_nrows entries; see
+ * es_study_resolver): a stored point's own, or, for one stored without
+ * them, ridge regression on the rows. */
+ES_API es_status es_study_point_weights(es_ctx *ctx, es_store *store, const char *spec,
+                                        const char *pca_name, double *lengths, double *scale,
+                                        double *weights);
 
 /* ---- tables -----------------------------------------------------------------
  * CSV files of results, with the labels a reader needs; every file is
