@@ -1,6 +1,8 @@
 /* tests/common/test_images.c — see test_images.h. */
 #include "test_images.h"
 
+#include <math.h>
+
 const char *tp_path(const char *sub, const char *name)
 {
     static char buf[8][2 * 4096 + 2]; /* room for dir + "/" + name */
