@@ -1,7 +1,9 @@
-/* lib/figure/figure_pkg.h — what plot.c, plot_canvas.c and render.c share: an
- * output canvas (a cairo surface chosen by the file extension), text,
- * axes with nice ticks, legends and colour bars. Only these files include
- * cairo.h. Never installed.
+/* lib/figure/figure_pkg.h — what the files of lib/figure share: an output
+ * canvas (a cairo surface chosen by the file extension), text, axes with
+ * nice ticks, legends and colour bars (plot.c, plot_canvas.c, render.c: the
+ * only files that draw), and the reading of numbers from CSV cells
+ * (table_figure.c, render_files.c). Only lib/figure includes cairo.h.
+ * Never installed.
  */
 #ifndef EDGESPACE_FIGURE_PKG_H
 #define EDGESPACE_FIGURE_PKG_H
@@ -88,5 +90,11 @@ double es__colorbar_width(cairo_t *cr, double w, double vmin, double vmax,
  * (symmetric about 0 for diverging maps); a degenerate range is widened. */
 void es__color_range(es_colormap cmap, const double *v, int64_t n, double *vmin,
                      double *vmax);
+
+/* A CSV cell as a number for the figures: blanks around it are ignored; an
+ * empty cell, "nan" or "na" (any case) is a missing value, NaN; anything
+ * strtod reads whole is its value. 0 for a number or a missing value, -1
+ * for text (*v is then 0). */
+int es__figure_cell_number(const char *s, double *v);
 
 #endif

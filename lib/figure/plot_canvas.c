@@ -65,6 +65,15 @@ void es_colormap_rgb(es_colormap map, double t, double rgb[3])
     }
 }
 
+int es_colormap_from_name(const char *name)
+{
+    static const char *const names[] = {"viridis", "rdbu", "greys"};
+    static const es_colormap maps[] = {ES_CMAP_VIRIDIS, ES_CMAP_RDBU, ES_CMAP_GREYS};
+    for (int k = 0; name && k < 3; k++)
+        if (!strcmp(name, names[k])) return (int)maps[k];
+    return -1;
+}
+
 void es_palette_rgb(int64_t i, double rgb[3])
 {
     if (i < 0) i = -i;

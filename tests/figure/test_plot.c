@@ -1,11 +1,15 @@
 /* tests/figure/test_plot.c — the figures of es_plot.h: nice ticks, colour maps,
  * valid PNG/SVG/PDF output of every plot kind, scatter points and heat-map
- * cells where the returned es_plot_info says they are, error paths. */
+ * cells where the returned es_plot_info says they are, error paths; the
+ * figures of a CSV table (es_figure_table, es_figure.h) read back from PNG,
+ * and its messages naming file, line and column. */
 #include "core/core_private.h"
 #include "es_test.h"
 #include "es_test_alloc.h"
+#include "es_test_files.h"
 #include "test_images.h"
 
+#include <edgespace/es_figure.h>
 #include <edgespace/es_plot.h>
 #include <sys/wait.h>
 
@@ -364,6 +368,293 @@ static void test_alloc_failures(es_ctx *ctx)
     }
 }
 
+/* ---- es_figure_table: figures of a CSV table ------------------------------ */
+
+enum { TN = 12 };
+
+/* Row i of the test table: x = i, y = 2 (i % 3) + i / 10, var = 10 / (i + 1);
+ * row 5 has no PC2 (an empty cell), and a blank line follows row 6. */
+static double tx(int i) { return i; }
+static double ty(int i) { return 2 * (i % 3) + 0.1 * i; }
+static double tvar(int i) { return 10.0 / (i + 1); }
+static const char *tgroup(int i) { return i % 3 == 0 ? "neutral" : i % 3 == 1 ? "happy" : "angry"; }
+
+static void write_table(const char *path)
+{
+    FILE *f = fopen(path, "w");
+    ES_CHECK(f != NULL);
+    if (!f) return;
+    fputs("subject,expression,PC1,PC2,var\n", f);
+    for (int i = 0; i < TN; i++) {
+        if (i == 5) fprintf(f, "s%03d,%s,%g,,%.17g\n", i, tgroup(i), tx(i), tvar(i));
+        else fprintf(f, "s%03d,%s,%g,%.17g,%.17g\n", i, tgroup(i), tx(i), ty(i), tvar(i));
+        if (i == 6) fputs("\n", f);
+    }
+    fclose(f);
+}
+
+/* Scatter coloured by category: every point's centre pixel has its group's
+ * palette colour (groups in order of first appearance); the missing PC2 is
+ * skipped; columns by number draw the same picture as by name. */
+static void test_table_scatter(es_ctx *ctx, const char *csv)
+{
+    char png[4200], png2[4200];
+    snprintf(png, sizeof png, "%s", tp_path("plot", "table_scatter.png"));
+    snprintf(png2, sizeof png2, "%s", tp_path("plot", "table_scatter_bynumber.png"));
+    static const char *const ycol[1] = {"PC2"};
+    es_figure_table_spec s;
+    es_figure_table_spec_init(&s);
+    ES_CHECK(s.kind == ES_TABLE_SCATTER && s.frame.width == 640 && s.frame.height == 480);
+    s.x = "PC1";
+    s.ny = 1;
+    s.y = ycol;
+    s.label = "expression";
+    es_plot_info info;
+    ES_CHECK_OK(ctx, es_figure_table(ctx, &s, csv, png, &info));
+    ES_CHECK(info.n_skipped == 1);
+    ES_CHECK(info.xmin <= 0 && info.xmax >= TN - 1 && info.ymin <= ty(0) && info.ymax >= ty(11));
+    tp_image im;
+    ES_CHECK(tp_load(png, &im) == 0);
+    if (im.s) {
+        ES_CHECK(im.w == 640 && im.h == 480);
+        int ok = 0;
+        for (int i = 0; i < TN; i++) {
+            if (i == 5) continue;
+            double px, py, rgb[3], want[3];
+            es_plot_info_to_device(&info, tx(i), ty(i), &px, &py);
+            es_palette_rgb(i % 3, want); /* neutral, happy, angry: first seen in that order */
+            tp_rgb(&im, (int)floor(px), (int)floor(py), rgb);
+            ok += tp_dist(rgb, want) < 0.08;
+        }
+        ES_CHECK_MSG(ok == TN - 1, "%d of %d table points found at their pixel", ok, TN - 1);
+        tp_free(&im);
+    }
+    static const char *const ynum[1] = {"4"};
+    s.x = "3";
+    s.y = ynum;
+    s.label = "2";
+    ES_CHECK_OK(ctx, es_figure_table(ctx, &s, csv, png2, NULL));
+    size_t n1 = 0, n2 = 0;
+    char *a = es_test_slurp(png, &n1), *b = es_test_slurp(png2, &n2);
+    ES_CHECK_MSG(a && b && n1 == n2 && !memcmp(a, b, n1), "columns by number differ from names");
+    free(a);
+    free(b);
+    const char *svg = tp_path("plot", "table_scatter.svg");
+    ES_CHECK_OK(ctx, es_figure_table(ctx, &s, csv, svg, NULL));
+    ES_CHECK(tp_file_has(svg, "<?xml", "<svg"));
+}
+
+/* Lines against PC1 (one series per y column), scree of var, histogram of var. */
+static void test_table_lines_scree_hist(es_ctx *ctx, const char *csv)
+{
+    static const char *const ycols[2] = {"PC2", "var"};
+    es_figure_table_spec s;
+    es_plot_info info;
+    tp_image im;
+    double px, py, rgb[3], want[3];
+    es_figure_table_spec_init(&s);
+    s.kind = ES_TABLE_LINES;
+    s.x = "PC1";
+    s.ny = 2;
+    s.y = ycols;
+    const char *png = tp_path("plot", "table_lines.png");
+    ES_CHECK_OK(ctx, es_figure_table(ctx, &s, csv, png, &info));
+    ES_CHECK(info.n_skipped == 1 && !info.logy);
+    ES_CHECK(info.ymax >= tvar(0) && info.xmax >= TN - 1);
+    ES_CHECK(tp_load(png, &im) == 0);
+    if (im.s) {
+        /* the second series' marker at x = 0, far above the first's */
+        es_plot_info_to_device(&info, tx(0), tvar(0), &px, &py);
+        es_palette_rgb(1, want);
+        tp_rgb(&im, (int)floor(px) + 1, (int)floor(py), rgb);
+        ES_CHECK_MSG(tp_dist(rgb, want) < 0.15, "lines: %g %g %g", rgb[0], rgb[1], rgb[2]);
+        tp_free(&im);
+    }
+    s.logy = 1;
+    s.x = NULL; /* row numbers 1..n */
+    ES_CHECK_OK(ctx, es_figure_table(ctx, &s, csv, tp_path("plot", "table_lines_log.png"), &info));
+    ES_CHECK(info.logy && info.xmin <= 1 && info.xmax >= TN && info.xmax < TN + 3);
+
+    es_figure_table_spec_init(&s);
+    s.kind = ES_TABLE_SCREE;
+    s.ny = 1;
+    s.y = ycols + 1;
+    png = tp_path("plot", "table_scree.png");
+    ES_CHECK_OK(ctx, es_figure_table(ctx, &s, csv, png, &info));
+    ES_CHECK(info.ymin == 0 && info.ymax == 100);
+    double sum = 0;
+    for (int i = 0; i < TN; i++) sum += tvar(i);
+    ES_CHECK(tp_load(png, &im) == 0);
+    if (im.s) {
+        /* inside the first bar, below its top (10 / sum of the total) */
+        es_plot_info_to_device(&info, 1, 100 * tvar(0) / sum - 3, &px, &py);
+        tp_rgb(&im, (int)px + 3, (int)py, rgb);
+        es_palette_rgb(0, want);
+        ES_CHECK(tp_dist(rgb, want) < 0.05);
+        tp_free(&im);
+    }
+
+    s.kind = ES_TABLE_HISTOGRAM;
+    s.bins = 4; /* [0.83, 10] in 4: 10 values in the first bin */
+    png = tp_path("plot", "table_histogram.png");
+    ES_CHECK_OK(ctx, es_figure_table(ctx, &s, csv, png, &info));
+    ES_CHECK(info.n_skipped == 0 && info.ymax >= 10);
+    ES_CHECK(tp_load(png, &im) == 0);
+    if (im.s) {
+        es_plot_info_to_device(&info, 1.5, 5, &px, &py);
+        tp_rgb(&im, (int)px, (int)py, rgb);
+        es_palette_rgb(0, want);
+        ES_CHECK(tp_dist(rgb, want) < 0.05);
+        tp_free(&im);
+    }
+}
+
+/* Heat map with row and column names; a table without a header draws its
+ * first two columns as x and y by default. */
+static void test_table_heatmap_defaults(es_ctx *ctx)
+{
+    char dist[4200], nohead[4200];
+    snprintf(dist, sizeof dist, "%s", tp_path("plot", "table_dist.csv"));
+    snprintf(nohead, sizeof nohead, "%s", tp_path("plot", "table_nohead.csv"));
+    es_test_write_file(dist, ",a,b,c\na,0,1,2\nb,1,0,1.5\nc,2,\"1.5\",0\n");
+    es_test_write_file(nohead, "1,2\n2,4\n3,9\n");
+    static const double d[3][3] = {{0, 1, 2}, {1, 0, 1.5}, {2, 1.5, 0}};
+    es_figure_table_spec s;
+    es_plot_info info;
+    tp_image im;
+    es_figure_table_spec_init(&s);
+    s.kind = ES_TABLE_HEATMAP;
+    const char *png = tp_path("plot", "table_heatmap.png");
+    ES_CHECK_OK(ctx, es_figure_table(ctx, &s, dist, png, &info));
+    ES_CHECK(info.xmin == 0 && info.xmax == 3 && info.ymin == 0 && info.ymax == 3);
+    ES_CHECK(tp_load(png, &im) == 0);
+    if (im.s) {
+        int ok = 0;
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++) {
+                double px, py, rgb[3], want[3];
+                es_plot_info_to_device(&info, j + 0.5, 3 - i - 0.5, &px, &py);
+                es_colormap_rgb(ES_CMAP_VIRIDIS, d[i][j] / 2, want);
+                tp_rgb(&im, (int)px, (int)py, rgb);
+                ok += tp_dist(rgb, want) < 0.02;
+            }
+        ES_CHECK_MSG(ok == 9, "%d of 9 table cells have their colour", ok);
+        tp_free(&im);
+    }
+    es_figure_table_spec_init(&s);
+    png = tp_path("plot", "table_nohead.png");
+    ES_CHECK_OK(ctx, es_figure_table(ctx, &s, nohead, png, &info));
+    ES_CHECK(info.xmin <= 1 && info.xmax >= 3 && info.ymin <= 2 && info.ymax >= 9);
+    ES_CHECK(tp_load(png, &im) == 0);
+    if (im.s) {
+        double px, py, rgb[3], want[3];
+        es_plot_info_to_device(&info, 2, 4, &px, &py);
+        es_palette_rgb(0, want);
+        tp_rgb(&im, (int)floor(px), (int)floor(py), rgb);
+        ES_CHECK(tp_dist(rgb, want) < 0.08);
+        tp_free(&im);
+    }
+    ES_CHECK(es_figure_table_kind_from_name("heatmap") == ES_TABLE_HEATMAP);
+    ES_CHECK(es_figure_table_kind_from_name("scree") == ES_TABLE_SCREE);
+    ES_CHECK(es_figure_table_kind_from_name("pie") == -1);
+    ES_CHECK(es_colormap_from_name("rdbu") == ES_CMAP_RDBU);
+    ES_CHECK(es_colormap_from_name("greys") == ES_CMAP_GREYS);
+    ES_CHECK(es_colormap_from_name("jet") == -1 && es_colormap_from_name(NULL) == -1);
+}
+
+/* Bad columns, text in numbers, malformed CSV: messages name the file and
+ * the line (of the file, past blank lines) and column. */
+static void test_table_errors(es_ctx *ctx, const char *csv)
+{
+    char p[4200], wbuf[4400];
+    const char *out = tp_path("plot", "table_error.png"), *want = wbuf;
+    static const char *const nope[1] = {"nope"}, *const expr[1] = {"expression"};
+    es_figure_table_spec s;
+    es_figure_table_spec_init(&s);
+    s.ny = 1;
+    s.y = nope;
+    snprintf(wbuf, sizeof wbuf, "'%s' has no column 'nope'", csv);
+    ES_CHECK_FAILS(ctx, es_figure_table(ctx, &s, csv, out, NULL), ES_ENOTFOUND, want);
+    s.y = expr;
+    snprintf(wbuf, sizeof wbuf, "%s: line 2, column 2: 'neutral' is not a number", csv);
+    ES_CHECK_FAILS(ctx, es_figure_table(ctx, &s, csv, out, NULL), ES_EFORMAT, want);
+    static const char *const pc2[1] = {"PC2"};
+    s.x = "PC1";
+    s.y = pc2;
+    s.label = "6";   /* one past the last column */
+    ES_CHECK_FAILS(ctx, es_figure_table(ctx, &s, csv, out, NULL), ES_ENOTFOUND, "no column '6'");
+    s.label = NULL;
+    s.x = NULL;
+    s.y = NULL;
+    s.ny = 0;
+
+    snprintf(p, sizeof p, "%s", tp_path("plot", "table_text.csv"));
+    es_test_write_file(p, "a,b\n1,2\n\n3,x\n");
+    snprintf(wbuf, sizeof wbuf, "%s: line 4, column 2: 'x' is not a number", p);
+    ES_CHECK_FAILS(ctx, es_figure_table(ctx, &s, p, out, NULL), ES_EFORMAT, want);
+    es_test_write_file(p, "a,b\n1,2\n3,4\"x\n");
+    snprintf(wbuf, sizeof wbuf, "table '%s' line 3: malformed CSV", p);
+    ES_CHECK_FAILS(ctx, es_figure_table(ctx, &s, p, out, NULL), ES_EFORMAT, want);
+    es_test_write_file(p, "a,b\n1,2\n3,\"4\n5,6\n");
+    ES_CHECK_FAILS(ctx, es_figure_table(ctx, &s, p, out, NULL), ES_EFORMAT,
+                   "unterminated quoted field (opened on line 3)");
+    es_test_write_file(p, "a,b\n");
+    snprintf(wbuf, sizeof wbuf, "'%s' has no data rows", p);
+    ES_CHECK_FAILS(ctx, es_figure_table(ctx, &s, p, out, NULL), ES_EFORMAT, want);
+    es_test_write_file(p, "names\nx\ny\n");
+    s.kind = ES_TABLE_HEATMAP;
+    ES_CHECK_FAILS(ctx, es_figure_table(ctx, &s, p, out, NULL), ES_EFORMAT, "no numeric columns");
+    s.kind = ES_TABLE_SCATTER;
+    ES_CHECK_FAILS(ctx, es_figure_table(ctx, &s, "/nonexistent-dir/t.csv", out, NULL), ES_EIO,
+                   "cannot open '/nonexistent-dir/t.csv'");
+    s.ny = 1; /* y NULL */
+    ES_CHECK_FAILS(ctx, es_figure_table(ctx, &s, csv, out, NULL), ES_EINVAL, "y columns");
+    s.ny = 0;
+    s.kind = (es_table_kind)9;
+    ES_CHECK_FAILS(ctx, es_figure_table(ctx, &s, csv, out, NULL), ES_EINVAL, "unknown kind");
+}
+
+/* Fail each allocation of a labelled table scatter in turn: ES_ENOMEM,
+ * nothing left allocated; the call without failures succeeds. */
+static void test_table_alloc_failures(es_ctx *ctx, const char *csv)
+{
+    static const char *const ycol[1] = {"PC2"};
+    es_figure_table_spec s;
+    es_figure_table_spec_init(&s);
+    s.x = "PC1", s.ny = 1, s.y = ycol, s.label = "expression";
+    const char *png = tp_path("plot", "table_alloc.png");
+    failing_alloc fa = {0, 0, 0};
+    es_allocator a = {fa_malloc, fa_realloc, fa_free, &fa};
+    es_ctx_set_allocator(ctx, &a);
+    ES_CHECK_OK(ctx, es_figure_table(ctx, &s, csv, png, NULL));
+    es_ctx_set_allocator(ctx, NULL);
+    int64_t total = fa.count, nomem = 0;
+    for (int64_t k = 1; k <= total; k++) {
+        failing_alloc fk = {0, k, 0};
+        es_allocator ak = {fa_malloc, fa_realloc, fa_free, &fk};
+        es_ctx_set_allocator(ctx, &ak);
+        es_status rc = es_figure_table(ctx, &s, csv, png, NULL);
+        es_ctx_set_allocator(ctx, NULL);
+        nomem += rc == ES_ENOMEM;
+        ES_CHECK_MSG(rc == ES_ENOMEM, "k %lld: rc %d", (long long)k, rc);
+        ES_CHECK_MSG(fk.live == 0, "k %lld: %lld blocks left", (long long)k, (long long)fk.live);
+    }
+    ES_CHECK_MSG(total > 20 && nomem == total, "%lld of %lld failed allocations reported",
+                 (long long)nomem, (long long)total);
+}
+
+static void test_table(es_ctx *ctx)
+{
+    char csv[4200];
+    snprintf(csv, sizeof csv, "%s", tp_path("plot", "table.csv"));
+    write_table(csv);
+    test_table_scatter(ctx, csv);
+    test_table_lines_scree_hist(ctx, csv);
+    test_table_heatmap_defaults(ctx);
+    test_table_errors(ctx, csv);
+    test_table_alloc_failures(ctx, csv);
+}
+
 static int run(const char *cmd)
 {
     int st = system(cmd);
@@ -442,6 +733,7 @@ int main(void)
     test_heatmap(ctx);
     test_histogram(ctx);
     test_alloc_failures(ctx);
+    test_table(ctx);
     test_cli();
     es_ctx_free(ctx);
     ES_TEST_END();

@@ -3,14 +3,18 @@
  * overlapping quads in either face order, back-face handling, scalar maps
  * with NaN values, colour-bar ends, the automatic view of a face-like
  * surface and its invariance under rotation, several panels with labels,
- * valid PNG and SVG output, errors. Figures are left in
+ * valid PNG and SVG output, errors; mesh files coloured by per-vertex,
+ * per-face and per-edge scalars from CSV files (es_figure_render_files)
+ * drawn exactly as the same arrays given to es_render. Figures are left in
  * build/test-out/render/ to be looked at. */
 #include "core/core_private.h"
 #include "es_test.h"
 #include "es_test_alloc.h"
+#include "es_test_files.h"
 #include "mesh_gen.h"
 #include "test_images.h"
 
+#include <edgespace/es_figure.h>
 #include <edgespace/es_io.h>
 #include <edgespace/es_render.h>
 #include <sys/wait.h>
@@ -573,6 +577,197 @@ static void test_shared_faces(es_ctx *ctx)
     for (int i = 0; i < 3; i++) es_meshdata_clear(ctx, &md[i]);
 }
 
+/* ---- es_figure_render_files: mesh files and scalar CSV files ------------ */
+
+static int same_file(const char *a, const char *b)
+{
+    size_t na = 0, nb = 0;
+    char *x = es_test_slurp(a, &na), *y = es_test_slurp(b, &nb);
+    int same = x && y && na == nb && !memcmp(x, y, na);
+    free(x);
+    free(y);
+    return same;
+}
+
+static void write_obj(const char *path, const tm_mesh *m)
+{
+    FILE *f = fopen(path, "w");
+    ES_CHECK(f != NULL);
+    if (!f) return;
+    for (int64_t v = 0; v < m->nv; v++)
+        fprintf(f, "v %.17g %.17g %.17g\n", m->xyz[3 * v], m->xyz[3 * v + 1], m->xyz[3 * v + 2]);
+    for (int64_t k = 0; k < m->nf; k++)
+        fprintf(f, "f %lld %lld %lld\n", (long long)m->faces[3 * k] + 1,
+                (long long)m->faces[3 * k + 1] + 1, (long long)m->faces[3 * k + 2] + 1);
+    fclose(f);
+}
+
+/* values[0..n) one per line, NaN as `missing` (a blank line, "nan", ...),
+ * after an optional header line. */
+static void write_values(const char *path, const char *header, const double *v, int64_t n,
+                         const char *missing)
+{
+    FILE *f = fopen(path, "w");
+    ES_CHECK(f != NULL);
+    if (!f) return;
+    if (header) fprintf(f, "%s\n", header);
+    for (int64_t i = 0; i < n; i++)
+        if (isnan(v[i])) fprintf(f, "%s\n", missing);
+        else fprintf(f, "%.17g,ignored\n", v[i]);
+    fclose(f);
+}
+
+/* The file route and es_render on the same arrays give the same picture
+ * byte for byte: vertex values with a header and blank-line and "nan"
+ * missing values, face values, edge values in es_mesh order. */
+static void test_render_files(es_ctx *ctx)
+{
+    tm_mesh s = tm_sphere(1, 16, 32);
+    es_mesh *mesh = NULL;
+    char obj[4200], csv[4200], a[4200], b[4200];
+    snprintf(obj, sizeof obj, "%s", tp_path("render", "files_sphere.obj"));
+    snprintf(csv, sizeof csv, "%s", tp_path("render", "files_scalars.csv"));
+    write_obj(obj, &s);
+    ES_CHECK_OK(ctx, es_mesh_new(ctx, s.nv, s.nf, s.faces, NULL, &mesh));
+    if (!mesh) return;
+    int64_t ne = es_mesh_nedges(mesh);
+    const int64_t *edges = es_mesh_edges(mesh);
+    ES_CHECK(ne != s.nv && ne != s.nf && s.nv != s.nf);
+    double *val = malloc((size_t)(ne + s.nv + s.nf) * sizeof *val);
+    es_render_spec spec;
+    es_render_spec_init(&spec);
+    spec.width = spec.height = 120;
+    spec.has_view = spec.has_up = 1;
+    spec.view[2] = -1;
+    spec.up[1] = 1;
+    es_render_report rep, rep2;
+    const char *const paths[1] = {obj}, *const scal[1] = {csv};
+    static const char *const what[3] = {"vertex", "face", "edge"};
+    static const es_scalar_kind kinds[3] = {ES_SCALARS_VERTEX, ES_SCALARS_FACE, ES_SCALARS_EDGE};
+    int64_t counts[3] = {s.nv, s.nf, ne};
+    for (int k = 0; k < 3; k++) {
+        int64_t n = counts[k];
+        for (int64_t i = 0; i < n; i++) {
+            const int64_t *c = k == 0 ? &i : k == 1 ? s.faces + 3 * i : edges + 2 * i;
+            int nc = k == 0 ? 1 : k == 1 ? 3 : 2;
+            val[i] = 0;
+            for (int j = 0; j < nc; j++) val[i] += s.xyz[3 * c[j] + 1] / nc; /* height */
+        }
+        val[3] = NAN;
+        if (k == 0) val[7] = NAN;
+        write_values(csv, k == 0 ? "height" : NULL, val, n, "");
+        if (k == 0) { /* one "nan" in place of a blank line */
+            write_values(csv, "height", val, 7, "");
+            FILE *f = fopen(csv, "a");
+            if (f) {
+                fprintf(f, "nan\n");
+                for (int64_t i = 8; i < n; i++) fprintf(f, "%.17g\n", val[i]);
+                fclose(f);
+            }
+        }
+        snprintf(a, sizeof a, "%s", tp_path("render", k == 0 ? "files_vertex.png" :
+                                                       k == 1 ? "files_face.png" : "files_edge.png"));
+        snprintf(b, sizeof b, "%s", tp_path("render", "files_direct.png"));
+        ES_CHECK_OK(ctx, es_figure_render_files(ctx, &spec, 1, paths, 1, scal, NULL, a, &rep));
+        ES_CHECK_MSG(rep.n_nan_scalars == (k == 0 ? 2 : 1), "%s: %lld missing", what[k],
+                     (long long)rep.n_nan_scalars);
+        ES_CHECK(rep.vmin > -1.01 && rep.vmax < 1.01 && rep.vmax - rep.vmin > 1.5);
+        es_render_mesh it = as_item(&s, NULL);
+        it.scalar_kind = kinds[k];
+        it.scalars = val;
+        it.nedges = ne;
+        it.edges = edges;
+        es_render_spec sp = spec;
+        sp.meshes = &it;
+        sp.nmeshes = 1;
+        ES_CHECK_OK(ctx, es_render(ctx, &sp, b, &rep2));
+        ES_CHECK_MSG(same_file(a, b), "%s scalars from a file differ from es_render's", what[k]);
+        ES_CHECK(rep2.n_nan_scalars == rep.n_nan_scalars && rep2.vmin == rep.vmin);
+        tp_image im;
+        ES_CHECK(tp_load(a, &im) == 0);
+        if (im.s) { /* top of the sphere near the map's high end, bottom near its low end */
+            double top[3], bottom[3], hi[3], lo[3];
+            int cx = (int)(rep.panel_x0 + 60), cy = (int)(rep.panel_y0 + 60);
+            tp_rgb(&im, cx, cy - 45, top);
+            tp_rgb(&im, cx, cy + 45, bottom);
+            es_colormap_rgb(spec.cmap, 1, hi);
+            es_colormap_rgb(spec.cmap, 0, lo);
+            ES_CHECK_MSG(tp_dist(top, hi) < tp_dist(top, lo) &&
+                         tp_dist(bottom, lo) < tp_dist(bottom, hi), "%s colours", what[k]);
+            tp_free(&im);
+        }
+    }
+
+    /* one file for two meshes: file names under the panels by default */
+    const char *const two[2] = {obj, obj}, *const lab[2] = {"first", NULL};
+    ES_CHECK_OK(ctx, es_figure_render_files(ctx, &spec, 2, two, 1, scal, lab,
+                                            tp_path("render", "files_two.png"), &rep));
+    ES_CHECK(rep.ncols == 2 && rep.width >= 2 * 120 && rep.n_nan_scalars == 2);
+    ES_CHECK_OK(ctx, es_figure_render_files(ctx, &spec, 2, two, 0, NULL, NULL,
+                                            tp_path("render", "files_two_plain.png"), &rep));
+    ES_CHECK(rep.n_nan_scalars == 0);
+
+    /* errors name the file, and the line */
+    char wbuf[8600];
+    const char *want = wbuf, *png = tp_path("render", "files_err.png");
+    es_test_write_file(csv, "1\n2\n3\n");
+    snprintf(wbuf, sizeof wbuf, "'%s' has 3 values; '%s' has %lld vertices, %lld edges, %lld faces",
+             csv, obj, (long long)s.nv, (long long)ne, (long long)s.nf);
+    ES_CHECK_FAILS(ctx, es_figure_render_files(ctx, &spec, 1, paths, 1, scal, NULL, png, NULL),
+                   ES_EMISMATCH, want);
+    es_test_write_file(csv, "v\n1\n\nx\n");
+    snprintf(wbuf, sizeof wbuf, "%s:4: 'x' is not a number", csv);
+    ES_CHECK_FAILS(ctx, es_figure_render_files(ctx, &spec, 1, paths, 1, scal, NULL, png, NULL),
+                   ES_EFORMAT, want);
+    es_test_write_file(csv, "1\n\"2\n");
+    snprintf(wbuf, sizeof wbuf, "scalars '%s' line 3: unterminated quoted field (opened on line 2)",
+             csv);
+    ES_CHECK_FAILS(ctx, es_figure_render_files(ctx, &spec, 1, paths, 1, scal, NULL, png, NULL),
+                   ES_EFORMAT, want);
+    const char *const gone[1] = {"/nonexistent-dir/s.csv"};
+    ES_CHECK_FAILS(ctx, es_figure_render_files(ctx, &spec, 1, paths, 1, gone, NULL, png, NULL),
+                   ES_EIO, "cannot open '/nonexistent-dir/s.csv'");
+    const char *const three[3] = {obj, obj, obj};
+    ES_CHECK_FAILS(ctx, es_figure_render_files(ctx, &spec, 3, three, 2, two, NULL, png, NULL),
+                   ES_EINVAL, "2 scalar files for 3 meshes");
+    const char *const nomesh[1] = {"/nonexistent-dir/m.obj"};
+    ES_CHECK_FAILS(ctx, es_figure_render_files(ctx, &spec, 1, nomesh, 0, NULL, NULL, png, NULL),
+                   ES_EIO, "/nonexistent-dir/m.obj");
+
+    /* allocation failures, on two squares with edge scalars: every allocation
+     * of a successful call failed in turn gives ES_ENOMEM (or, where a
+     * reader only shrinks a buffer, success) and leaves nothing allocated */
+    tm_mesh sq = make_square();
+    static const double ev[5] = {1, 2, 3, 4, NAN};
+    snprintf(obj, sizeof obj, "%s", tp_path("render", "files_square.obj"));
+    write_obj(obj, &sq);
+    write_values(csv, "e", ev, 5, "");
+    spec.width = spec.height = 32;
+    failing_alloc fa = {0, 0, 0};
+    es_allocator al = {fa_malloc, fa_realloc, fa_free, &fa};
+    es_ctx_set_allocator(ctx, &al);
+    ES_CHECK_OK(ctx, es_figure_render_files(ctx, &spec, 2, two, 1, scal, NULL, png, &rep));
+    es_ctx_set_allocator(ctx, NULL);
+    ES_CHECK(rep.n_nan_scalars == 2 && fa.live == 0);
+    int64_t total = fa.count, nomem = 0;
+    for (int64_t k = 1; k <= total; k++) {
+        failing_alloc fk = {0, k, 0};
+        es_allocator ak = {fa_malloc, fa_realloc, fa_free, &fk};
+        es_ctx_set_allocator(ctx, &ak);
+        es_status rc = es_figure_render_files(ctx, &spec, 2, two, 1, scal, NULL, png, NULL);
+        es_ctx_set_allocator(ctx, NULL);
+        nomem += rc == ES_ENOMEM;
+        ES_CHECK_MSG(rc == ES_OK || rc == ES_ENOMEM, "k %lld: rc %d", (long long)k, rc);
+        ES_CHECK_MSG(fk.live == 0, "k %lld: %lld blocks left", (long long)k, (long long)fk.live);
+    }
+    ES_CHECK_MSG(total > 20 && nomem > total / 2, "%lld of %lld failed allocations reported",
+                 (long long)nomem, (long long)total);
+    tm_free(&sq);
+    free(val);
+    es_mesh_free(mesh);
+    tm_free(&s);
+}
+
 /* The edgespace render command on a sphere written as OBJ. */
 static int run(const char *cmd)
 {
@@ -682,6 +877,7 @@ int main(void)
     test_errors(ctx);
     test_alloc_failures(ctx);
     test_shared_faces(ctx);
+    test_render_files(ctx);
     test_cli();
     es_ctx_free(ctx);
     ES_TEST_END();

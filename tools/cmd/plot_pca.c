@@ -1,13 +1,12 @@
-/* tools/cmd/plot_pca.c — edgespace plot-pca: figures of a stored PCA: scores on two
- * components coloured by a label column (Fig. 9 of Fisher et al.) or the
- * scree plot; PNG, SVG or PDF by the output's extension. */
+/* tools/cmd/plot_pca.c — edgespace plot-pca: figures of a stored PCA
+ * (es_figure_pca): scores on two components coloured by a label column
+ * (Fig. 9 of Fisher et al.) or the scree plot; PNG, SVG or PDF by the
+ * output's extension. */
 #include "cli.h"
 #include "commands.h"
 
 #include <getopt.h>
 #include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
 
 static const char usage[] =
     "usage: edgespace plot-pca STORE [--pca NAME] [--pcs A,B] [--color COLUMN] -o OUT\n"
@@ -61,64 +60,10 @@ int cmd_plot_pca(int argc, char **argv)
     es_ctx *ctx = cli_ctx_new("plot-pca");
     if (!ctx) return CLI_FAIL;
     es_store *st = NULL;
-    es_pca *p = NULL;
-    int64_t *rows = NULL, nrows = 0;
-    const char **labels = NULL;
-    int ret = CLI_FAIL;
-    char xl[64], yl[64];
     es_status rc = es_store_open(ctx, argv[optind], ES_STORE_READ, &st);
-    if (rc == ES_OK) rc = es_study_pca_load(ctx, st, pca_name, &p, &rows, &nrows);
-    if (rc != ES_OK) {
-        cli_fail("plot-pca", ctx, rc);
-        goto done;
-    }
-    if (scree) {
-        es_scree_spec sp;
-        es_scree_spec_init(&sp);
-        sp.n = p->ncomp;
-        sp.variance = p->eigenvalues;
-        sp.total = p->total_variance;
-        sp.frame.title = title;
-        rc = es_plot_scree(ctx, &sp, out, NULL);
-    } else {
-        if (a > p->ncomp || b > p->ncomp) {
-            fprintf(stderr, "edgespace plot: the PCA has %lld components\n", (long long)p->ncomp);
-            goto done;
-        }
-        int64_t col = color ? es_store_find_column(st, color) : -1;
-        if (color && col < 0) {
-            fprintf(stderr, "edgespace plot: no label column '%s'\n", color);
-            goto done;
-        }
-        if (col >= 0) {
-            labels = malloc((size_t)(nrows > 0 ? nrows : 1) * sizeof *labels);
-            if (!labels) goto done;
-            for (int64_t i = 0; i < nrows; i++) labels[i] = es_store_label(st, rows[i], col);
-        }
-        es_scatter_spec sp;
-        es_scatter_spec_init(&sp);
-        snprintf(xl, sizeof xl, "PC%lld (%.1f%%)", a, 100 * p->explained[a - 1]);
-        snprintf(yl, sizeof yl, "PC%lld (%.1f%%)", b, 100 * p->explained[b - 1]);
-        sp.frame.xlabel = xl;
-        sp.frame.ylabel = yl;
-        sp.frame.title = title;
-        sp.n = nrows;
-        sp.x = p->scores + (a - 1) * nrows;
-        sp.y = p->scores + (b - 1) * nrows;
-        sp.labels = labels;
-        sp.legend_title = color;
-        rc = es_plot_scatter(ctx, &sp, out, NULL);
-    }
-    if (rc != ES_OK) {
-        cli_fail("plot-pca", ctx, rc);
-        goto done;
-    }
-    printf("wrote %s\n", out);
-    ret = CLI_OK;
-done:
-    free(labels);
-    es_free(ctx, rows);
-    es_pca_free(p);
+    if (rc == ES_OK) rc = es_figure_pca(ctx, st, pca_name, a, b, color, scree, title, out);
+    int ret = rc == ES_OK ? CLI_OK : cli_fail("plot-pca", ctx, rc);
+    if (rc == ES_OK) printf("wrote %s\n", out);
     es_store_close(st);
     es_ctx_free(ctx);
     return ret;

@@ -1,16 +1,13 @@
-/* tools/cmd/render.c — `edgespace render`: draw one or several meshes side
- * by side to PNG, SVG or PDF (es_render.h), optionally coloured by scalars
- * read from a CSV file (one value per vertex, edge or face, in order). */
+/* tools/cmd/render.c — `edgespace render`: draw one or several mesh files
+ * side by side to PNG, SVG or PDF (es_figure_render_files), optionally
+ * coloured by scalars read from CSV files (one value per vertex, edge or
+ * face, in order). */
 #include "cli.h"
 #include "commands.h"
 
-#include <errno.h>
 #include <getopt.h>
-#include <math.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 
 #define VERB "render"
 
@@ -66,67 +63,6 @@ static int parse_vec3(const char *s, double v[3])
     return k == 3 && (v[0] != 0 || v[1] != 0 || v[2] != 0) ? 0 : -1;
 }
 
-/* First column of a CSV file as doubles; a first line that is not a number
- * is a header. Empty fields and "nan" are NaN. Prints its own errors. */
-static int read_column(const char *path, double **out, int64_t *n)
-{
-    FILE *f = fopen(path, "r");
-    char line[4096];
-    int64_t cap = 1024, lineno = 0;
-    *n = 0;
-    *out = NULL;
-    if (!f) {
-        fprintf(stderr, "edgespace %s: cannot open '%s': %s\n", VERB, path, strerror(errno));
-        return -1;
-    }
-    double *v = malloc((size_t)cap * sizeof *v);
-    if (!v) goto oom;
-    while (fgets(line, sizeof line, f)) {
-        lineno++;
-        size_t len = strcspn(line, ",\r\n");
-        line[len] = 0;
-        char *s = line;
-        while (*s == ' ' || *s == '\t' || *s == '"') s++;
-        char *e = s + strlen(s);
-        while (e > s && (e[-1] == ' ' || e[-1] == '\t' || e[-1] == '"')) *--e = 0;
-        double x;
-        if (!*s || !strcasecmp(s, "nan") || !strcasecmp(s, "na")) x = NAN;
-        else {
-            char *end;
-            x = strtod(s, &end);
-            if (*end) {
-                if (lineno == 1) continue; /* header */
-                fprintf(stderr, "edgespace %s: %s:%lld: '%s' is not a number\n", VERB, path,
-                        (long long)lineno, s);
-                free(v);
-                fclose(f);
-                return -1;
-            }
-        }
-        if (*n == cap) {
-            double *w = realloc(v, 2 * (size_t)cap * sizeof *v);
-            if (!w) goto oom;
-            v = w;
-            cap *= 2;
-        }
-        v[(*n)++] = x;
-    }
-    fclose(f);
-    *out = v;
-    return 0;
-oom:
-    free(v);
-    fclose(f);
-    fprintf(stderr, "edgespace %s: out of memory reading '%s'\n", VERB, path);
-    return -1;
-}
-
-static const char *base_name(const char *p)
-{
-    const char *s = strrchr(p, '/');
-    return s ? s + 1 : p;
-}
-
 int cmd_render(int argc, char **argv)
 {
     static const struct option opts[] = {
@@ -142,7 +78,7 @@ int cmd_render(int argc, char **argv)
         {"help", no_argument, NULL, 'h'}, {NULL, 0, NULL, 0}};
     es_render_spec spec;
     const char *out = NULL, *scalar_files[MAX_MESHES], *labels[MAX_MESHES];
-    int nscalar_files = 0, nlabels = 0, c;
+    int nscalar_files = 0, nlabels = 0, c, m;
     double range[3];
     int64_t v64;
 
@@ -166,10 +102,9 @@ int cmd_render(int argc, char **argv)
             scalar_files[nscalar_files++] = optarg;
             break;
         case 'c':
-            if (!strcmp(optarg, "viridis")) spec.cmap = ES_CMAP_VIRIDIS;
-            else if (!strcmp(optarg, "rdbu")) spec.cmap = ES_CMAP_RDBU;
-            else if (!strcmp(optarg, "greys")) spec.cmap = ES_CMAP_GREYS;
-            else return cli_usage_error(VERB, "unknown colour map '%s'", optarg);
+            if ((m = es_colormap_from_name(optarg)) < 0)
+                return cli_usage_error(VERB, "unknown colour map '%s'", optarg);
+            spec.cmap = (es_colormap)m;
             break;
         case 'r': {
             char buf[256];
@@ -222,61 +157,15 @@ int cmd_render(int argc, char **argv)
 
     es_ctx *ctx = cli_ctx_new(VERB);
     if (!ctx) return CLI_FAIL;
-    es_meshdata md[MAX_MESHES];
-    es_mesh *mesh[MAX_MESHES];
-    double *scal[MAX_MESHES];
-    es_render_mesh items[MAX_MESHES];
-    memset(md, 0, sizeof md);
-    memset(mesh, 0, sizeof mesh);
-    memset(scal, 0, sizeof scal);
-    memset(items, 0, sizeof items);
-    int rc = CLI_FAIL;
-    es_status st;
-
-    for (int i = 0; i < nm; i++) {
-        const char *path = argv[optind + i];
-        if ((st = es_meshdata_read(ctx, path, ES_FORMAT_AUTO, &md[i])) != ES_OK) {
-            rc = cli_fail(VERB, ctx, st);
-            goto done;
-        }
-        es_render_mesh *it = &items[i];
-        it->nverts = md[i].nverts;
-        it->nfaces = md[i].nfaces;
-        it->xyz = md[i].xyz;
-        it->faces = md[i].faces;
-        it->label = i < nlabels ? labels[i] : nm > 1 ? base_name(path) : NULL;
-        if (nscalar_files == 0) continue;
-        const char *sf = scalar_files[nscalar_files == 1 ? 0 : i];
-        int64_t ns;
-        if (read_column(sf, &scal[i], &ns)) goto done;
-        it->scalars = scal[i];
-        if (ns == it->nverts) it->scalar_kind = ES_SCALARS_VERTEX;
-        else if (ns == it->nfaces) it->scalar_kind = ES_SCALARS_FACE;
-        else {
-            /* per edge: the edges of the topology, in es_mesh order */
-            if ((st = es_mesh_new(ctx, md[i].nverts, md[i].nfaces, md[i].faces, NULL,
-                                  &mesh[i])) != ES_OK) {
-                rc = cli_fail(VERB, ctx, st);
-                goto done;
-            }
-            if (ns != es_mesh_nedges(mesh[i])) {
-                fprintf(stderr, "edgespace %s: '%s' has %lld values; '%s' has %lld vertices, "
-                        "%lld edges, %lld faces\n", VERB, sf, (long long)ns, path,
-                        (long long)it->nverts, (long long)es_mesh_nedges(mesh[i]),
-                        (long long)it->nfaces);
-                goto done;
-            }
-            it->scalar_kind = ES_SCALARS_EDGE;
-            it->nedges = ns;
-            it->edges = es_mesh_edges(mesh[i]);
-        }
-    }
-    spec.meshes = items;
-    spec.nmeshes = nm;
+    const char *lab[MAX_MESHES] = {NULL};   /* NULL: the file name (several meshes) */
+    for (int i = 0; i < nlabels; i++) lab[i] = labels[i];
     es_render_report rep;
-    if ((st = es_render(ctx, &spec, out, &rep)) != ES_OK) {
-        rc = cli_fail(VERB, ctx, st);
-        goto done;
+    es_status st = es_figure_render_files(ctx, &spec, nm, (const char *const *)argv + optind,
+                                          nscalar_files, scalar_files, lab, out, &rep);
+    if (st != ES_OK) {
+        cli_fail(VERB, ctx, st);
+        es_ctx_free(ctx);
+        return CLI_FAIL;
     }
     if (rep.n_nan_scalars)
         fprintf(stderr, "edgespace %s: warning: %lld missing or non-finite scalars drawn grey\n",
@@ -285,13 +174,6 @@ int cmd_render(int argc, char **argv)
            rep.view[0], rep.view[1], rep.view[2], rep.up[0], rep.up[1], rep.up[2]);
     if (nscalar_files) printf(", colour range %.4g..%.4g", rep.vmin, rep.vmax);
     printf("\n");
-    rc = CLI_OK;
-done:
-    for (int i = 0; i < nm; i++) {
-        es_meshdata_clear(ctx, &md[i]);
-        es_mesh_free(mesh[i]);
-        free(scal[i]);
-    }
     es_ctx_free(ctx);
-    return rc;
+    return CLI_OK;
 }

@@ -1,13 +1,19 @@
-/* lib/include/edgespace/es_figure.h — lib/figure's figures of whole studies:
- * what a command or notebook draws from stored results in one call (the
- * plot and render primitives are es_plot.h and es_render.h). Built only
- * when libedgespace has figures (es_config.h: ES_HAVE_FIGURES).
+/* lib/include/edgespace/es_figure.h — lib/figure's figures of whole studies
+ * and files: what a command, notebook or the Python package draws in one
+ * call from stored results, a CSV table or mesh files (the plot and render
+ * primitives are es_plot.h and es_render.h). Built only when libedgespace
+ * has figures (es_config.h: ES_HAVE_FIGURES).
+ *
+ * Every message names the file it is about, and the line and column of a
+ * table where one is to blame.
  */
 #ifndef EDGESPACE_ES_FIGURE_H
 #define EDGESPACE_ES_FIGURE_H
 
 #include "es_core.h"
 #include "es_compare.h"
+#include "es_plot.h"
+#include "es_render.h"
 #include "es_store.h"
 
 #ifdef __cplusplus
@@ -28,6 +34,111 @@ ES_API es_status es_figure_compare(es_ctx *ctx, es_store *store, const char *gpa
                                    const char *by, const es_compare_opts *opts,
                                    const char *name, const char *out_dir, const char *command,
                                    es_compare_result **res);
+
+/* ---- a figure of a CSV table (edgespace plot) -------------------------------
+ *
+ * The table is RFC 4180 CSV (quoted fields may hold commas, quotes and line
+ * breaks; a stray quote or an unterminated quoted field is an error naming
+ * the line). Its first record sets the number of columns: cells past it are
+ * ignored, missing cells of shorter records are empty. The first record is
+ * a header when not all its cells are numbers. Empty cells, "nan" and "na"
+ * (any case) are missing values (NaN: skipped and counted by the plots);
+ * other text where a number is wanted is an error naming the line and
+ * column. Blank lines are skipped. */
+
+typedef enum es_table_kind {
+    ES_TABLE_SCATTER = 0,  /* points (x, y[0]) coloured by the category in `label` */
+    ES_TABLE_LINES,        /* one curve per y column against x (legend: header names) */
+    ES_TABLE_SCREE,        /* bars of y[0] (variances) in percent of the total, and cumulative */
+    ES_TABLE_HISTOGRAM,    /* distribution of y[0] */
+    ES_TABLE_HEATMAP       /* the whole table as a matrix; a non-numeric first column
+                            * holds row labels, a header the column labels */
+} es_table_kind;
+
+/* Columns are named by their header name or by 1-based number (a name is
+ * looked up first). */
+typedef struct es_figure_table_spec {
+    es_table_kind kind;        /* ES_TABLE_SCATTER */
+    const char *x;             /* scatter and lines; NULL: column 1 for a scatter, the
+                                * row number 1, 2, ... for lines */
+    int64_t ny;                /* number of y columns; 0: the default column */
+    const char *const *y;      /* ny columns (all are read and checked; lines draws
+                                * each, the others use y[0]); default "2" for scatter
+                                * and lines, "1" for scree and histogram */
+    const char *label;         /* scatter: category column, or NULL */
+    /* Size, font, title and axis labels; an axis label left NULL is the
+     * header name of its column (scatter, lines, histogram x) or the plot's
+     * default (es_plot.h). */
+    es_plot_frame frame;
+    int logy;                  /* lines: log10 y axis (0) */
+    int64_t bins;              /* histogram bins; 0: Freedman-Diaconis (es_plot.h) */
+    double total;              /* scree: total variance of the percentages; 0: the sum */
+    es_colormap cmap;          /* heatmap colours (ES_CMAP_VIRIDIS) */
+    int equal;                 /* scatter: equal scales on x and y (0) */
+} es_figure_table_spec;
+
+/* Defaults as marked above; the frame as es_plot.h's (640 x 480, 12 pt). */
+ES_API void es_figure_table_spec_init(es_figure_table_spec *spec);
+
+/* The kind named "scatter", "lines", "scree", "histogram" or "heatmap", or
+ * -1 for any other name. */
+ES_API int es_figure_table_kind_from_name(const char *name);
+
+/* Draw the figure `spec` asks for from the table in csv_path to out_path
+ * (format by extension as in es_plot.h). info: NULL, or filled by the plot
+ * (es_plot_info).
+ * Errors: ES_EIO (the table cannot be read, the figure not written),
+ * ES_EFORMAT (malformed CSV, no data rows, text in a numeric column, a
+ * heat map without numeric columns), ES_ENOTFOUND (no such column),
+ * ES_EINVAL (a bad spec, or the plot's own checks), ES_ENOMEM. */
+ES_API es_status es_figure_table(es_ctx *ctx, const es_figure_table_spec *spec,
+                                 const char *csv_path, const char *out_path,
+                                 es_plot_info *info);
+
+/* ---- a stored PCA (edgespace plot-pca) ---------------------------------------- */
+
+/* The PCA `pca_name` of store (NULL: the only one or "default"; see
+ * es_study_pca_load) drawn to out_path: the scores on components pc_a and
+ * pc_b (1-based; axes "PCk (x.x%)"), one colour per value of the label
+ * column color_column (NULL: one colour; it also titles the legend) —
+ * Fig. 9 of Fisher et al. — or, when scree is non-zero, the scree plot of
+ * all its components against the total variance (pc_a, pc_b and
+ * color_column unused). title: NULL for none.
+ * Errors: those of es_study_pca_load; ES_EINVAL (a component outside
+ * 1..K: "the PCA has K components"), ES_ENOTFOUND (no label column
+ * color_column), those of es_plot_scatter / es_plot_scree. */
+ES_API es_status es_figure_pca(es_ctx *ctx, es_store *store, const char *pca_name,
+                               int64_t pc_a, int64_t pc_b, const char *color_column,
+                               int scree, const char *title, const char *out_path);
+
+/* ---- mesh files side by side (edgespace render) ------------------------------- */
+
+/* Read n mesh files (OBJ, PLY, OFF: es_meshdata_read, ES_FORMAT_AUTO)
+ * and draw them with es_render under spec (its meshes and nmeshes are
+ * ignored: the files fill them) to out_path; rep: NULL or filled.
+ *
+ * labels: NULL, or n entries; a NULL entry (or labels NULL) is the file's
+ * base name when n > 1 and no label for a single mesh.
+ *
+ * Scalars: nscalars is 0 (none), 1 (one file for every mesh) or n (one per
+ * mesh). A scalar file holds one value per line in its first CSV column
+ * (more columns are ignored); a first line that is not a number is a
+ * header; empty lines and cells, "nan" and "na" are missing (drawn grey and
+ * counted in rep->n_nan_scalars). The count decides what the values are
+ * for: the mesh's vertices, else its faces, else its edges in es_mesh order
+ * (es_mesh_edges of the file's topology, as the store and es_edge_lengths
+ * number them).
+ * Errors: those of es_meshdata_read and es_mesh_new (named by file);
+ * ES_EIO (a scalar file cannot be read); ES_EFORMAT (malformed CSV, text
+ * where a value belongs: "FILE:LINE: 'text' is not a number");
+ * ES_EMISMATCH (a count that fits neither the vertices, edges nor faces);
+ * ES_EINVAL (n < 1, nscalars not 0, 1 or n, NULL paths); those of
+ * es_render. */
+ES_API es_status es_figure_render_files(es_ctx *ctx, const es_render_spec *spec, int64_t n,
+                                        const char *const *mesh_paths, int64_t nscalars,
+                                        const char *const *scalar_paths,
+                                        const char *const *labels, const char *out_path,
+                                        es_render_report *rep);
 
 #ifdef __cplusplus
 }

@@ -41,6 +41,10 @@ typedef enum es_colormap {
 #define ES_NAN_GREY 0.6
 ES_API void es_colormap_rgb(es_colormap map, double t, double rgb[3]);
 
+/* The map named "viridis", "rdbu" or "greys" (the names the commands and
+ * the Python package take), or -1 for any other name. */
+ES_API int es_colormap_from_name(const char *name);
+
 /* Colour i (any i >= 0, cycling) of the categorical palette (Tableau 10:
  * distinct, colour-blind aware, readable on white). */
 ES_API void es_palette_rgb(int64_t i, double rgb[3]);
