@@ -1,4 +1,4 @@
-/* lib/embed/embed_walk.c — vertex figures: corner angles, the ladybug walk of
+/* lib/embed/closure.c — vertex figures: corner angles, the ladybug walk of
  * edge-length-interpolation Section 2.1 (eq. 1-11), closure energy and its
  * gradient, edge-length error metrics, Kabsch alignment.
  *
