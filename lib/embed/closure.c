@@ -1,6 +1,8 @@
 /* lib/embed/closure.c — vertex figures: corner angles, the ladybug walk of
- * edge-length-interpolation Section 2.1 (eq. 1-11), closure energy and its
- * gradient, edge-length error metrics, Kabsch alignment.
+ * edge-length-interpolation Section 2.1 (eq. 1-11), and its closure energy
+ * with the energy's derivatives. Stage 1 of the embedding minimizes this
+ * energy, stage 2 starts from the walk's frames (solve.c), and
+ * es_embed_closure gives it to callers.
  *
  * The walk around vertex v with fan spokes u_0..u_{k-1} (es_mesh.h order) is
  *   P = Z(theta_0) X(alpha_1) Z(theta_1) X(alpha_2) ... Z(theta_{k-1}) X(alpha_0)
@@ -11,111 +13,9 @@
  * Conventions and checks: ../shared/oracle/embed/README.
  */
 #include "embed/embed_pkg.h"
-#include "edgespace/es_embed.h"
 
-#include <lapacke.h>
 #include <math.h>
-#include <stdlib.h>
-
-/* ---- 3 x 3 helpers (row-major) --------------------------------------- */
-
-void es__mat3_mul(const double *a, const double *b, double *out)
-{
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            out[3 * i + j] = a[3 * i] * b[j] + a[3 * i + 1] * b[3 + j] + a[3 * i + 2] * b[6 + j];
-}
-
-void es__mat3_mul_bt(const double *a, const double *b, double *out)
-{
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            out[3 * i + j] = a[3 * i] * b[3 * j] + a[3 * i + 1] * b[3 * j + 1] +
-                             a[3 * i + 2] * b[3 * j + 2];
-}
-
-static double det3(const double *m)
-{
-    return m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
-           m[2] * (m[3] * m[7] - m[4] * m[6]);
-}
-
-static void set_identity(double *m)
-{
-    for (int i = 0; i < 9; i++) m[i] = (i % 4 == 0) ? 1.0 : 0.0;
-}
-
-/* Polar factor by SVD with the last singular vector flipped when needed
- * (the proper rotation nearest in Frobenius norm). */
-static int nearest_rotation_svd(double *m)
-{
-    double a[9], s[3], u[9], vt[9], sup[2], r[9];
-    for (int i = 0; i < 9; i++) a[i] = m[i];   /* row-major m = column-major m^T */
-    if (LAPACKE_dgesvd(LAPACK_COL_MAJOR, 'A', 'A', 3, 3, a, 3, s, u, 3, vt, 3, sup) != 0 ||
-        !(s[0] > 0)) {
-        set_identity(m);
-        return -1;
-    }
-    /* column-major: m^T = U S V^T, so m = V S U^T; rotation V U^T (col-major r^T). */
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) {
-            /* r = (U V^T)^T in col-major = V U^T: r[i][j] = sum_k vt[k][i] u[j][k] */
-            r[3 * i + j] = 0;
-            for (int k = 0; k < 3; k++) r[3 * i + j] += vt[k + 3 * i] * u[j + 3 * k];
-        }
-    if (det3(r) < 0) {
-        for (int i = 0; i < 3; i++)
-            for (int j = 0; j < 3; j++) {
-                r[3 * i + j] = 0;
-                for (int k = 0; k < 3; k++)
-                    r[3 * i + j] += (k == 2 ? -1.0 : 1.0) * vt[k + 3 * i] * u[j + 3 * k];
-            }
-    }
-    for (int i = 0; i < 9; i++) m[i] = r[i];
-    return 0;
-}
-
-int es__mat3_nearest_rotation(double *m)
-{
-    /* Newton's iteration for the polar factor with Higham's scaling; it keeps
-     * det > 0, so it returns the nearest proper rotation when det(m) > 0. */
-    double x[9], inv_t[9];
-    double d = det3(m);
-    for (int i = 0; i < 9; i++)
-        if (!isfinite(m[i])) {
-            set_identity(m);
-            return -1;
-        }
-    if (!(d > 1e-12 * pow(fabs(m[0]) + fabs(m[4]) + fabs(m[8]) + 1e-300, 3)))
-        return nearest_rotation_svd(m);
-    for (int i = 0; i < 9; i++) x[i] = m[i];
-    for (int it = 0; it < 30; it++) {
-        double dt = det3(x), nx = 0, ni = 0, g, diff = 0;
-        /* inverse transpose = cofactor matrix / det */
-        inv_t[0] = (x[4] * x[8] - x[5] * x[7]) / dt;
-        inv_t[1] = -(x[3] * x[8] - x[5] * x[6]) / dt;
-        inv_t[2] = (x[3] * x[7] - x[4] * x[6]) / dt;
-        inv_t[3] = -(x[1] * x[8] - x[2] * x[7]) / dt;
-        inv_t[4] = (x[0] * x[8] - x[2] * x[6]) / dt;
-        inv_t[5] = -(x[0] * x[7] - x[1] * x[6]) / dt;
-        inv_t[6] = (x[1] * x[5] - x[2] * x[4]) / dt;
-        inv_t[7] = -(x[0] * x[5] - x[2] * x[3]) / dt;
-        inv_t[8] = (x[0] * x[4] - x[1] * x[3]) / dt;
-        for (int i = 0; i < 9; i++) {
-            nx += x[i] * x[i];
-            ni += inv_t[i] * inv_t[i];
-        }
-        g = it < 6 ? sqrt(sqrt(ni / nx)) : 1.0;
-        for (int i = 0; i < 9; i++) {
-            double y = 0.5 * (g * x[i] + inv_t[i] / g);
-            diff += (y - x[i]) * (y - x[i]);
-            x[i] = y;
-        }
-        if (diff < 1e-30) break;
-    }
-    for (int i = 0; i < 9; i++) m[i] = x[i];
-    return 0;
-}
+#include <string.h>
 
 /* ---- corner angles ---------------------------------------------------- */
 
@@ -214,7 +114,7 @@ void es__fan_frames(int64_t k, int64_t nface, const double *theta, const double 
                     double *C, double *P)
 {
     double cur[9];
-    set_identity(cur);
+    es__mat3_identity(cur);
     for (int64_t j = 0; j < k; j++) {
         memcpy(C + 9 * j, cur, sizeof cur);
         if (j == k - 1) {
@@ -235,7 +135,7 @@ double es__fan_closure(int64_t k, const double *theta, const double *alpha, doub
 {
     int64_t nf = 2 * k;
     double *A = work, *B = work + 9 * (nf + 1), e = 0;
-    set_identity(A);
+    es__mat3_identity(A);
     for (int64_t i = 0; i < nf; i++) {
         memcpy(A + 9 * (i + 1), A + 9 * i, 9 * sizeof(double));
         if (i % 2 == 0) es__mat3_right_z(A + 9 * (i + 1), theta[i / 2]);
@@ -246,7 +146,7 @@ double es__fan_closure(int64_t k, const double *theta, const double *alpha, doub
         e += r[m] * r[m];
     }
     if (!J) return e;
-    set_identity(B + 9 * nf);
+    es__mat3_identity(B + 9 * nf);
     for (int64_t i = nf - 1; i >= 0; i--) {
         memcpy(B + 9 * i, B + 9 * (i + 1), 9 * sizeof(double));
         if (i % 2 == 0) left_z(B + 9 * i, theta[i / 2]);
@@ -335,127 +235,4 @@ done:
     es__free(ctx, J);
     es__free(ctx, work);
     return rc;
-}
-
-/* ---- public: metrics, alignment -------------------------------------- */
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y ? 1 : 0;
-}
-
-es_status es_embed_length_error(es_ctx *ctx, const es_mesh *mesh, const double *xyz,
-                                 const double *target, int normalize, double *rms_ratio,
-                                 double *max_rel, double *p99_rel)
-{
-    int64_t ne = es_mesh_nedges(mesh);
-    const int64_t *ed = es_mesh_edges(mesh);
-    double *rel, *len, sl = 0, st = 0, f = 1, ss = 0, mx = 0;
-    if (ne <= 0) ES_FAIL(ctx, ES_EINVAL, "embed: mesh has no edges");
-    rel = es__alloc_array(ctx, ne, sizeof *rel);
-    len = es__alloc_array(ctx, ne, sizeof *len);
-    if (!rel || !len) {
-        es__free(ctx, rel);
-        es__free(ctx, len);
-        return ES_ENOMEM;
-    }
-    for (int64_t e = 0; e < ne; e++) {
-        const double *a = xyz + 3 * ed[2 * e], *b = xyz + 3 * ed[2 * e + 1];
-        len[e] = sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-                      (a[2] - b[2]) * (a[2] - b[2]));
-        sl += len[e];
-        st += target[e];
-    }
-    if (normalize && sl > 0) f = st / sl;
-    for (int64_t e = 0; e < ne; e++) {
-        double d = len[e] * f - target[e];
-        ss += d * d;
-        rel[e] = fabs(d) / target[e];
-        if (!(rel[e] <= mx)) mx = rel[e];
-    }
-    if (rms_ratio) *rms_ratio = sqrt(ss / (double)ne) / (st / (double)ne);
-    if (max_rel) *max_rel = mx;
-    if (p99_rel) {
-        qsort(rel, (size_t)ne, sizeof *rel, cmp_double);
-        *p99_rel = rel[(int64_t)floor(0.99 * (double)(ne - 1))];
-    }
-    es__free(ctx, rel);
-    es__free(ctx, len);
-    return ES_OK;
-}
-
-es_status es_kabsch_align(es_ctx *ctx, int64_t nverts, double *xyz, const double *ref,
-                          const double *w, double *rms)
-{
-    return es_kabsch_align_parts(ctx, nverts, xyz, ref, w, NULL, rms);
-}
-
-/* One pass gathers every part's weighted centroids and cross-covariance,
- * one 3 x 3 SVD per part gives its rotation, one pass moves the vertices:
- * O(V + parts), so a mesh split into many pieces (seams cut open) costs no
- * more than one piece. */
-es_status es_kabsch_align_parts(es_ctx *ctx, int64_t nverts, double *xyz, const double *ref,
-                                const double *w, const int64_t *part, double *rms)
-{
-    int64_t np = 1;
-    double *acc, ss = 0;   /* per part: sum w, centroid of xyz (3), of ref (3), h (9), r (9) */
-    enum { SW = 0, CA = 1, CB = 4, H = 7, R = 16, STRIDE = 25 };
-    if (nverts <= 0 || !xyz || !ref) ES_FAIL(ctx, ES_EINVAL, "kabsch: empty input");
-    if (part)
-        for (int64_t v = 0; v < nverts; v++)
-            if (part[v] + 1 > np) np = part[v] + 1;
-    acc = es__calloc(ctx, (size_t)np * STRIDE, sizeof *acc);
-    if (!acc) return ES_ENOMEM;
-    for (int64_t v = 0; v < nverts; v++) {
-        double wv = w ? w[v] : 1.0, *a;
-        if (part && part[v] < 0) continue;
-        a = acc + STRIDE * (part ? part[v] : 0);
-        a[SW] += wv;
-        for (int i = 0; i < 3; i++) {
-            a[CA + i] += wv * xyz[3 * v + i];
-            a[CB + i] += wv * ref[3 * v + i];
-        }
-    }
-    if (!part && !(acc[SW] > 0)) {
-        es__free(ctx, acc);
-        ES_FAIL(ctx, ES_EINVAL, "kabsch: weights sum to %g", acc[SW]);
-    }
-    for (int64_t p = 0; p < np; p++)
-        for (int i = 0; i < 6; i++)
-            if (acc[STRIDE * p + SW] > 0) acc[STRIDE * p + CA + i] /= acc[STRIDE * p + SW];
-    /* h = sum w (ref - cb)(xyz - ca)^T; the rotation R maximizing tr(R^T h)
-     * is the polar factor of h (Kabsch 1976). */
-    for (int64_t v = 0; v < nverts; v++) {
-        double wv = w ? w[v] : 1.0, *a;
-        if (part && part[v] < 0) continue;
-        a = acc + STRIDE * (part ? part[v] : 0);
-        for (int i = 0; i < 3; i++)
-            for (int j = 0; j < 3; j++)
-                a[H + 3 * i + j] += wv * (ref[3 * v + i] - a[CB + i]) * (xyz[3 * v + j] - a[CA + j]);
-    }
-    for (int64_t p = 0; p < np; p++) {
-        double *a = acc + STRIDE * p;
-        for (int i = 0; i < 9; i++) a[R + i] = a[H + i];
-        /* a part with no weight keeps its place (identity, no shift) */
-        if (!(a[SW] > 0) || nearest_rotation_svd(a + R) != 0) set_identity(a + R);
-        if (!(a[SW] > 0))
-            for (int i = 0; i < 3; i++) a[CA + i] = a[CB + i] = 0;
-    }
-    for (int64_t v = 0; v < nverts; v++) {
-        double p[3], q[3];
-        const double *a, *r;
-        if (part && part[v] < 0) continue;
-        a = acc + STRIDE * (part ? part[v] : 0);
-        r = a + R;
-        for (int i = 0; i < 3; i++) p[i] = xyz[3 * v + i] - a[CA + i];
-        for (int i = 0; i < 3; i++) {
-            q[i] = r[3 * i] * p[0] + r[3 * i + 1] * p[1] + r[3 * i + 2] * p[2] + a[CB + i];
-            xyz[3 * v + i] = q[i];
-            if (!w || w[v] > 0) ss += (q[i] - ref[3 * v + i]) * (q[i] - ref[3 * v + i]);
-        }
-    }
-    es__free(ctx, acc);
-    if (rms) *rms = sqrt(ss / (double)nverts);
-    return ES_OK;
 }
