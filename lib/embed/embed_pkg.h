@@ -1,6 +1,9 @@
-/* lib/embed/embed_pkg.h — pieces of the embedding shared by embed.c,
- * embed_walk.c and interp.c: corner angles, vertex-figure walks, closure
- * residuals and their derivatives, small rotation helpers. Never installed.
+/* lib/embed/embed_pkg.h — what the files of lib/embed share: the es_embedder
+ * object (its CHOLMOD matrices, factors and work buffers), the sparse
+ * kernels (sparse.c), the four stages (stage_*.c) that solve.c drives, and
+ * the vertex-figure and rotation helpers (closure.c, align.c). Never
+ * installed; this is the one header that includes cholmod.h, so CHOLMOD's
+ * types stay inside lib/embed.
  *
  * 3 x 3 matrices here are row-major double[9] (m[3*i + j]); they never
  * leave these files.
@@ -13,7 +16,116 @@
 #endif
 
 #include "core/core_private.h"
+#include "edgespace/es_embed.h"
 #include "edgespace/es_mesh.h"
+
+#include <cholmod.h>
+
+/* ---- the embedder (embedder.c) ------------------------------------------ */
+
+/* Everything here is sized and, for the sparse matrices, patterned and
+ * analysed once per topology by es_embedder_new; a solve only writes
+ * values. */
+struct es_embedder {
+    es_ctx *ctx;
+    const es_mesh *mesh;
+    int64_t nv, ne, nf, maxk, nint;
+    const int64_t *off, *sv, *se, *sf, *edges, *ef;
+    const uint8_t *vb, *eb;
+    int64_t *slot_corner;   /* 2E: corner of the slot's face at the slot's vertex */
+    int64_t *edge_slot;     /* 2E: slot of e in the star of edges[2e], of edges[2e+1] */
+    uint8_t *pinned;        /* V: lowest vertex of its component */
+    double *vweight;        /* V: 1 for vertices in a face, else 0 */
+    int64_t *rank, *nlow;   /* block-pattern bookkeeping (see es__pos_off) */
+    /* closure variables */
+    int64_t nvar, *var, *amap_off, *amap, *adiag;
+    cholmod_common cm;
+    int cm_started;
+    cholmod_sparse *H3, *H1, *HA;
+    cholmod_factor *L3, *L1, *LA;
+    cholmod_dense *X, *Y, *Ew, *B3, *B1, *BA;
+    /* work, sized once */
+    double *ang, *theta, *C, *G, *len, *alpha, *alpha_try, *alpha_keep, *xyz, *xyz_try, *xyz_best;
+    double *init_copy;   /* init_xyz when the caller passes the output array itself */
+    int64_t progress_total; /* progress steps of the solve running (0: none) */
+    double *ltarget, *lpath, *res, *grad, *diag, *pcg, *jw, *fanwork, *fanr, *fanth, *fanal, *vclos, *verr;
+    int have_vertex_results;
+    int64_t nfactor;        /* numeric factorizations in the last solve */
+};
+
+/* Value slots of the upper-triangular block pattern (bs x bs blocks) of a
+ * V x V vertex adjacency that embedder.c builds: entry (r, c) of the block
+ * of edge e = (a, b), a < b, in column block b, and entry (r, c) of the
+ * diagonal block of v. Edges are sorted by (min, max), so rank[e] is the
+ * position of a among b's lower neighbours and nlow[v] their count. */
+static inline int64_t es__pos_off(const cholmod_sparse *A, int bs, const int64_t *rank, int64_t e,
+                                  int64_t b, int r, int c)
+{
+    return ((const int64_t *)A->p)[bs * b + c] + bs * rank[e] + r;
+}
+
+static inline int64_t es__pos_diag(const cholmod_sparse *A, int bs, const int64_t *nlow, int64_t v,
+                                   int r, int c)
+{
+    return ((const int64_t *)A->p)[bs * v + c] + bs * nlow[v] + r;
+}
+
+/* ---- sparse kernels (sparse.c) ---------------------------------------- */
+
+/* Translate emb->cm.status: ES_OK for success and the soft statuses
+ * (not positive definite, tiny diagonal), else the code with a message
+ * naming `what`. */
+es_status es__cm_check(es_embedder *emb, const char *what);
+
+/* Numeric factorization of A into L (analysed by es_embedder_new); returns
+ * CHOLMOD's ok flag. */
+int es__factorize(es_embedder *emb, cholmod_sparse *A, cholmod_factor *L);
+
+/* Factorize A and solve A X = B into emb->X. Returns 1 if A is not
+ * positive definite (nothing solved), 0 on success, -1 on a CHOLMOD
+ * failure (message set). */
+int es__factor_solve(es_embedder *emb, cholmod_sparse *A, cholmod_factor *L, cholmod_dense *B);
+
+/* y = A x for the symmetric matrix held in its upper triangle (CSC). */
+void es__sym_matvec(const cholmod_sparse *A, const double *x, double *y);
+
+/* a . b over n entries. */
+double es__dot(const double *a, const double *b, int64_t n);
+
+/* Solve A d = b by conjugate gradients preconditioned with the factor Lf
+ * of an earlier A (B: a dense of A's size for the preconditioner's
+ * right-hand side). Returns the iterations used, or -1 if the relative
+ * residual did not reach eta within max_it. */
+int es__lagged_pcg(es_embedder *emb, const cholmod_sparse *A, cholmod_factor *Lf,
+                   cholmod_dense *B, const double *b, double *d, double eta, int max_it);
+
+/* ---- the stages (stage_*.c), driven by solve.c ------------------------- */
+
+/* Closure energy (eq. 3) of dihedrals alpha with the corner angles in
+ * emb->theta; residuals to emb->res, with_jac: Jacobian blocks to emb->jw;
+ * vclos (V, may be NULL): each vertex's energy. */
+double es__closure_eval(es_embedder *emb, const double *alpha, int with_jac, double *vclos);
+
+/* Stage 1: up to max_iter Levenberg-Marquardt iterations on the closure
+ * residuals, alpha in place. *e_out: the final energy; *iters grows by the
+ * iterations run; *lambda_io carries the damping between calls. */
+es_status es__stage_dihedrals(es_embedder *emb, const es_embed_opts *o, int max_iter,
+                              double *alpha, double *e_out, int64_t *iters, double *lambda_io);
+
+/* Stage 2: the walk's frames from dihedrals alpha (emb->C), then the
+ * vertex frames (emb->G) by least squares, each projected onto the nearest
+ * rotation. */
+es_status es__stage_frames(es_embedder *emb, const double *alpha);
+
+/* Stage 3: positions xyz (3 x V) from the frames and edge lengths len. */
+es_status es__stage_positions(es_embedder *emb, const double *len, double *xyz);
+
+/* Stage 4: Levenberg-Marquardt on the relative edge-length residuals
+ * against L, xyz in place; *iters grows by the iterations run. */
+es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz, int max_iter,
+                           double rtol, double tol, int verbose, int64_t *iters);
+
+/* ---- vertex figures (closure.c) ----------------------------------------- */
 
 /* Corner angles of all faces from lengths (3 x F, angle at corner k of
  * face f in ang[3f + k]) by Kahan's needle-stable formula ("Miscalculating
@@ -41,12 +153,20 @@ void es__fan_frames(int64_t k, int64_t nface, const double *theta, const double 
 double es__fan_closure(int64_t k, const double *theta, const double *alpha, double *r,
                        double *J, double *work);
 
+/* m = m Z(t) (eq. 6's rotation about z). */
+void es__mat3_right_z(double *m, double t);
+
+/* ---- rotations (align.c) ------------------------------------------------ */
+
+static inline void es__mat3_identity(double *m)
+{
+    for (int i = 0; i < 9; i++) m[i] = (i % 4 == 0) ? 1.0 : 0.0;
+}
+
 /* out = a b (3 x 3 row-major); out may not alias. */
 void es__mat3_mul(const double *a, const double *b, double *out);
 /* out = a b^T. */
 void es__mat3_mul_bt(const double *a, const double *b, double *out);
-/* m = m Z(t) (eq. 6's rotation about z). */
-void es__mat3_right_z(double *m, double t);
 /* Nearest proper rotation to m (in place); returns 0, or -1 if m is
  * degenerate (then m is set to I). */
 int es__mat3_nearest_rotation(double *m);

@@ -1,9 +1,61 @@
-/* lib/embed/embed_report.c — the text of an embedding's quality report,
- * for commands and notebooks (es_embed.h). */
+/* lib/embed/embed_report.c — how well an embedding realizes its target:
+ * the edge-length error measures (es_embed_length_error, also for callers
+ * that embed by other means) and the text of an embedding's quality
+ * report, for commands and notebooks (es_embed.h).
+ */
 #include "core/core_private.h"
 #include "edgespace/es_embed.h"
 
+#include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y ? 1 : 0;
+}
+
+es_status es_embed_length_error(es_ctx *ctx, const es_mesh *mesh, const double *xyz,
+                                 const double *target, int normalize, double *rms_ratio,
+                                 double *max_rel, double *p99_rel)
+{
+    int64_t ne = es_mesh_nedges(mesh);
+    const int64_t *ed = es_mesh_edges(mesh);
+    double *rel, *len, sl = 0, st = 0, f = 1, ss = 0, mx = 0;
+    if (ne <= 0) ES_FAIL(ctx, ES_EINVAL, "embed: mesh has no edges");
+    rel = es__alloc_array(ctx, ne, sizeof *rel);
+    len = es__alloc_array(ctx, ne, sizeof *len);
+    if (!rel || !len) {
+        es__free(ctx, rel);
+        es__free(ctx, len);
+        return ES_ENOMEM;
+    }
+    for (int64_t e = 0; e < ne; e++) {
+        const double *a = xyz + 3 * ed[2 * e], *b = xyz + 3 * ed[2 * e + 1];
+        len[e] = sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                      (a[2] - b[2]) * (a[2] - b[2]));
+        sl += len[e];
+        st += target[e];
+    }
+    if (normalize && sl > 0) f = st / sl;
+    for (int64_t e = 0; e < ne; e++) {
+        double d = len[e] * f - target[e];
+        ss += d * d;
+        rel[e] = fabs(d) / target[e];
+        if (!(rel[e] <= mx)) mx = rel[e];
+    }
+    if (rms_ratio) *rms_ratio = sqrt(ss / (double)ne) / (st / (double)ne);
+    if (max_rel) *max_rel = mx;
+    if (p99_rel) {
+        qsort(rel, (size_t)ne, sizeof *rel, cmp_double);
+        *p99_rel = rel[(int64_t)floor(0.99 * (double)(ne - 1))];
+    }
+    es__free(ctx, rel);
+    es__free(ctx, len);
+    return ES_OK;
+}
+
 
 const char *es_embed_report_format(const es_embed_report *r, char *buf, size_t n)
 {

@@ -3,7 +3,7 @@
  * scale-normalized lengths, circular means of dihedrals for the start of
  * the embedding, sequences aligned frame to frame. See es_interp.h.
  */
-#include "embed/embed_pkg.h"
+#include "core/core_private.h"
 #include "edgespace/es_interp.h"
 #include "edgespace/es_geom.h"
 

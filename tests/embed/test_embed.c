@@ -4,7 +4,7 @@
  * energies at given dihedrals, the frames-and-positions stages from exact
  * dihedrals, round trips on closed (sphere, torus: genus 1) and open (disc)
  * meshes, a mesh of several pieces, interpolation and extrapolation,
- * garbage in.
+ * garbage in, failure messages on the caller's context.
  */
 #include "es_test.h"
 #include "mesh_gen.h"
@@ -726,6 +726,45 @@ static void test_garbage(es_ctx *ctx)
     tm_free(&s);
 }
 
+/* An embedder works on the context it was made with; es_embed_solve may be
+ * called with another (one context per thread), and a failure's message
+ * must reach the caller's context, also for a NULL embedder. A success
+ * leaves the caller's context alone. */
+static void test_caller_ctx(es_ctx *ctx)
+{
+    sphere_case c;
+    es_ctx *other = NULL;
+    es_embed_report r;
+    double keep;
+    ES_CHECK(es_ctx_new(&other) == ES_OK);
+    if (!other) return;
+    if (sphere_open(ctx, &c)) {
+        keep = c.len[7];
+        c.len[7] = -2;
+        ES_CHECK_FAILS(other, es_embed_solve(other, c.emb, c.len, 0, c.al, NULL, NULL, c.out, &r),
+                       ES_EINVAL, "target length of edge 7");
+        c.len[7] = keep;
+        ES_CHECK_FAILS(other, es_embed_solve(other, c.emb, c.len, 0, NULL, NULL, NULL, c.out, &r),
+                       ES_EINVAL, "need initial dihedrals or initial positions");
+        ES_CHECK_FAILS(other, es_embed_solve(other, c.emb, c.len, NAN, c.al, NULL, NULL, c.out, &r),
+                       ES_EINVAL, "scale nan");
+        ES_CHECK_FAILS(other, es_embed_solve(other, c.emb, NULL, 0, c.al, NULL, NULL, c.out, &r),
+                       ES_EINVAL, "NULL target or output");
+        /* the messages came from the embedder's context, which still has
+         * the last one; a success does not overwrite the caller's */
+        ES_CHECK(es_test_contains(es_ctx_errmsg(ctx), "NULL target or output"));
+        ES_CHECK_OK(other, es_embed_solve(other, c.emb, c.len, 0, c.al, NULL, NULL, c.out, &r));
+        ES_CHECK(r.realized && r.max_rel < 1e-8);
+        ES_CHECK(es_test_contains(es_ctx_errmsg(other), "NULL target or output"));
+        /* no context given: the failure is still reported by its code */
+        ES_CHECK(es_embed_solve(NULL, c.emb, NULL, 0, c.al, NULL, NULL, c.out, &r) == ES_EINVAL);
+        ES_CHECK_FAILS(other, es_embed_solve(other, NULL, c.len, 0, c.al, NULL, NULL, c.out, &r),
+                       ES_EINVAL, "no embedder");
+    }
+    sphere_close(&c);
+    es_ctx_free(other);
+}
+
 static void log_stderr(void *ud, es_log_level level, const char *msg)
 {
     (void)ud, (void)level;
@@ -747,6 +786,7 @@ int main(void)
     test_blas_threads(ctx);
     test_interp(ctx);
     test_garbage(ctx);
+    test_caller_ctx(ctx);
     es_ctx_free(ctx);
     ES_TEST_END();
 }

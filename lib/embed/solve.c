@@ -1,0 +1,401 @@
+/* lib/embed/solve.c — edge lengths to vertex positions: es_embed_solve,
+ * which checks the input and drives the four stages.
+ *
+ * Stage 1 (stage_dihedrals.c) repairs the initial dihedrals' closure,
+ * stages 2-3 (stage_frames.c) turn dihedrals into frames and positions,
+ * stage 4 (stage_refine.c) refines the positions against the lengths
+ * (edge-length-interpolation Section 2, with the changes of es_embed.h;
+ * Lipman et al. 2005 for the frames, Marquardt 1963 for stages 1 and 4).
+ * Alternatively stage 4 runs alone along a path of lengths from the initial
+ * mesh (continuation). The result is rigidly aligned to the initial or
+ * reference positions per component (Kabsch 1976, align.c) and measured
+ * for the report.
+ */
+#include "embed/embed_pkg.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+#include <time.h>
+
+void es_embed_opts_init(es_embed_opts *o)
+{
+    o->dihedral_mode = ES_EMBED_DIHEDRAL_AUTO;
+    o->dihedral_max_iter = 30;
+    o->dihedral_rtol = 1e-4;
+    o->dihedral_tol = 1e-24;
+    o->refine_max_iter = 12;
+    o->refine_rtol = 1e-3;
+    o->refine_tol = 1e-13;
+    o->continuation_steps = 0;
+    o->try_both = 0;
+    o->align = 1;
+    o->bad_face_rtol = 1e-12;
+    o->realized_rtol = 1e-2;
+    o->verbose = 0;
+    o->blas_threads = 1;
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int all_finite(const double *x, int64_t n)
+{
+    for (int64_t i = 0; i < n; i++)
+        if (!isfinite(x[i])) return 0;
+    return 1;
+}
+
+static void edge_lengths_of(const es_embedder *emb, const double *xyz, double *len)
+{
+    for (int64_t e = 0; e < emb->ne; e++) {
+        const double *a = xyz + 3 * emb->edges[2 * e], *b = xyz + 3 * emb->edges[2 * e + 1];
+        len[e] = sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                      (a[2] - b[2]) * (a[2] - b[2]));
+    }
+}
+
+/* Signed bending angles (es_geom.h convention) of positions xyz. */
+static void dihedrals_of(const es_embedder *emb, const double *xyz, double *alpha)
+{
+    const int64_t *F = es_mesh_faces(emb->mesh);
+    for (int64_t e = 0; e < emb->ne; e++) {
+        int64_t f = emb->ef[2 * e], g = emb->ef[2 * e + 1];
+        double n[2][3], t[3], c[3], tl;
+        alpha[e] = 0;
+        if (f < 0 || g < 0) continue;
+        for (int s = 0; s < 2; s++) {
+            const int64_t *fc = F + 3 * (s ? g : f);
+            const double *p0 = xyz + 3 * fc[0], *p1 = xyz + 3 * fc[1], *p2 = xyz + 3 * fc[2];
+            double u[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+            double w[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+            n[s][0] = u[1] * w[2] - u[2] * w[1];
+            n[s][1] = u[2] * w[0] - u[0] * w[2];
+            n[s][2] = u[0] * w[1] - u[1] * w[0];
+        }
+        for (int i = 0; i < 3; i++)
+            t[i] = xyz[3 * emb->edges[2 * e + 1] + i] - xyz[3 * emb->edges[2 * e] + i];
+        tl = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+        /* atan2 is scale-free in its two arguments: unnormalized normals are
+         * fine as long as both arguments share the factor |n_f||n_g|. */
+        c[0] = n[1][1] * n[0][2] - n[1][2] * n[0][1];
+        c[1] = n[1][2] * n[0][0] - n[1][0] * n[0][2];
+        c[2] = n[1][0] * n[0][1] - n[1][1] * n[0][0];
+        if (tl > 0)
+            alpha[e] = atan2((c[0] * t[0] + c[1] * t[1] + c[2] * t[2]) / tl,
+                             n[1][0] * n[0][0] + n[1][1] * n[0][1] + n[1][2] * n[0][2]);
+        if (!isfinite(alpha[e])) alpha[e] = 0;
+    }
+}
+
+/* RMS ratio and max relative error of es_embed_length_error (normalize 0)
+ * without its allocation and percentile sort, for comparing candidates
+ * inside a solve. */
+static void quick_metrics(const es_embedder *emb, const double *xyz, const double *L,
+                          double *rms, double *mx)
+{
+    double ss = 0, sl = 0, m = 0;
+    for (int64_t e = 0; e < emb->ne; e++) {
+        const double *a = xyz + 3 * emb->edges[2 * e], *b = xyz + 3 * emb->edges[2 * e + 1];
+        double d = sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                        (a[2] - b[2]) * (a[2] - b[2])) - L[e];
+        ss += d * d;
+        sl += L[e];
+        if (!(fabs(d) / L[e] <= m)) m = fabs(d) / L[e];
+    }
+    *rms = sqrt(ss / (double)emb->ne) / (sl / (double)emb->ne);
+    *mx = m;
+}
+
+/* Continuation: stage 4 along l(s) = (1 - s) l_init + s l_target from the
+ * initial mesh (scaled to the target's sum), which realizes l(0) exactly. */
+static es_status run_continuation(es_embedder *emb, const es_embed_opts *o, const double *L,
+                                  const double *init_xyz, double *xyz, int64_t *iters)
+{
+    int64_t n = o->continuation_steps, ne = emb->ne;
+    double s0 = 0, s1 = 0, f;
+    es_status rc;
+    edge_lengths_of(emb, init_xyz, emb->lpath);
+    for (int64_t e = 0; e < ne; e++) {
+        s0 += emb->lpath[e];
+        s1 += L[e];
+    }
+    f = s0 > 0 ? s1 / s0 : 1.0;
+    for (int64_t i = 0; i < 3 * emb->nv; i++) xyz[i] = init_xyz[i] * f;
+    for (int64_t e = 0; e < ne; e++) emb->lpath[e] *= f;
+    for (int64_t step = 1; step <= n; step++) {
+        double s = (double)step / (double)n;
+        double *lp = emb->alpha_try;   /* scratch E */
+        for (int64_t e = 0; e < ne; e++) lp[e] = (1 - s) * emb->lpath[e] + s * L[e];
+        rc = es__stage_refine(emb, lp, xyz, step == n ? o->refine_max_iter : 4,
+                              step == n ? o->refine_rtol : 1e-3, o->refine_tol, o->verbose,
+                              iters);
+        if (rc != ES_OK) return rc;
+        es__progress(emb->ctx, "embed: continuation", step, n);
+    }
+    return ES_OK;
+}
+
+/* Stages 2-3 from dihedrals alpha; a result that is not finite becomes the
+ * origin, from which the refinement starts. Adds to the report's stage
+ * times. */
+static es_status linear_stages(es_embedder *emb, const double *alpha, const double *L,
+                               double *xyz, es_embed_report *rep)
+{
+    es_status rc;
+    double t1 = now_s();
+    if ((rc = es__stage_frames(emb, alpha)) != ES_OK) return rc;
+    rep->t_frames += now_s() - t1;
+    t1 = now_s();
+    if ((rc = es__stage_positions(emb, L, xyz)) != ES_OK) return rc;
+    rep->t_positions += now_s() - t1;
+    if (!all_finite(xyz, 3 * emb->nv))
+        for (int64_t i = 0; i < 3 * emb->nv; i++) xyz[i] = 0;
+    return ES_OK;
+}
+
+static es_status embed_solve(es_embedder *emb, const double *target, double scale,
+                             const double *init_alpha, const double *init_xyz,
+                             const es_embed_opts *opts, double *xyz, es_embed_report *report)
+{
+    es_ctx *ctx;
+    es_embed_opts dflt;
+    es_embed_report rep;
+    const es_embed_opts *o = opts;
+    int64_t nv, ne, n3;
+    double sum = 0, f, t0 = now_s(), t1, *L, *alpha;
+    const double *ref;
+    es_status rc;
+    int have_dihedral_result = 0;
+    if (!emb) return ES_EINVAL;
+    ctx = emb->ctx;
+    nv = emb->nv;
+    ne = emb->ne;
+    n3 = 3 * nv;
+    memset(&rep, 0, sizeof rep);
+    rep.worst_edge = -1;
+    if (!o) {
+        es_embed_opts_init(&dflt);
+        o = &dflt;
+    }
+    if (!target || !xyz) ES_FAIL(ctx, ES_EINVAL, "embed: NULL target or output");
+    if (!init_alpha && !init_xyz)
+        ES_FAIL(ctx, ES_EINVAL, "embed: need initial dihedrals or initial positions");
+    if (!(isfinite(scale) && scale >= 0))
+        ES_FAIL(ctx, ES_EINVAL, "embed: scale %g is not finite and >= 0", scale);
+    for (int64_t e = 0; e < ne; e++) {
+        if (!(isfinite(target[e]) && target[e] > 0))
+            ES_FAIL(ctx, ES_EINVAL, "embed: target length of edge %lld (%lld-%lld) is %g, not "
+                    "finite and positive", (long long)e, (long long)emb->edges[2 * e],
+                    (long long)emb->edges[2 * e + 1], target[e]);
+        sum += target[e];
+    }
+    if (!isfinite(sum)) ES_FAIL(ctx, ES_EINVAL, "embed: target lengths sum to %g", sum);
+    if (init_alpha)
+        for (int64_t e = 0; e < ne; e++)
+            if (!emb->eb[e] && !isfinite(init_alpha[e]))
+                ES_FAIL(ctx, ES_EINVAL, "embed: initial dihedral of edge %lld is not finite",
+                        (long long)e);
+    if (init_xyz)   /* all vertices: those in no face are copied to the output */
+        for (int64_t i = 0; i < n3; i++)
+            if (!isfinite(init_xyz[i]))
+                ES_FAIL(ctx, ES_EINVAL, "embed: initial position of vertex %lld is not finite",
+                        (long long)(i / 3));
+
+    L = emb->ltarget;
+    alpha = emb->alpha;
+    f = scale > 0 ? scale / sum : 1.0;
+    for (int64_t e = 0; e < ne; e++) L[e] = target[e] * f;
+    rep.scale = scale > 0 ? scale : sum;
+    rep.n_bad_faces = es__corner_angles(emb->mesh, L, o->bad_face_rtol, emb->ang);
+    for (int64_t i = 0; i < emb->off[nv]; i++)
+        emb->theta[i] = emb->slot_corner[i] >= 0 ? emb->ang[emb->slot_corner[i]] : 0.0;
+    if (init_alpha) {
+        for (int64_t e = 0; e < ne; e++) alpha[e] = emb->eb[e] ? 0.0 : init_alpha[e];
+    } else {
+        dihedrals_of(emb, init_xyz, alpha);
+    }
+    rep.closure_before = es__closure_eval(emb, alpha, 0, NULL);
+    emb->have_vertex_results = 0;
+
+    /* dihedral path: stages 1-4. Stage 1 repairs incoherent (noisy)
+     * dihedrals but can pull interpolated ones into a wrong closure minimum
+     * (oracle README, failure E). In auto mode one LM iteration decides:
+     * stage 1 goes on only if that iteration removed 99 % of the closure
+     * energy, else its dihedrals are dropped. On noisy dihedrals (0.001-0.1
+     * rad, six real meshes) one iteration cuts the energy 300-20000x; on
+     * interpolated ones (midpoints of six real pairs) 1.1-36x, and there a
+     * finished stage 1 was always worse than none (failure E), and even the
+     * one iteration gave no better result after the refinement (cactus
+     * midpoints, 5K and 21K vertices: RMS ratio 0.0183 % / 0.0097 % with it,
+     * 0.0170 % / 0.0093 % without). So the linear stages run once. */
+    if (!(o->continuation_steps > 0 && init_xyz) || o->try_both) {
+        double mx;
+        int mode = o->dihedral_mode;
+        if (emb->nvar == 0 || o->dihedral_max_iter <= 0) mode = ES_EMBED_DIHEDRAL_OFF;
+        rep.closure_stage1 = rep.closure_before;
+        /* one bar on a terminal: stage 1, stages 2-3, each refinement iteration */
+        emb->progress_total = 3 + (o->refine_max_iter > 0 ? o->refine_max_iter : 0);
+        es__progress(ctx, "embedding", 0, emb->progress_total);
+        if (mode != ES_EMBED_DIHEDRAL_OFF) {
+            double lambda1 = 1e-3;
+            int first = mode == ES_EMBED_DIHEDRAL_AUTO ? 1 : o->dihedral_max_iter;
+            memcpy(emb->alpha_keep, alpha, (size_t)ne * sizeof *alpha);
+            t1 = now_s();
+            if ((rc = es__stage_dihedrals(emb, o, first, alpha, &rep.closure_stage1,
+                                      &rep.dihedral_iters, &lambda1)) != ES_OK)
+                return rc;
+            rep.used_stage1 = 1;
+            if (mode == ES_EMBED_DIHEDRAL_AUTO) {
+                if (!(rep.closure_stage1 < 0.01 * rep.closure_before)) {
+                    memcpy(alpha, emb->alpha_keep, (size_t)ne * sizeof *alpha);
+                    rep.used_stage1 = 0;
+                } else if (first < o->dihedral_max_iter &&
+                           (rc = es__stage_dihedrals(emb, o, o->dihedral_max_iter - first, alpha,
+                                                 &rep.closure_stage1, &rep.dihedral_iters,
+                                                 &lambda1)) != ES_OK) {
+                    return rc;
+                }
+            }
+            rep.t_dihedral = now_s() - t1;
+        }
+        es__progress(ctx, "embedding", 1, emb->progress_total);
+        if ((rc = linear_stages(emb, alpha, L, xyz, &rep)) != ES_OK) return rc;
+        es__progress(ctx, "embedding", 2, emb->progress_total);
+        quick_metrics(emb, xyz, L, &rep.rms_ratio_linear, &mx);
+        t1 = now_s();
+        if (o->refine_max_iter > 0 &&
+            (rc = es__stage_refine(emb, L, xyz, o->refine_max_iter, o->refine_rtol, o->refine_tol,
+                               o->verbose, &rep.refine_iters)) != ES_OK)
+            return rc;
+        rep.t_refine = now_s() - t1;
+        es__progress(ctx, "embedding", emb->progress_total, emb->progress_total);
+        emb->progress_total = 0;
+        have_dihedral_result = 1;
+    }
+    /* continuation path */
+    if (o->continuation_steps > 0 && init_xyz) {
+        double *cx = have_dihedral_result ? emb->xyz_best : xyz;
+        int64_t it = 0;
+        t1 = now_s();
+        if ((rc = run_continuation(emb, o, L, init_xyz, cx, &it)) != ES_OK) return rc;
+        rep.t_refine += now_s() - t1;
+        rep.continuation_steps = o->continuation_steps;
+        if (have_dihedral_result) {
+            double r1, m1, r2, m2;
+            quick_metrics(emb, xyz, L, &r1, &m1);
+            quick_metrics(emb, cx, L, &r2, &m2);
+            if (all_finite(cx, n3) && (m2 < m1 || !all_finite(xyz, n3))) {
+                memcpy(xyz, cx, (size_t)n3 * sizeof *xyz);
+                rep.used_continuation = 1;
+                rep.refine_iters = it;
+            }
+        } else {
+            rep.used_continuation = 1;
+            rep.refine_iters = it;
+        }
+    }
+    if (!all_finite(xyz, n3))
+        for (int64_t i = 0; i < n3; i++) xyz[i] = init_xyz ? init_xyz[i] * f : 0.0;
+    for (int64_t v = 0; v < nv; v++)
+        if (emb->vweight[v] == 0) xyz[3 * v] = xyz[3 * v + 1] = xyz[3 * v + 2] = 0;
+
+    /* alignment */
+    ref = init_xyz ? init_xyz : es_mesh_xyz(emb->mesh);
+    if (o->align && ref) {
+        double r;
+        if ((rc = es_kabsch_align_parts(ctx, nv, xyz, ref, emb->vweight,
+                                        es_mesh_vertex_component(emb->mesh), &r)) != ES_OK)
+            return rc;
+        for (int64_t v = 0; v < nv; v++)
+            if (emb->vweight[v] == 0)
+                for (int i = 0; i < 3; i++) xyz[3 * v + i] = ref[3 * v + i];
+    }
+
+    /* report */
+    if ((rc = es_embed_length_error(ctx, emb->mesh, xyz, L, 0, &rep.rms_ratio, &rep.max_rel,
+                                    &rep.p99_rel)) != ES_OK)
+        return rc;
+    edge_lengths_of(emb, xyz, emb->lpath);
+    for (int64_t v = 0; v < nv; v++) emb->verr[v] = 0;
+    {
+        double mx = -1;
+        for (int64_t e = 0; e < ne; e++) {
+            double r = fabs(emb->lpath[e] - L[e]) / L[e];
+            emb->verr[emb->edges[2 * e]] += r;
+            emb->verr[emb->edges[2 * e + 1]] += r;
+            if (r > mx) {
+                mx = r;
+                rep.worst_edge = e;
+            }
+        }
+    }
+    for (int64_t v = 0; v < nv; v++) {
+        int64_t k = emb->off[v + 1] - emb->off[v];
+        if (k) emb->verr[v] /= (double)k;
+    }
+    dihedrals_of(emb, xyz, emb->alpha_try);
+    rep.closure_after = es__closure_eval(emb, emb->alpha_try, 0, emb->vclos);
+    emb->have_vertex_results = 1;
+    rep.realized = rep.max_rel <= o->realized_rtol && rep.n_bad_faces == 0;
+    rep.t_total = now_s() - t0;
+    if (report) *report = rep;
+    return ES_OK;
+}
+
+/* The BLAS work of an embedding is many small dense blocks (the supernodes
+ * of a surface mesh's factor). Threaded OpenBLAS made whole midpoint
+ * embeddings 25-33 % slower with 2 threads than with 1 on this project's
+ * 2-core machine (9.4K, 13.6K and 54K vertices; OMP_NUM_THREADS=1 too), so
+ * the solve runs with opts->blas_threads threads and restores the caller's
+ * setting. OpenBLAS's setter is a weak symbol: with another BLAS the
+ * setting is left alone. */
+#if defined(__GNUC__)
+extern void openblas_set_num_threads(int n) __attribute__((weak));
+extern int openblas_get_num_threads(void) __attribute__((weak));
+#define ES_HAVE_BLAS_THREADS 1
+#endif
+
+es_status es_embed_solve(es_ctx *ctx, es_embedder *emb, const double *target, double scale,
+                         const double *init_alpha, const double *init_xyz,
+                         const es_embed_opts *opts, double *xyz, es_embed_report *report)
+{
+    es_status rc;
+    if (!emb) ES_FAIL(ctx, ES_EINVAL, "embed: no embedder");
+    int want = opts ? opts->blas_threads : 1, had = 0;
+    /* init_xyz may be the output array (a sequence aligned frame to frame):
+     * the solve writes its output before it aligns it to init_xyz, so it
+     * must read a copy then */
+    if (init_xyz && xyz) {
+        uintptr_t a = (uintptr_t)init_xyz, b = (uintptr_t)xyz;
+        uintptr_t n = 3 * (uintptr_t)emb->nv * sizeof *xyz;
+        if (a < b + n && b < a + n) {
+            memcpy(emb->init_copy, init_xyz, (size_t)n);
+            init_xyz = emb->init_copy;
+        }
+    }
+#ifdef ES_HAVE_BLAS_THREADS
+    if (want > 0 && openblas_set_num_threads && openblas_get_num_threads) {
+        had = openblas_get_num_threads();
+        if (had != want) openblas_set_num_threads(want);
+        else had = 0;
+    }
+#endif
+    rc = embed_solve(emb, target, scale, init_alpha, init_xyz, opts, xyz, report);
+    if (emb->progress_total) {   /* failed part way: close the bar */
+        es__progress(emb->ctx, "embedding", emb->progress_total, emb->progress_total);
+        emb->progress_total = 0;
+    }
+#ifdef ES_HAVE_BLAS_THREADS
+    if (had > 0) openblas_set_num_threads(had);
+#endif
+    (void)want;
+    (void)had;
+    /* the embedder works on its own context; the caller's gets the message */
+    if (rc != ES_OK && ctx && ctx != emb->ctx) es__fail(ctx, rc, "%s", es_ctx_errmsg(emb->ctx));
+    return rc;
+}
