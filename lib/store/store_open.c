@@ -145,7 +145,8 @@ static es_status load(es_store *s)
     s->nrows = n;
     if ((rc = es__h5_read_strings(ctx, s->file, "/shapes/ids", n, s->ids)) ||
         (rc = es__h5_read_strings(ctx, s->file, "/shapes/source_paths", n, s->sources)) ||
-        (rc = es__h5_read_strings(ctx, s->file, "/shapes/content_hash", n, s->hashes)))
+        (rc = es__h5_read_strings(ctx, s->file, "/shapes/content_hash", n, s->hashes)) ||
+        (rc = es__store_index_ids(s)))
         return rc;
     return load_columns(s);
 }
@@ -213,14 +214,32 @@ es_status es_store_open(es_ctx *ctx, const char *path, es_store_mode mode, es_st
     return rc;
 }
 
+/* /topology/<name>: n rows of `width` vertex indices, fixed size (the
+ * topology never changes after creation, so it is neither chunked nor
+ * extendable). */
+static es_status write_topology(es_ctx *ctx, hid_t g, const char *name, int64_t n, int width,
+                                const int64_t *data)
+{
+    hsize_t d[2] = {(hsize_t)n, (hsize_t)width};
+    hid_t sp = -1, ds = -1;
+    es_status rc = ES_OK;
+    if ((sp = H5Screate_simple(2, d, NULL)) < 0 ||
+        (ds = H5Dcreate2(g, name, H5T_STD_I64LE, sp, H5P_DEFAULT, H5P_DEFAULT,
+                         H5P_DEFAULT)) < 0 ||
+        (n > 0 && H5Dwrite(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0))
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot write /topology/%s", name);
+    es__h5_close(ds);
+    es__h5_close(sp);
+    return rc;
+}
+
 static es_status create_impl(es_ctx *ctx, const char *path, int64_t nverts, int64_t nfaces,
                              const int64_t *faces, int64_t nedges, const int64_t *edges,
                              const char *fingerprint, es_store **out)
 {
     es_store *s;
     es_status rc = ES_OK;
-    hid_t fapl = -1, g = -1, sp = -1, ds = -1, t = -1;
-    hsize_t d[2];
+    hid_t fapl = -1, g = -1, t = -1;
     char when[32];
     time_t now = time(NULL);
     struct tm tmv;
@@ -279,27 +298,9 @@ static es_status create_impl(es_ctx *ctx, const char *path, int64_t nverts, int6
     if ((rc = es__h5_write_attr_i64(ctx, g, "nverts", nverts)) ||
         (rc = es__h5_write_attr_str(ctx, g, "fingerprint", s->fingerprint)))
         goto fail;
-    d[0] = (hsize_t)nfaces;
-    d[1] = 3;
-    if ((sp = H5Screate_simple(2, d, NULL)) < 0 ||
-        (ds = H5Dcreate2(g, "faces", H5T_STD_I64LE, sp, H5P_DEFAULT, H5P_DEFAULT,
-                         H5P_DEFAULT)) < 0 ||
-        (nfaces > 0 && H5Dwrite(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, faces) < 0)) {
-        rc = es__h5_fail(ctx, ES_EIO, "store: cannot write /topology/faces");
+    if ((rc = write_topology(ctx, g, "faces", nfaces, 3, faces)) ||
+        (rc = write_topology(ctx, g, "edges", nedges, 2, edges)))
         goto fail;
-    }
-    es__h5_close(ds);
-    es__h5_close(sp);
-    ds = sp = -1;
-    d[0] = (hsize_t)nedges;
-    d[1] = 2;
-    if ((sp = H5Screate_simple(2, d, NULL)) < 0 ||
-        (ds = H5Dcreate2(g, "edges", H5T_STD_I64LE, sp, H5P_DEFAULT, H5P_DEFAULT,
-                         H5P_DEFAULT)) < 0 ||
-        (nedges > 0 && H5Dwrite(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, edges) < 0)) {
-        rc = es__h5_fail(ctx, ES_EIO, "store: cannot write /topology/edges");
-        goto fail;
-    }
     es__h5_close(g);
     g = -1;
     if ((g = H5Gcreate2(s->file, "/shapes", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) < 0 ||
@@ -332,16 +333,12 @@ static es_status create_impl(es_ctx *ctx, const char *path, int64_t nverts, int6
     g = -1;
     if ((rc = es__store_reserve_rows(s, 1))) goto fail;
     es__h5_close(t);
-    es__h5_close(ds);
-    es__h5_close(sp);
     es__h5_close(fapl);
     *out = s;
     return ES_OK;
 fail:
     es__h5_close(t);
     es__h5_close(g);
-    es__h5_close(ds);
-    es__h5_close(sp);
     es__h5_close(fapl);
     release(s, false);
     return rc;

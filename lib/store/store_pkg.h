@@ -12,6 +12,7 @@
 #endif
 
 #include "core/core_private.h"
+#include "core/strmap.h"
 #include "edgespace/es_store.h"
 
 #include <hdf5.h>
@@ -42,6 +43,8 @@ struct es_store {
     char fingerprint[17];
     char **ids, **sources, **hashes; /* nrows each */
     int64_t cap;
+    es__strmap id_rows;    /* ids[i] -> i; its keys are the strings ids[i] point
+                            * to, which stay put when ids itself is regrown */
     int64_t ncols;
     char **colnames;
     char ***labels;        /* labels[col][row] */
@@ -105,9 +108,11 @@ es_status es__store_publish(es_ctx *ctx, es_store *s);
 
 /* ---- in-memory row metadata (store_rows.c) ---- */
 
-/* Free ids, sources, hashes, labels and column names. */
+/* Free ids, sources, hashes, labels, column names and the id map. */
 void es__store_free_rows(es_store *s);
 /* Grow the per-row arrays to hold `need` rows; new slots are NULL. */
 es_status es__store_reserve_rows(es_store *s, int64_t need);
+/* Map each of the s->nrows loaded ids to its row (the first of repeats). */
+es_status es__store_index_ids(es_store *s);
 
 #endif
