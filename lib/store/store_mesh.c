@@ -1,7 +1,7 @@
 /* lib/store/store_mesh.c — the store's topology as an es_mesh, both ways:
  * es_store_create takes the faces, edges and fingerprint of a mesh, and
  * es_store_mesh rebuilds the mesh (with row 0 as reference positions).
- * Kept apart from store.c so that the HDF5 layer depends on raw arrays
+ * Kept apart from the HDF5 files so that they depend on raw arrays
  * only. */
 #include "core/core_private.h"
 #include "edgespace/es_mesh.h"

@@ -1,0 +1,386 @@
+/* lib/store/store_open.c — the store handle: open and create, load and
+ * check what the file holds, close (committing) or abort, and the handle's
+ * getters (datasets-spec/store-format.md).
+ *
+ * One HDF5 file: a format version at the root, the topology, per-shape rows
+ * (normalized lengths N x E, scales, positions N x V x 3, ids, source paths,
+ * content hashes), string label columns, and analysis results with their
+ * provenance. Opening reads the row metadata (ids, paths, hashes, labels)
+ * into the handle once, checking the shape of every dataset against the
+ * topology, so the getters never touch the file and a store that does not
+ * fit its format is refused at open rather than half-way through a study.
+ * Every public entry point runs with HDF5's error printing off
+ * (H5E_BEGIN_TRY/H5E_END_TRY).
+ */
+#include "store/store_pkg.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+/* Version 1: meshes only. Version 2 adds the root attribute topology_kind
+ * ("mesh", "truss", "none"): faces may be empty (truss: an edge list of
+ * landmark pairs), and so may edges (none: landmark configurations only, no
+ * /shapes/lengths or /shapes/scales). Mesh stores are still written as
+ * version 1, byte-compatible with earlier releases; both versions are read. */
+#define FORMAT_VERSION 1
+#define FORMAT_VERSION_KIND 2
+
+static es_status load_columns(es_store *s)
+{
+    es_ctx *ctx = s->ctx;
+    hid_t g = -1, a = -1, sp = -1, t = -1;
+    hssize_t n = 0;
+    char **raw = NULL;
+    es_status rc = ES_OK;
+    if ((g = H5Gopen2(s->file, "/labels", H5P_DEFAULT)) < 0 ||
+        (a = H5Aopen(g, "columns", H5P_DEFAULT)) < 0 || (sp = H5Aget_space(a)) < 0) {
+        rc = es__h5_fail(ctx, ES_EFORMAT, "store: '%s': /labels lacks its 'columns' attribute",
+                         s->path);
+        goto done;
+    }
+    n = H5Sget_simple_extent_type(sp) == H5S_NULL ? 0 : H5Sget_simple_extent_npoints(sp);
+    if (n > 0) {
+        if (!(raw = es__alloc_array(ctx, n, sizeof *raw)) ||
+            !(s->colnames = es__alloc_array(ctx, n, sizeof *s->colnames)) ||
+            !(s->labels = es__alloc_array(ctx, n, sizeof *s->labels))) {
+            rc = ES_ENOMEM;
+            goto done;
+        }
+        if ((t = es__h5_str_type()) < 0 || H5Aread(a, t, raw) < 0) {
+            rc = es__h5_fail(ctx, ES_EFORMAT, "store: cannot read /labels columns");
+            goto done;
+        }
+        s->ncols = n;
+        for (hssize_t c = 0; c < n && rc == ES_OK; c++)
+            if (!(s->colnames[c] = es__strdup(ctx, raw[c] ? raw[c] : ""))) rc = ES_ENOMEM;
+        H5Dvlen_reclaim(t, sp, H5P_DEFAULT, raw);
+        for (hssize_t c = 0; c < n && rc == ES_OK; c++) {
+            if (!(s->labels[c] = es__alloc_array(ctx, s->cap ? s->cap : 1, sizeof(char *))))
+                rc = ES_ENOMEM;
+            else
+                rc = es__h5_read_strings(ctx, g, s->colnames[c], s->nrows, s->labels[c]);
+        }
+    }
+done:
+    es__free(ctx, raw);
+    es__h5_close(t);
+    es__h5_close(sp);
+    es__h5_close(a);
+    es__h5_close(g);
+    return rc;
+}
+
+/* Check the format version and the shapes of every dataset; load ids,
+ * source paths, hashes and labels. */
+static es_status load(es_store *s)
+{
+    es_ctx *ctx = s->ctx;
+    int64_t version = 0, n;
+    hsize_t dims[3];
+    es_status rc;
+    hid_t g;
+    char fp[64];
+    if ((rc = es__h5_read_attr_i64(ctx, s->file, "the root group", "format_version", &version)))
+        return es__fail(ctx, ES_EFORMAT, "store: '%s' is not an edgespace store (%s)",
+                        s->path, es_ctx_errmsg(ctx));
+    if (version != FORMAT_VERSION && version != FORMAT_VERSION_KIND)
+        ES_FAIL(ctx, ES_EFORMAT, "store: '%s' has format version %lld; this edgespace reads "
+                "versions %d and %d", s->path, (long long)version, FORMAT_VERSION,
+                FORMAT_VERSION_KIND);
+    s->kind = ES_TOPOLOGY_MESH;
+    if (version == FORMAT_VERSION_KIND) {
+        char kind[16];
+        if (es__h5_read_attr_text(ctx, s->file, "topology_kind", kind, sizeof kind))
+            ES_FAIL(ctx, ES_EFORMAT, "store: '%s' has format version 2 but no topology_kind "
+                    "attribute", s->path);
+        if (!strcmp(kind, "mesh")) s->kind = ES_TOPOLOGY_MESH;
+        else if (!strcmp(kind, "truss")) s->kind = ES_TOPOLOGY_TRUSS;
+        else if (!strcmp(kind, "none")) s->kind = ES_TOPOLOGY_NONE;
+        else
+            ES_FAIL(ctx, ES_EFORMAT, "store: '%s' has topology_kind '%s' (want mesh, truss or "
+                    "none)", s->path, kind);
+    }
+    if ((g = H5Gopen2(s->file, "/topology", H5P_DEFAULT)) < 0)
+        return es__h5_fail(ctx, ES_EFORMAT, "store: '%s' has no /topology", s->path);
+    rc = es__h5_read_attr_i64(ctx, g, "/topology", "nverts", &s->nverts);
+    if (!rc) rc = es__h5_read_attr_text(ctx, g, "fingerprint", fp, sizeof fp);
+    H5Gclose(g);
+    if (rc) return rc;
+    snprintf(s->fingerprint, sizeof s->fingerprint, "%.16s", fp);
+    if ((s->nfaces = es__h5_dataset_rows(s->file, "/topology/faces", 2, dims)) < 0 ||
+        dims[1] != 3)
+        ES_FAIL(ctx, ES_EFORMAT, "store: '%s': /topology/faces is not F x 3", s->path);
+    if ((s->nedges = es__h5_dataset_rows(s->file, "/topology/edges", 2, dims)) < 0 ||
+        dims[1] != 2)
+        ES_FAIL(ctx, ES_EFORMAT, "store: '%s': /topology/edges is not E x 2", s->path);
+    if ((s->kind == ES_TOPOLOGY_MESH) != (s->nfaces > 0) ||
+        (s->kind == ES_TOPOLOGY_NONE) != (s->nedges == 0))
+        ES_FAIL(ctx, ES_EFORMAT, "store: '%s': topology kind '%s' with %lld faces and %lld "
+                "edges", s->path, es_topology_kind_name(s->kind), (long long)s->nfaces,
+                (long long)s->nedges);
+    if (s->kind == ES_TOPOLOGY_NONE) {
+        n = es__h5_dataset_rows(s->file, "/shapes/positions", 3, dims);
+        if (n < 0 || (int64_t)dims[1] != s->nverts || dims[2] != 3)
+            ES_FAIL(ctx, ES_EFORMAT, "store: '%s': /shapes/positions is not N x %lld x 3",
+                    s->path, (long long)s->nverts);
+    } else if ((n = es__h5_dataset_rows(s->file, "/shapes/lengths", 2, dims)) < 0 ||
+               (int64_t)dims[1] != s->nedges) {
+        ES_FAIL(ctx, ES_EFORMAT, "store: '%s': /shapes/lengths is not N x %lld", s->path,
+                (long long)s->nedges);
+    }
+    if (es__h5_dataset_rows(s->file, "/shapes/positions", 3, dims) != n ||
+        (int64_t)dims[1] != s->nverts || dims[2] != 3)
+        ES_FAIL(ctx, ES_EFORMAT, "store: '%s': /shapes/positions is not %lld x %lld x 3",
+                s->path, (long long)n, (long long)s->nverts);
+    if (s->kind != ES_TOPOLOGY_NONE &&
+        es__h5_dataset_rows(s->file, "/shapes/scales", 1, dims) != n)
+        ES_FAIL(ctx, ES_EFORMAT, "store: '%s': /shapes/scales does not have %lld rows",
+                s->path, (long long)n);
+    s->nrows = 0;
+    if ((rc = es__store_reserve_rows(s, n > 0 ? n : 1))) return rc;
+    s->nrows = n;
+    if ((rc = es__h5_read_strings(ctx, s->file, "/shapes/ids", n, s->ids)) ||
+        (rc = es__h5_read_strings(ctx, s->file, "/shapes/source_paths", n, s->sources)) ||
+        (rc = es__h5_read_strings(ctx, s->file, "/shapes/content_hash", n, s->hashes)) ||
+        (rc = es__store_index_ids(s)))
+        return rc;
+    return load_columns(s);
+}
+
+static void release(es_store *s, bool keep_work)
+{
+    if (!s) return;
+    es_ctx *ctx = s->ctx;
+    if (s->file >= 0) H5Fclose(s->file);
+    s->file = -1;
+    if (s->work && !keep_work) unlink(s->work);
+    es__store_free_rows(s);
+    es__free(ctx, s->work);
+    es__free(ctx, s->path);
+    es__free(ctx, s);
+}
+
+static es_status open_impl(es_ctx *ctx, const char *path, es_store_mode mode, es_store **out)
+{
+    es_store *s;
+    es_status rc;
+    htri_t is;
+    hid_t fapl;
+    *out = NULL;
+    if (!path || !*path) ES_FAIL(ctx, ES_EINVAL, "store: empty path");
+    if (mode != ES_STORE_READ && mode != ES_STORE_WRITE)
+        ES_FAIL(ctx, ES_EINVAL, "store: bad open mode %d", (int)mode);
+    if (access(path, F_OK) != 0)
+        ES_FAIL(ctx, errno == ENOENT ? ES_ENOTFOUND : ES_EIO, "store: cannot open '%s': %s",
+                path, strerror(errno));
+    if ((is = H5Fis_hdf5(path)) <= 0) {
+        if (is < 0) return es__h5_fail(ctx, ES_EIO, "store: cannot read '%s'", path);
+        ES_FAIL(ctx, ES_EFORMAT, "store: '%s' is not an HDF5 file", path);
+    }
+    if (!(s = es__calloc(ctx, 1, sizeof *s))) return ES_ENOMEM;
+    s->ctx = ctx;
+    s->file = -1;
+    s->mode = mode;
+    if (!(s->path = es__strdup(ctx, path))) { rc = ES_ENOMEM; goto fail; }
+    /* Before opening: if another writer replaces the file in between, the
+     * first write sees a different identity and refuses (never stale rows). */
+    if (stat(path, &s->opened) != 0) {
+        rc = es__fail(ctx, ES_EIO, "store: cannot open '%s': %s", path, strerror(errno));
+        goto fail;
+    }
+    fapl = es__h5_file_access();
+    s->file = H5Fopen(path, H5F_ACC_RDONLY, fapl);
+    es__h5_close(fapl);
+    if (s->file < 0) {
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot open '%s'", path);
+        goto fail;
+    }
+    if ((rc = load(s))) goto fail;
+    *out = s;
+    return ES_OK;
+fail:
+    release(s, false);
+    return rc;
+}
+
+es_status es_store_open(es_ctx *ctx, const char *path, es_store_mode mode, es_store **out)
+{
+    es_status rc;
+    H5E_BEGIN_TRY { rc = open_impl(ctx, path, mode, out); } H5E_END_TRY
+    return rc;
+}
+
+/* /topology/<name>: n rows of `width` vertex indices, fixed size (the
+ * topology never changes after creation, so it is neither chunked nor
+ * extendable). */
+static es_status write_topology(es_ctx *ctx, hid_t g, const char *name, int64_t n, int width,
+                                const int64_t *data)
+{
+    hsize_t d[2] = {(hsize_t)n, (hsize_t)width};
+    hid_t sp = -1, ds = -1;
+    es_status rc = ES_OK;
+    if ((sp = H5Screate_simple(2, d, NULL)) < 0 ||
+        (ds = H5Dcreate2(g, name, H5T_STD_I64LE, sp, H5P_DEFAULT, H5P_DEFAULT,
+                         H5P_DEFAULT)) < 0 ||
+        (n > 0 && H5Dwrite(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0))
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot write /topology/%s", name);
+    es__h5_close(ds);
+    es__h5_close(sp);
+    return rc;
+}
+
+static es_status create_impl(es_ctx *ctx, const char *path, int64_t nverts, int64_t nfaces,
+                             const int64_t *faces, int64_t nedges, const int64_t *edges,
+                             const char *fingerprint, es_store **out)
+{
+    es_store *s;
+    es_status rc = ES_OK;
+    hid_t fapl = -1, g = -1, t = -1;
+    char when[32];
+    time_t now = time(NULL);
+    struct tm tmv;
+    *out = NULL;
+    if (!path || !*path) ES_FAIL(ctx, ES_EINVAL, "store: empty path");
+    if (nverts < 1 || nfaces < 0 || nedges < 0 || (nfaces > 0 && (!faces || nedges < 1)) ||
+        (nedges > 0 && !edges))
+        ES_FAIL(ctx, ES_EINVAL, "store: bad topology (%lld vertices, %lld faces, %lld "
+                "edges)", (long long)nverts, (long long)nfaces, (long long)nedges);
+    for (int64_t e = 0; nfaces == 0 && e < nedges; e++) {
+        const int64_t *p = edges + 2 * e;
+        if (p[0] < 0 || p[0] >= p[1] || p[1] >= nverts ||
+            (e > 0 && (p[-2] > p[0] || (p[-2] == p[0] && p[-1] >= p[1]))))
+            ES_FAIL(ctx, ES_EINVAL, "store: edge %lld (%lld, %lld) is not a (min, max) pair of "
+                    "vertices below %lld in sorted order without repeats", (long long)e,
+                    (long long)p[0], (long long)p[1], (long long)nverts);
+    }
+    if (access(path, F_OK) == 0)
+        ES_FAIL(ctx, ES_EEXIST, "store: '%s' exists already", path);
+    if (!(s = es__calloc(ctx, 1, sizeof *s))) return ES_ENOMEM;
+    s->ctx = ctx;
+    s->file = -1;
+    s->mode = ES_STORE_WRITE;
+    s->is_new = true;
+    s->nverts = nverts;
+    s->nfaces = nfaces;
+    s->nedges = nedges;
+    s->kind = nfaces > 0 ? ES_TOPOLOGY_MESH : nedges > 0 ? ES_TOPOLOGY_TRUSS : ES_TOPOLOGY_NONE;
+    snprintf(s->fingerprint, sizeof s->fingerprint, "%.16s", fingerprint ? fingerprint : "");
+    if (!(s->path = es__strdup(ctx, path)) || !(s->work = es__store_temp_name(s))) {
+        rc = ES_ENOMEM;
+        goto fail;
+    }
+    es__store_clean_stale(path);
+    fapl = es__h5_file_access();
+    s->file = H5Fcreate(s->work, H5F_ACC_EXCL, H5P_DEFAULT, fapl);
+    if (s->file < 0) {
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot create '%s'", s->work);
+        goto fail;
+    }
+    gmtime_r(&now, &tmv);
+    strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", &tmv);
+    if ((rc = es__h5_write_attr_i64(ctx, s->file, "format_version",
+                                    s->kind == ES_TOPOLOGY_MESH ? FORMAT_VERSION
+                                                         : FORMAT_VERSION_KIND)) ||
+        (rc = es__h5_write_attr_str(ctx, s->file, "creator", "edgespace " ES_VERSION_STRING)) ||
+        (rc = es__h5_write_attr_str(ctx, s->file, "created", when)) ||
+        (s->kind != ES_TOPOLOGY_MESH &&
+         (rc = es__h5_write_attr_str(ctx, s->file, "topology_kind",
+                                     es_topology_kind_name(s->kind)))))
+        goto fail;
+    if ((g = H5Gcreate2(s->file, "/topology", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) < 0) {
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot create /topology");
+        goto fail;
+    }
+    if ((rc = es__h5_write_attr_i64(ctx, g, "nverts", nverts)) ||
+        (rc = es__h5_write_attr_str(ctx, g, "fingerprint", s->fingerprint)))
+        goto fail;
+    if ((rc = write_topology(ctx, g, "faces", nfaces, 3, faces)) ||
+        (rc = write_topology(ctx, g, "edges", nedges, 2, edges)))
+        goto fail;
+    es__h5_close(g);
+    g = -1;
+    if ((g = H5Gcreate2(s->file, "/shapes", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) < 0 ||
+        (t = es__h5_str_type()) < 0) {
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot create /shapes");
+        goto fail;
+    }
+    /* HDF5 chunks cannot be 0 wide: a store without edges has no lengths
+     * (and no scales, which are sums of raw edge lengths). */
+    if ((nedges > 0 &&
+         ((rc = es__h5_create_rows(ctx, g, "lengths", H5T_IEEE_F64LE, 2, (hsize_t)nedges, 0, 8)) ||
+          (rc = es__h5_create_rows(ctx, g, "scales", H5T_IEEE_F64LE, 1, 0, 0, 8)))) ||
+        (rc = es__h5_create_rows(ctx, g, "positions", H5T_IEEE_F64LE, 3, (hsize_t)nverts, 3, 8)) ||
+        (rc = es__h5_create_rows(ctx, g, "ids", t, 1, 0, 0, 16)) ||
+        (rc = es__h5_create_rows(ctx, g, "source_paths", t, 1, 0, 0, 16)) ||
+        (rc = es__h5_create_rows(ctx, g, "content_hash", t, 1, 0, 0, 16)))
+        goto fail;
+    es__h5_close(g);
+    if ((g = H5Gcreate2(s->file, "/labels", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) < 0) {
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot create /labels");
+        goto fail;
+    }
+    if ((rc = es__h5_write_attr_strs(ctx, g, "columns", NULL, 0))) goto fail;
+    es__h5_close(g);
+    if ((g = H5Gcreate2(s->file, "/analysis", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) < 0) {
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot create /analysis");
+        goto fail;
+    }
+    es__h5_close(g);
+    g = -1;
+    if ((rc = es__store_reserve_rows(s, 1))) goto fail;
+    es__h5_close(t);
+    es__h5_close(fapl);
+    *out = s;
+    return ES_OK;
+fail:
+    es__h5_close(t);
+    es__h5_close(g);
+    es__h5_close(fapl);
+    release(s, false);
+    return rc;
+}
+
+es_status es__store_create_raw(es_ctx *ctx, const char *path, int64_t nverts, int64_t nfaces,
+                               const int64_t *faces, int64_t nedges, const int64_t *edges,
+                               const char *fingerprint, es_store **out)
+{
+    es_status rc;
+    H5E_BEGIN_TRY {
+        rc = create_impl(ctx, path, nverts, nfaces, faces, nedges, edges, fingerprint, out);
+    } H5E_END_TRY
+    return rc;
+}
+
+void es_store_abort(es_store *store)
+{
+    if (!store) return;
+    H5E_BEGIN_TRY { release(store, false); } H5E_END_TRY
+}
+
+void es_store_close(es_store *store)
+{
+    if (!store) return;
+    H5E_BEGIN_TRY {
+        if (store->work && !store->broken) {
+            es_status rc = es__store_publish(store->ctx, store);
+            if (rc != ES_OK)
+                es__warn(store->ctx, "%s", es_ctx_errmsg(store->ctx));
+        }
+        release(store, false);
+    } H5E_END_TRY
+}
+
+int64_t es_store_nrows(const es_store *s) { return s ? s->nrows : 0; }
+int64_t es_store_nedges(const es_store *s) { return s ? s->nedges : 0; }
+int64_t es_store_nverts(const es_store *s) { return s ? s->nverts : 0; }
+int64_t es_store_nfaces(const es_store *s) { return s ? s->nfaces : 0; }
+es_topology_kind es_store_topology_kind(const es_store *s)
+{
+    return s ? s->kind : ES_TOPOLOGY_MESH;
+}
+const char *es_store_path(const es_store *s) { return s ? s->path : NULL; }
+const char *es_store_fingerprint(const es_store *s) { return s ? s->fingerprint : NULL; }

@@ -1,0 +1,277 @@
+/* lib/store/store_publish.c — crash-safe writing: the working copy, its
+ * publishing by atomic rename, and the checks that keep two writers from
+ * losing each other's work.
+ *
+ * The store file itself is never written in place. A handle opened for
+ * writing reads the original until its first write; then it copies the
+ * file to a temporary sibling ".<name>.tmp-<pid>-<n>" and every write goes
+ * to the copy. es_store_commit (also done by es_store_close) flushes and
+ * closes the copy, fsyncs it, and rename()s it over the original, then
+ * fsyncs the directory: a reader sees the old store or the new one, never
+ * a mix, and a process killed at any moment leaves the original
+ * byte-for-byte as it was plus, at worst, a stale temporary that the next
+ * writer removes (its pid is dead). A new store is made the same way and
+ * published with link(), which refuses to clobber a file that appeared
+ * meanwhile. If the original changed under us (another writer committed
+ * first), commit refuses rather than silently losing its work; the check
+ * and the rename hold an advisory lock on the folder. This is the "write a
+ * new file, then rename" scheme of editors and package managers (SQLite
+ * keeps every fsync and rename in os_unix.c for the same reason); HDF5 1.10
+ * has no transactional writes of its own.
+ */
+#include "store/store_pkg.h"
+#include "core/files.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+/* kill(pid, 0) failing with ESRCH is the only proof that the writer is
+ * gone: EPERM means alive under another user, so its copy is kept. */
+void es__store_clean_stale(const char *path)
+{
+    char dirbuf[4096], prefix[512];
+    const char *base = es__path_base(path);
+    size_t dn = (size_t)(base - path);
+    DIR *d;
+    struct dirent *e;
+    if (dn >= sizeof dirbuf) return;
+    if (dn == 0) snprintf(dirbuf, sizeof dirbuf, ".");
+    else {
+        memcpy(dirbuf, path, dn);
+        dirbuf[dn] = '\0';
+    }
+    snprintf(prefix, sizeof prefix, ".%s.tmp-", base);
+    if (!(d = opendir(dirbuf))) return;
+    while ((e = readdir(d))) {
+        size_t pn = strlen(prefix);
+        char *end, full[4608];
+        long pid;
+        if (strncmp(e->d_name, prefix, pn)) continue;
+        pid = strtol(e->d_name + pn, &end, 10);
+        if (end == e->d_name + pn || *end != '-' || pid <= 0) continue;
+        if (pid == (long)getpid() || kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue;
+        snprintf(full, sizeof full, "%s/%s", dirbuf, e->d_name);
+        unlink(full);
+    }
+    closedir(d);
+}
+
+char *es__store_temp_name(es_store *s)
+{
+    const char *base = es__path_base(s->path);
+    size_t dn = (size_t)(base - s->path), n = strlen(s->path) + 64;
+    char *t = es__malloc(s->ctx, n);
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    /* pid first (stale copies are recognized by it), then enough to keep
+     * two handles of one process apart. */
+    if (t) snprintf(t, n, "%.*s.%s.tmp-%ld-%lx%lx%u", (int)dn, s->path, base, (long)getpid(),
+                    (unsigned long)(uintptr_t)s, (unsigned long)ts.tv_nsec, s->tmp_counter++);
+    return t;
+}
+
+static es_status copy_file(es_ctx *ctx, const char *src, const char *dst, struct stat *st)
+{
+    int in = -1, out = -1;
+    es_status rc = ES_OK;
+    char *buf = NULL;
+    if ((in = open(src, O_RDONLY | O_CLOEXEC)) < 0 || fstat(in, st) < 0) {
+        rc = es__fail(ctx, ES_EIO, "store: cannot read '%s': %s", src, strerror(errno));
+        goto done;
+    }
+    if ((out = open(dst, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, st->st_mode & 07777)) < 0) {
+        rc = es__fail(ctx, ES_EIO, "store: cannot create working copy '%s': %s", dst,
+                      strerror(errno));
+        goto done;
+    }
+    if (!(buf = es__malloc(ctx, 1 << 20))) { rc = ES_ENOMEM; goto done; }
+    for (;;) {
+        ssize_t r = read(in, buf, 1 << 20), w = 0;
+        if (r < 0 && errno == EINTR) continue;
+        if (r < 0) {
+            rc = es__fail(ctx, ES_EIO, "store: cannot read '%s': %s", src, strerror(errno));
+            goto done;
+        }
+        if (r == 0) break;
+        while (w < r) {
+            ssize_t k = write(out, buf + w, (size_t)(r - w));
+            if (k < 0 && errno == EINTR) continue;
+            if (k < 0) {
+                rc = es__fail(ctx, ES_EIO, "store: cannot write '%s': %s", dst,
+                              strerror(errno));
+                goto done;
+            }
+            w += k;
+        }
+    }
+done:
+    es__free(ctx, buf);
+    if (in >= 0) close(in);
+    if (out >= 0 && close(out) < 0 && rc == ES_OK)
+        rc = es__fail(ctx, ES_EIO, "store: cannot write '%s': %s", dst, strerror(errno));
+    if (rc != ES_OK && out >= 0) unlink(dst);
+    return rc;
+}
+
+static es_status fsync_path(es_ctx *ctx, const char *path, bool dir)
+{
+    int fd = open(path, (dir ? O_RDONLY | O_DIRECTORY : O_RDONLY) | O_CLOEXEC);
+    if (fd < 0 || (fsync(fd) < 0 && !dir)) {
+        int e = errno;
+        if (fd >= 0) close(fd);
+        ES_FAIL(ctx, ES_EIO, "store: cannot sync '%s': %s", path, strerror(e));
+    }
+    close(fd);
+    return ES_OK;
+}
+
+/* Another writer's commit replaces the file (a new inode) and an in-place
+ * writer (h5py, h5repack) changes its size or mtime: either way the rows
+ * this handle holds are no longer the file's. */
+static bool same_identity(const struct stat *a, const struct stat *b)
+{
+    return a->st_ino == b->st_ino && a->st_dev == b->st_dev && a->st_size == b->st_size &&
+           a->st_mtim.tv_sec == b->st_mtim.tv_sec && a->st_mtim.tv_nsec == b->st_mtim.tv_nsec;
+}
+
+/* First write on a handle opened for writing: switch to a working copy. */
+es_status es__store_begin_write(es_store *s)
+{
+    es_ctx *ctx = s->ctx;
+    es_status rc;
+    hid_t fapl;
+    if (s->mode != ES_STORE_WRITE)
+        ES_FAIL(ctx, ES_EINVAL, "store: '%s' is open read-only", s->path);
+    if (s->broken)
+        ES_FAIL(ctx, ES_EIO, "store: an earlier write to '%s' failed; reopen the store",
+                s->path);
+    if (s->work) return ES_OK;
+    es__store_clean_stale(s->path);
+    if (!(s->work = es__store_temp_name(s))) return ES_ENOMEM;
+    if ((rc = copy_file(ctx, s->path, s->work, &s->orig))) goto fail;
+    if (!same_identity(&s->orig, &s->opened)) {
+        /* Rows, ids and columns in memory are those of the file we opened;
+         * writing them onto another writer's newer store would corrupt it. */
+        unlink(s->work);
+        rc = es__fail(ctx, ES_EIO, "store: '%s' was changed by another writer since it was "
+                      "opened; nothing written", s->path);
+        goto fail;
+    }
+    H5Fclose(s->file);
+    fapl = es__h5_file_access();
+    s->file = H5Fopen(s->work, H5F_ACC_RDWR, fapl);
+    es__h5_close(fapl);
+    if (s->file < 0) {
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot open working copy '%s'", s->work);
+        unlink(s->work);
+        s->file = H5Fopen(s->path, H5F_ACC_RDONLY, H5P_DEFAULT);
+        if (s->file < 0) s->broken = true;
+        goto fail;
+    }
+    return ES_OK;
+fail:
+    es__free(ctx, s->work);
+    s->work = NULL;
+    return rc;
+}
+
+es_status es__store_publish(es_ctx *ctx, es_store *s)
+{
+    es_status rc = ES_OK;
+    struct stat now, done;
+    char *dir = NULL;
+    hid_t fapl;
+    if (!s->work) return ES_OK; /* nothing written */
+    if (s->broken)
+        ES_FAIL(ctx, ES_EIO, "store: an earlier write to '%s' failed; nothing committed",
+                s->path);
+    if (H5Fflush(s->file, H5F_SCOPE_GLOBAL) < 0) {
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot flush '%s'", s->work);
+        goto fail;
+    }
+    if (H5Fclose(s->file) < 0) {
+        s->file = -1;
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot close '%s'", s->work);
+        goto fail;
+    }
+    s->file = -1;
+    if ((rc = fsync_path(ctx, s->work, false))) goto fail;
+    /* the identity the published file will have (link and rename keep the
+     * inode): taken now, a commit landing right after ours is not mistaken
+     * for the file this handle's rows come from */
+    if (stat(s->work, &done) != 0) memset(&done, 0, sizeof done);
+    if (s->is_new) {
+        /* link() refuses to replace a file that appeared meanwhile. */
+        if (link(s->work, s->path) != 0) {
+            if (errno == EEXIST) {
+                rc = es__fail(ctx, ES_EEXIST, "store: '%s' was created by someone else "
+                              "meanwhile; nothing written", s->path);
+                goto fail;
+            }
+            if (access(s->path, F_OK) == 0 || rename(s->work, s->path) != 0) {
+                rc = es__fail(ctx, ES_EIO, "store: cannot create '%s': %s", s->path,
+                              strerror(errno));
+                goto fail;
+            }
+        } else {
+            unlink(s->work);
+        }
+    } else {
+        /* The identity check and the rename are one step for every writer of
+         * this folder (an advisory lock on the folder): otherwise another
+         * commit landing between them would be replaced unseen. */
+        int dfd = -1;
+        if ((dir = es__path_dir(ctx, s->path)) &&
+            (dfd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC)) >= 0)
+            while (flock(dfd, LOCK_EX) != 0 && errno == EINTR) {
+            }
+        /* a folder that cannot be opened or locked (unreadable, some network
+         * file systems) leaves the commit unlocked: the identity check alone */
+        if (stat(s->path, &now) != 0 || !same_identity(&now, &s->orig)) {
+            rc = es__fail(ctx, ES_EIO, "store: '%s' was changed by another writer since it "
+                          "was opened; nothing written", s->path);
+        } else if (rename(s->work, s->path) != 0) {
+            rc = es__fail(ctx, ES_EIO, "store: cannot replace '%s': %s", s->path,
+                          strerror(errno));
+        }
+        if (dfd >= 0) close(dfd);   /* releases the lock */
+        es__free(ctx, dir);
+        dir = NULL;
+        if (rc != ES_OK) goto fail;
+    }
+    s->opened = done;
+    if ((dir = es__path_dir(ctx, s->path))) {
+        fsync_path(ctx, dir, true);
+        es__free(ctx, dir);
+    }
+    es__free(ctx, s->work);
+    s->work = NULL;
+    s->is_new = false;
+    fapl = es__h5_file_access();
+    s->file = H5Fopen(s->path, H5F_ACC_RDONLY, fapl);
+    es__h5_close(fapl);
+    if (s->file < 0)
+        return es__h5_fail(ctx, ES_EIO, "store: committed '%s' but cannot reopen it", s->path);
+    return ES_OK;
+fail:
+    s->broken = true;
+    return rc;
+}
+
+es_status es_store_commit(es_ctx *ctx, es_store *store)
+{
+    es_status rc;
+    if (!store) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    H5E_BEGIN_TRY { rc = es__store_publish(ctx, store); } H5E_END_TRY
+    return rc;
+}

@@ -1,0 +1,472 @@
+/* lib/store/store_results.c — analysis results in a store: each result is
+ * a group /analysis/<kind>/<name> begun with its provenance (command, tool
+ * version, time, parameters, the rows it used) and filled with datasets
+ * (matrices, vectors, integers, strings) and string attributes, read back
+ * by path, tested for and listed.
+ *
+ * Paths are at most 8 components, each checked like an HDF5 link name, so
+ * a result path from a command line can neither climb out of /analysis nor
+ * make HDF5 parse "." or "..". A matrix is stored as a cols x rows dataset,
+ * the bytes of its column-major memory unchanged (as /shapes/lengths is
+ * N x E); h5py and numpy read its transpose. Writes go through the working
+ * copy (store_publish.c); a failed write marks the handle broken.
+ */
+#include "store/store_pkg.h"
+
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+
+/* Split "a/b/c" into validated components; returns how many (max 8). */
+static int split_path(es_ctx *ctx, const char *path, char parts[8][128], es_status *rc)
+{
+    int n = 0;
+    *rc = ES_OK;
+    for (const char *p = path; p;) {
+        const char *slash = strchr(p, '/');
+        size_t len = slash ? (size_t)(slash - p) : strlen(p);
+        if (n == 8 || len == 0 || len >= 128 || (len == 1 && p[0] == '.') ||
+            (len == 2 && p[0] == '.' && p[1] == '.')) {
+            *rc = es__fail(ctx, ES_EINVAL, "store: bad result path '%s'", path ? path : "");
+            return -1;
+        }
+        memcpy(parts[n], p, len);
+        parts[n][len] = '\0';
+        n++;
+        p = slash ? slash + 1 : NULL;
+    }
+    return n;
+}
+
+static bool link_exists(hid_t file, const char *full)
+{
+    char buf[1200];
+    size_t n = strlen(full);
+    if (n >= sizeof buf) return false;
+    memcpy(buf, full, n + 1);
+    for (char *p = buf + 1;; p++) {
+        if (*p == '/' || *p == '\0') {
+            char save = *p;
+            *p = '\0';
+            if (H5Lexists(file, buf, H5P_DEFAULT) <= 0) return false;
+            if (!save) return true;
+            *p = save;
+        }
+    }
+}
+
+static void full_path(char *buf, size_t n, const char *rel)
+{
+    snprintf(buf, n, "/analysis/%s", rel);
+}
+
+static es_status result_begin_impl(es_ctx *ctx, es_store *s, const char *kind, const char *name,
+                                   const es_provenance *prov)
+{
+    char full[600], when[32];
+    hid_t g = -1, lcpl = -1;
+    es_status rc;
+    time_t now = time(NULL);
+    struct tm tmv;
+    int64_t *all = NULL;
+    if (es__h5_bad_name(kind) || es__h5_bad_name(name) || strlen(kind) > 120 || strlen(name) > 120)
+        ES_FAIL(ctx, ES_EINVAL, "store: bad result kind/name '%s/%s'", kind ? kind : "",
+                name ? name : "");
+    if (!prov || !prov->command) ES_FAIL(ctx, ES_EINVAL, "store: a result needs provenance");
+    if (prov->rows)
+        for (int64_t i = 0; i < prov->nrows; i++)
+            if (prov->rows[i] < 0 || prov->rows[i] >= s->nrows)
+                ES_FAIL(ctx, ES_ERANGE, "store: provenance row %lld is out of range",
+                        (long long)prov->rows[i]);
+    if ((rc = es__store_begin_write(s))) return rc;
+    snprintf(full, sizeof full, "/analysis/%s/%s", kind, name);
+    if (link_exists(s->file, full) && H5Ldelete(s->file, full, H5P_DEFAULT) < 0) {
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot replace %s", full);
+        goto fail;
+    }
+    if ((lcpl = H5Pcreate(H5P_LINK_CREATE)) < 0 || H5Pset_create_intermediate_group(lcpl, 1) < 0 ||
+        (g = H5Gcreate2(s->file, full, lcpl, H5P_DEFAULT, H5P_DEFAULT)) < 0) {
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot create %s", full);
+        goto fail;
+    }
+    gmtime_r(&now, &tmv);
+    strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", &tmv);
+    if ((rc = es__h5_write_attr_str(ctx, g, "command", prov->command)) ||
+        (rc = es__h5_write_attr_str(ctx, g, "tool_version", "edgespace " ES_VERSION_STRING)) ||
+        (rc = es__h5_write_attr_str(ctx, g, "time", when)) ||
+        (rc = es__h5_write_attr_str(ctx, g, "params", prov->params ? prov->params : "")) ||
+        (rc = es__h5_write_attr_i64(ctx, g, "store_nrows", s->nrows)))
+        goto fail;
+    {
+        /* input_rows is a dataset, not an attribute: it can exceed 64 KiB. */
+        int64_t nr = prov->rows ? prov->nrows : s->nrows;
+        const int64_t *rows = prov->rows;
+        hsize_t d = (hsize_t)nr;
+        hid_t sp = -1, ds = -1;
+        if (!rows) {
+            if (!(all = es__alloc_array(ctx, nr ? nr : 1, sizeof *all))) {
+                rc = ES_ENOMEM;
+                goto fail;
+            }
+            for (int64_t i = 0; i < nr; i++) all[i] = i;
+            rows = all;
+        }
+        if ((sp = H5Screate_simple(1, &d, NULL)) < 0 ||
+            (ds = H5Dcreate2(g, "input_rows", H5T_STD_I64LE, sp, H5P_DEFAULT, H5P_DEFAULT,
+                             H5P_DEFAULT)) < 0 ||
+            (nr > 0 && H5Dwrite(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, rows) < 0))
+            rc = es__h5_fail(ctx, ES_EIO, "store: cannot write %s/input_rows", full);
+        es__h5_close(ds);
+        es__h5_close(sp);
+        if (rc) goto fail;
+    }
+    es__free(ctx, all);
+    es__h5_close(g);
+    es__h5_close(lcpl);
+    return ES_OK;
+fail:
+    es__free(ctx, all);
+    es__h5_close(g);
+    es__h5_close(lcpl);
+    s->broken = true;
+    return rc;
+}
+
+es_status es_store_result_begin(es_ctx *ctx, es_store *s, const char *kind, const char *name,
+                                const es_provenance *prov)
+{
+    es_status rc;
+    if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    H5E_BEGIN_TRY { rc = result_begin_impl(ctx, s, kind, name, prov); } H5E_END_TRY
+    return rc;
+}
+
+/* Prepare a put: the path must be kind/name/dataset inside a begun result;
+ * an existing dataset of that name is removed. */
+static es_status put_prepare(es_ctx *ctx, es_store *s, const char *path, char *full, size_t n)
+{
+    char parts[8][128], group[600];
+    es_status rc;
+    int np = split_path(ctx, path, parts, &rc);
+    if (np < 0) return rc;
+    if (np < 3) ES_FAIL(ctx, ES_EINVAL, "store: '%s' is not kind/name/dataset", path);
+    if ((rc = es__store_begin_write(s))) return rc;
+    snprintf(group, sizeof group, "/analysis/%s/%s", parts[0], parts[1]);
+    if (!link_exists(s->file, group))
+        ES_FAIL(ctx, ES_ENOTFOUND, "store: result %s/%s was not begun "
+                "(es_store_result_begin)", parts[0], parts[1]);
+    full_path(full, n, path);
+    if (link_exists(s->file, full) && H5Ldelete(s->file, full, H5P_DEFAULT) < 0) {
+        s->broken = true;
+        return es__h5_fail(ctx, ES_EIO, "store: cannot replace %s", full);
+    }
+    return ES_OK;
+}
+
+static es_status put_impl(es_ctx *ctx, es_store *s, const char *path, int rank,
+                          const hsize_t *dims, hid_t ftype, hid_t mtype, const void *buf)
+{
+    char full[700];
+    hid_t sp = -1, ds = -1, lcpl = -1;
+    es_status rc = put_prepare(ctx, s, path, full, sizeof full);
+    hsize_t total = 1;
+    if (rc) return rc;
+    for (int k = 0; k < rank; k++) total *= dims[k];
+    if ((lcpl = H5Pcreate(H5P_LINK_CREATE)) < 0 || H5Pset_create_intermediate_group(lcpl, 1) < 0 ||
+        (sp = H5Screate_simple(rank, dims, NULL)) < 0 ||
+        (ds = H5Dcreate2(s->file, full, ftype, sp, lcpl, H5P_DEFAULT, H5P_DEFAULT)) < 0 ||
+        (total > 0 && H5Dwrite(ds, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0)) {
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot write %s", full);
+        s->broken = true;
+    }
+    es__h5_close(ds);
+    es__h5_close(sp);
+    es__h5_close(lcpl);
+    return rc;
+}
+
+es_status es_store_put_matrix(es_ctx *ctx, es_store *s, const char *path, es_mat m)
+{
+    es_status rc;
+    hsize_t dims[2] = {(hsize_t)m.cols, (hsize_t)m.rows};
+    double *packed = NULL;
+    const double *src = m.data;
+    if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    if (m.rows < 0 || m.cols < 0 || m.ld < m.rows || (!m.data && m.rows * m.cols > 0))
+        ES_FAIL(ctx, ES_EINVAL, "store: bad matrix for %s", path ? path : "");
+    if (m.ld != m.rows && m.rows > 0 && m.cols > 0) {
+        int64_t total;
+        if (!es__mul_i64(m.rows, m.cols, &total))
+            ES_FAIL(ctx, ES_ERANGE, "store: matrix too large");
+        if (!(packed = es__alloc_array(ctx, total, sizeof *packed))) return ES_ENOMEM;
+        for (int64_t j = 0; j < m.cols; j++)
+            memcpy(packed + j * m.rows, m.data + j * m.ld, (size_t)m.rows * sizeof *packed);
+        src = packed;
+    }
+    H5E_BEGIN_TRY {
+        rc = put_impl(ctx, s, path, 2, dims, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, src);
+    } H5E_END_TRY
+    es__free(ctx, packed);
+    return rc;
+}
+
+es_status es_store_put_vector(es_ctx *ctx, es_store *s, const char *path, const double *v,
+                              int64_t n)
+{
+    es_status rc;
+    hsize_t d = (hsize_t)n;
+    if (!s || n < 0 || (n > 0 && !v)) ES_FAIL(ctx, ES_EINVAL, "store: bad vector argument");
+    H5E_BEGIN_TRY { rc = put_impl(ctx, s, path, 1, &d, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, v); }
+    H5E_END_TRY
+    return rc;
+}
+
+es_status es_store_put_ints(es_ctx *ctx, es_store *s, const char *path, const int64_t *v,
+                            int64_t n)
+{
+    es_status rc;
+    hsize_t d = (hsize_t)n;
+    if (!s || n < 0 || (n > 0 && !v)) ES_FAIL(ctx, ES_EINVAL, "store: bad vector argument");
+    H5E_BEGIN_TRY { rc = put_impl(ctx, s, path, 1, &d, H5T_STD_I64LE, H5T_NATIVE_INT64, v); }
+    H5E_END_TRY
+    return rc;
+}
+
+es_status es_store_put_strings(es_ctx *ctx, es_store *s, const char *path,
+                               const char *const *str, int64_t n)
+{
+    es_status rc;
+    hsize_t d = (hsize_t)n;
+    hid_t t;
+    if (!s || n < 0 || (n > 0 && !str)) ES_FAIL(ctx, ES_EINVAL, "store: bad strings argument");
+    for (int64_t i = 0; i < n; i++)
+        if (!str[i])
+            ES_FAIL(ctx, ES_EINVAL, "store: string %lld of %s is NULL", (long long)i, path);
+    H5E_BEGIN_TRY {
+        t = es__h5_str_type();
+        rc = t < 0 ? es__h5_fail(ctx, ES_EIO, "store: string type") :
+                     put_impl(ctx, s, path, 1, &d, t, t, str);
+        es__h5_close(t);
+    } H5E_END_TRY
+    return rc;
+}
+
+static es_status put_attr_impl(es_ctx *ctx, es_store *s, const char *path, const char *key,
+                               const char *value)
+{
+    char parts[8][128], full[700];
+    es_status rc;
+    hid_t obj;
+    int np = split_path(ctx, path, parts, &rc);
+    if (np < 0) return rc;
+    if (np < 2 || !key || !*key || !value)
+        ES_FAIL(ctx, ES_EINVAL, "store: bad attribute '%s' on '%s'", key ? key : "", path);
+    if ((rc = es__store_begin_write(s))) return rc;
+    full_path(full, sizeof full, path);
+    if (!link_exists(s->file, full))
+        ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
+    if ((obj = H5Oopen(s->file, full, H5P_DEFAULT)) < 0)
+        return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
+    rc = es__h5_write_attr_str(ctx, obj, key, value);
+    H5Oclose(obj);
+    if (rc) s->broken = true;
+    return rc;
+}
+
+es_status es_store_put_attr(es_ctx *ctx, es_store *s, const char *path, const char *key,
+                            const char *value)
+{
+    es_status rc;
+    if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    H5E_BEGIN_TRY { rc = put_attr_impl(ctx, s, path, key, value); } H5E_END_TRY
+    return rc;
+}
+
+/* Open /analysis/<path> as a dataset of the given rank; dims out. */
+static es_status get_open(es_ctx *ctx, es_store *s, const char *path, int rank, hsize_t *dims,
+                          hid_t *ds)
+{
+    char parts[8][128], full[700];
+    es_status rc;
+    hid_t sp;
+    if (split_path(ctx, path, parts, &rc) < 0) return rc;
+    full_path(full, sizeof full, path);
+    if (!link_exists(s->file, full)) ES_FAIL(ctx, ES_ENOTFOUND, "store: no dataset %s", full);
+    if ((*ds = H5Dopen2(s->file, full, H5P_DEFAULT)) < 0)
+        return es__h5_fail(ctx, ES_EFORMAT, "store: %s is not a dataset", full);
+    sp = H5Dget_space(*ds);
+    if (sp < 0 || H5Sget_simple_extent_ndims(sp) != rank) {
+        es__h5_close(sp);
+        H5Dclose(*ds);
+        *ds = -1;
+        ES_FAIL(ctx, ES_EFORMAT, "store: %s is not of rank %d", full, rank);
+    }
+    H5Sget_simple_extent_dims(sp, dims, NULL);
+    H5Sclose(sp);
+    return ES_OK;
+}
+
+static es_status get_impl(es_ctx *ctx, es_store *s, const char *path, int rank, hid_t mtype,
+                          size_t elem, void **data, int64_t *d0, int64_t *d1)
+{
+    hsize_t dims[2] = {0, 1};
+    hid_t ds = -1;
+    int64_t total;
+    es_status rc = get_open(ctx, s, path, rank, dims, &ds);
+    *data = NULL;
+    if (rc) return rc;
+    if (!es__mul_i64((int64_t)dims[0], (int64_t)dims[1], &total)) {
+        H5Dclose(ds);
+        ES_FAIL(ctx, ES_ERANGE, "store: %s is too large", path);
+    }
+    if (!(*data = es__alloc_array(ctx, total ? total : 1, elem))) {
+        H5Dclose(ds);
+        return ES_ENOMEM;
+    }
+    if (total > 0 && H5Dread(ds, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, *data) < 0) {
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot read %s", path);
+        es__free(ctx, *data);
+        *data = NULL;
+    }
+    H5Dclose(ds);
+    *d0 = (int64_t)dims[0];
+    if (d1) *d1 = (int64_t)dims[1];
+    return rc;
+}
+
+es_status es_store_get_matrix(es_ctx *ctx, es_store *s, const char *path, es_mat *m)
+{
+    es_status rc;
+    void *data = NULL;
+    int64_t cols = 0, rows = 0;
+    if (!s || !m) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument");
+    H5E_BEGIN_TRY {
+        rc = get_impl(ctx, s, path, 2, H5T_NATIVE_DOUBLE, sizeof(double), &data, &cols, &rows);
+    } H5E_END_TRY
+    if (rc) return rc;
+    m->data = data;
+    m->rows = rows;
+    m->cols = cols;
+    m->ld = rows > 0 ? rows : 1;
+    return ES_OK;
+}
+
+es_status es_store_get_vector(es_ctx *ctx, es_store *s, const char *path, double **v,
+                              int64_t *n)
+{
+    es_status rc;
+    void *data = NULL;
+    if (!s || !v || !n) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument");
+    H5E_BEGIN_TRY {
+        rc = get_impl(ctx, s, path, 1, H5T_NATIVE_DOUBLE, sizeof(double), &data, n, NULL);
+    } H5E_END_TRY
+    *v = data;
+    return rc;
+}
+
+es_status es_store_get_ints(es_ctx *ctx, es_store *s, const char *path, int64_t **v,
+                            int64_t *n)
+{
+    es_status rc;
+    void *data = NULL;
+    if (!s || !v || !n) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument");
+    H5E_BEGIN_TRY {
+        rc = get_impl(ctx, s, path, 1, H5T_NATIVE_INT64, sizeof(int64_t), &data, n, NULL);
+    } H5E_END_TRY
+    *v = data;
+    return rc;
+}
+
+static es_status get_attr_impl(es_ctx *ctx, es_store *s, const char *path, const char *key,
+                               char *buf, size_t n)
+{
+    char parts[8][128], full[700];
+    es_status rc;
+    hid_t obj;
+    if (split_path(ctx, path, parts, &rc) < 0) return rc;
+    full_path(full, sizeof full, path);
+    if (!link_exists(s->file, full)) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
+    if ((obj = H5Oopen(s->file, full, H5P_DEFAULT)) < 0)
+        return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
+    if (H5Aexists(obj, key) <= 0) {
+        H5Oclose(obj);
+        ES_FAIL(ctx, ES_ENOTFOUND, "store: %s has no attribute '%s'", full, key);
+    }
+    rc = es__h5_read_attr_text(ctx, obj, key, buf, n);
+    H5Oclose(obj);
+    return rc;
+}
+
+es_status es_store_get_attr(es_ctx *ctx, es_store *s, const char *path, const char *key,
+                            char *buf, size_t n)
+{
+    es_status rc;
+    if (!s || !key || !buf) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument");
+    H5E_BEGIN_TRY { rc = get_attr_impl(ctx, s, path, key, buf, n); } H5E_END_TRY
+    return rc;
+}
+
+int es_store_has(es_store *s, const char *path)
+{
+    char full[700];
+    int r = 0;
+    if (!s || !path || !*path) return 0;
+    full_path(full, sizeof full, path);
+    H5E_BEGIN_TRY { r = link_exists(s->file, full) ? 1 : 0; } H5E_END_TRY
+    return r;
+}
+
+typedef struct name_list { es_ctx *ctx; char **names; int64_t n, cap; es_status rc; } name_list;
+
+static herr_t list_cb(hid_t g, const char *name, const H5L_info_t *info, void *data)
+{
+    name_list *l = data;
+    (void)g;
+    (void)info;
+    if (l->n == l->cap) {
+        int64_t cap = l->cap ? 2 * l->cap : 16;
+        char **p = es__realloc(l->ctx, l->names, (size_t)cap * sizeof *p);
+        if (!p) { l->rc = ES_ENOMEM; return -1; }
+        l->names = p;
+        l->cap = cap;
+    }
+    if (!(l->names[l->n] = es__strdup(l->ctx, name))) { l->rc = ES_ENOMEM; return -1; }
+    l->n++;
+    return 0;
+}
+
+static es_status list_impl(es_ctx *ctx, es_store *s, const char *kind, char ***names,
+                           int64_t *n)
+{
+    char full[600];
+    name_list l = {ctx, NULL, 0, 0, ES_OK};
+    hid_t g;
+    if (kind && *kind && es__h5_bad_name(kind))
+        ES_FAIL(ctx, ES_EINVAL, "store: bad result kind '%s'", kind);
+    snprintf(full, sizeof full, "/analysis%s%s", kind && *kind ? "/" : "", kind ? kind : "");
+    if (!link_exists(s->file, full)) return ES_OK;
+    if ((g = H5Gopen2(s->file, full, H5P_DEFAULT)) < 0)
+        return es__h5_fail(ctx, ES_EFORMAT, "store: %s is not a group", full);
+    if (H5Literate(g, H5_INDEX_NAME, H5_ITER_INC, NULL, list_cb, &l) < 0) {
+        es_status rc = l.rc ? l.rc : es__h5_fail(ctx, ES_EIO, "store: cannot list %s", full);
+        H5Gclose(g);
+        for (int64_t i = 0; i < l.n; i++) es__free(ctx, l.names[i]);
+        es__free(ctx, l.names);
+        return rc;
+    }
+    H5Gclose(g);
+    *names = l.names;
+    *n = l.n;
+    return ES_OK;
+}
+
+es_status es_store_list_results(es_ctx *ctx, es_store *s, const char *kind, char ***names,
+                                int64_t *n)
+{
+    es_status rc;
+    if (!s || !names || !n) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument");
+    *names = NULL;
+    *n = 0;
+    H5E_BEGIN_TRY { rc = list_impl(ctx, s, kind, names, n); } H5E_END_TRY
+    return rc;
+}

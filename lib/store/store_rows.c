@@ -1,0 +1,493 @@
+/* lib/store/store_rows.c — the shapes of a store, one row each: the
+ * in-memory row metadata (ids, source paths, content hashes, labels) and
+ * the id map, reading lengths, scales, positions and the topology,
+ * appending rows (with new label columns), and selecting rows by label.
+ *
+ * Lengths are N x E on disk, the same memory as the library's E x N
+ * column-major shape sets, so a block of rows reads straight into an es_mat
+ * column per shape. Appends are all-or-nothing for the caller: everything
+ * is validated before the first write, and a failure after it marks the
+ * handle broken so the half-written working copy is never published.
+ */
+#include "store/store_pkg.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+void es__store_free_rows(es_store *s)
+{
+    es_ctx *ctx = s->ctx;
+    for (int64_t i = 0; i < s->nrows; i++) {
+        if (s->ids) es__free(ctx, s->ids[i]);
+        if (s->sources) es__free(ctx, s->sources[i]);
+        if (s->hashes) es__free(ctx, s->hashes[i]);
+    }
+    for (int64_t c = 0; c < s->ncols; c++) {
+        for (int64_t i = 0; s->labels && s->labels[c] && i < s->nrows; i++)
+            es__free(ctx, s->labels[c][i]);
+        if (s->labels) es__free(ctx, s->labels[c]);
+        if (s->colnames) es__free(ctx, s->colnames[c]);
+    }
+    es__free(ctx, s->ids);
+    es__free(ctx, s->sources);
+    es__free(ctx, s->hashes);
+    es__free(ctx, s->labels);
+    es__free(ctx, s->colnames);
+    es__strmap_clear(ctx, &s->id_rows);
+    s->ids = s->sources = s->hashes = s->colnames = NULL;
+    s->labels = NULL;
+    s->nrows = s->ncols = s->cap = 0;
+}
+
+/* Doubling keeps a long run of small appends linear; only the pointer
+ * arrays move, never the strings (the id map's keys). */
+es_status es__store_reserve_rows(es_store *s, int64_t need)
+{
+    es_ctx *ctx = s->ctx;
+    int64_t cap = s->cap ? s->cap : 16;
+    if (need <= s->cap) return ES_OK;
+    while (cap < need) cap *= 2;
+    char ***arrs[3] = {&s->ids, &s->sources, &s->hashes};
+    size_t bytes;
+    if (!es__mul_size((size_t)cap, sizeof(char *), &bytes))
+        ES_FAIL(ctx, ES_ENOMEM, "store: too many rows (%lld)", (long long)need);
+    for (int k = 0; k < 3; k++) {
+        char **p = es__realloc(ctx, *arrs[k], bytes);
+        if (!p) return ES_ENOMEM;
+        memset(p + s->cap, 0, (size_t)(cap - s->cap) * sizeof *p);
+        *arrs[k] = p;
+    }
+    for (int64_t c = 0; c < s->ncols; c++) {
+        char **p = es__realloc(ctx, s->labels[c], bytes);
+        if (!p) return ES_ENOMEM;
+        memset(p + s->cap, 0, (size_t)(cap - s->cap) * sizeof *p);
+        s->labels[c] = p;
+    }
+    s->cap = cap;
+    return ES_OK;
+}
+
+es_status es__store_index_ids(es_store *s)
+{
+    es_status rc;
+    es__strmap_clear(s->ctx, &s->id_rows);
+    if ((rc = es__strmap_init(s->ctx, &s->id_rows, s->nrows))) return rc;
+    for (int64_t i = 0; i < s->nrows; i++)
+        if ((rc = es__strmap_put(s->ctx, &s->id_rows, s->ids[i], i, NULL))) return rc;
+    return ES_OK;
+}
+
+const char *es_store_row_id(const es_store *s, int64_t row)
+{
+    return s && row >= 0 && row < s->nrows ? s->ids[row] : NULL;
+}
+const char *es_store_source_path(const es_store *s, int64_t row)
+{
+    return s && row >= 0 && row < s->nrows ? s->sources[row] : NULL;
+}
+const char *es_store_content_hash(const es_store *s, int64_t row)
+{
+    return s && row >= 0 && row < s->nrows ? s->hashes[row] : NULL;
+}
+
+int64_t es_store_find_row(const es_store *s, const char *id)
+{
+    return s && id ? es__strmap_get(&s->id_rows, id) : -1;
+}
+
+int64_t es_store_ncolumns(const es_store *s) { return s ? s->ncols : 0; }
+const char *es_store_column_name(const es_store *s, int64_t col)
+{
+    return s && col >= 0 && col < s->ncols ? s->colnames[col] : NULL;
+}
+int64_t es_store_find_column(const es_store *s, const char *name)
+{
+    if (!s || !name) return -1;
+    for (int64_t c = 0; c < s->ncols; c++)
+        if (!strcmp(s->colnames[c], name)) return c;
+    return -1;
+}
+const char *es_store_label(const es_store *s, int64_t row, int64_t col)
+{
+    if (!s || row < 0 || row >= s->nrows || col < 0 || col >= s->ncols) return NULL;
+    return s->labels[col][row];
+}
+
+/* Read rows [row0, row0+n) of a 2-D dataset (row length m) into memory
+ * laid out as n rows of stride ld >= m. */
+static es_status read_block(es_ctx *ctx, es_store *s, const char *name, int64_t row0, int64_t n,
+                            int64_t m, double *buf, int64_t ld)
+{
+    hsize_t fstart[2] = {(hsize_t)row0, 0}, cnt[2] = {(hsize_t)n, (hsize_t)m};
+    hsize_t mdims[2] = {(hsize_t)n, (hsize_t)ld}, mstart[2] = {0, 0};
+    hid_t ds = -1, fsp = -1, msp = -1;
+    es_status rc = ES_OK;
+    if (n == 0) return ES_OK;
+    if ((ds = es__h5_open_ds_nocache(s->file, name)) < 0 || (fsp = H5Dget_space(ds)) < 0 ||
+        H5Sselect_hyperslab(fsp, H5S_SELECT_SET, fstart, NULL, cnt, NULL) < 0 ||
+        (msp = H5Screate_simple(2, mdims, NULL)) < 0 ||
+        H5Sselect_hyperslab(msp, H5S_SELECT_SET, mstart, NULL, cnt, NULL) < 0 ||
+        H5Dread(ds, H5T_NATIVE_DOUBLE, msp, fsp, H5P_DEFAULT, buf) < 0)
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot read rows %lld..%lld of %s in '%s'",
+                         (long long)row0, (long long)(row0 + n - 1), name, s->path);
+    es__h5_close(msp);
+    es__h5_close(fsp);
+    es__h5_close(ds);
+    return rc;
+}
+
+static es_status no_edges(es_ctx *ctx, const es_store *s)
+{
+    ES_FAIL(ctx, ES_EINVAL, "store: '%s' has no edges: it holds landmarks only; give --edges "
+            "or --triangles at ingest", s->path);
+}
+
+static es_status check_out(es_ctx *ctx, es_store *s, int64_t n, es_mat out)
+{
+    if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    if (s->nedges == 0) return no_edges(ctx, s);
+    if (n < 0 || !out.data || out.rows != s->nedges || out.cols != n || out.ld < out.rows)
+        ES_FAIL(ctx, ES_EINVAL, "store: output matrix is %lld x %lld (ld %lld), need "
+                "%lld x %lld", (long long)out.rows, (long long)out.cols, (long long)out.ld,
+                (long long)s->nedges, (long long)n);
+    return ES_OK;
+}
+
+static es_status read_lengths_impl(es_ctx *ctx, es_store *s, int64_t row0, int64_t n,
+                                   es_mat out)
+{
+    es_status rc = check_out(ctx, s, n, out);
+    if (rc) return rc;
+    if (row0 < 0 || row0 > s->nrows || n > s->nrows - row0)
+        ES_FAIL(ctx, ES_ERANGE, "store: rows %lld..%lld are out of range (store has %lld "
+                "rows)", (long long)row0, (long long)(row0 + n - 1), (long long)s->nrows);
+    return read_block(ctx, s, "/shapes/lengths", row0, n, s->nedges, out.data, out.ld);
+}
+
+es_status es_store_read_lengths(es_ctx *ctx, es_store *s, int64_t row0, int64_t n, es_mat out)
+{
+    es_status rc;
+    H5E_BEGIN_TRY { rc = read_lengths_impl(ctx, s, row0, n, out); } H5E_END_TRY
+    return rc;
+}
+
+static es_status read_lengths_rows_impl(es_ctx *ctx, es_store *s, const int64_t *rows,
+                                        int64_t nrows, es_mat out)
+{
+    es_status rc = check_out(ctx, s, nrows, out);
+    if (rc) return rc;
+    for (int64_t j = 0; j < nrows; j++)
+        if (rows[j] < 0 || rows[j] >= s->nrows)
+            ES_FAIL(ctx, ES_ERANGE, "store: row %lld is out of range (store has %lld rows)",
+                    (long long)rows[j], (long long)s->nrows);
+    /* Runs of consecutive rows are read as one block. */
+    for (int64_t j = 0; j < nrows;) {
+        int64_t k = j + 1;
+        while (k < nrows && rows[k] == rows[k - 1] + 1) k++;
+        if ((rc = read_block(ctx, s, "/shapes/lengths", rows[j], k - j, s->nedges,
+                             out.data + j * out.ld, out.ld)))
+            return rc;
+        j = k;
+    }
+    return ES_OK;
+}
+
+es_status es_store_read_lengths_rows(es_ctx *ctx, es_store *s, const int64_t *rows,
+                                     int64_t nrows, es_mat out)
+{
+    es_status rc;
+    H5E_BEGIN_TRY { rc = read_lengths_rows_impl(ctx, s, rows, nrows, out); } H5E_END_TRY
+    return rc;
+}
+
+static es_status read_1d(es_ctx *ctx, es_store *s, const char *name, hid_t mtype, void *buf)
+{
+    hid_t ds;
+    es_status rc = ES_OK;
+    if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    if ((ds = es__h5_open_ds(s->file, name)) < 0 ||
+        H5Dread(ds, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0)
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot read %s of '%s'", name, s->path);
+    es__h5_close(ds);
+    return rc;
+}
+
+es_status es_store_read_scales(es_ctx *ctx, es_store *s, double *scales)
+{
+    es_status rc = ES_OK;
+    if (s && s->nedges == 0) return no_edges(ctx, s);
+    if (s && s->nrows == 0) return ES_OK;
+    H5E_BEGIN_TRY { rc = read_1d(ctx, s, "/shapes/scales", H5T_NATIVE_DOUBLE, scales); }
+    H5E_END_TRY
+    return rc;
+}
+
+es_status es_store_read_faces(es_ctx *ctx, es_store *s, int64_t *faces)
+{
+    es_status rc;
+    if (s && s->nfaces == 0) return ES_OK;
+    H5E_BEGIN_TRY { rc = read_1d(ctx, s, "/topology/faces", H5T_NATIVE_INT64, faces); }
+    H5E_END_TRY
+    return rc;
+}
+
+es_status es_store_read_edges(es_ctx *ctx, es_store *s, int64_t *edges)
+{
+    es_status rc;
+    if (s && s->nedges == 0) return ES_OK;
+    H5E_BEGIN_TRY { rc = read_1d(ctx, s, "/topology/edges", H5T_NATIVE_INT64, edges); }
+    H5E_END_TRY
+    return rc;
+}
+
+static es_status read_positions_impl(es_ctx *ctx, es_store *s, int64_t row, double *xyz)
+{
+    hsize_t start[3] = {(hsize_t)row, 0, 0}, cnt[3] = {1, (hsize_t)s->nverts, 3};
+    hid_t ds = -1, fsp = -1, msp = -1;
+    es_status rc = ES_OK;
+    if (row < 0 || row >= s->nrows)
+        ES_FAIL(ctx, ES_ERANGE, "store: row %lld is out of range (store has %lld rows)",
+                (long long)row, (long long)s->nrows);
+    if ((ds = es__h5_open_ds(s->file, "/shapes/positions")) < 0 || (fsp = H5Dget_space(ds)) < 0 ||
+        H5Sselect_hyperslab(fsp, H5S_SELECT_SET, start, NULL, cnt, NULL) < 0 ||
+        (msp = H5Screate_simple(3, cnt, NULL)) < 0 ||
+        H5Dread(ds, H5T_NATIVE_DOUBLE, msp, fsp, H5P_DEFAULT, xyz) < 0)
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot read positions of row %lld in '%s'",
+                         (long long)row, s->path);
+    es__h5_close(msp);
+    es__h5_close(fsp);
+    es__h5_close(ds);
+    return rc;
+}
+
+es_status es_store_read_positions(es_ctx *ctx, es_store *s, int64_t row, double *xyz)
+{
+    es_status rc;
+    if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    H5E_BEGIN_TRY { rc = read_positions_impl(ctx, s, row, xyz); } H5E_END_TRY
+    return rc;
+}
+
+/* Row i's values: a positive scale, finite lengths, every label given. */
+static es_status check_values(es_ctx *ctx, const es_store *s, const es_store_rows *r, int64_t i)
+{
+    const char *id = r->ids[i];
+    if (s->nedges > 0 && (!(r->scales[i] > 0) || !isfinite(r->scales[i])))
+        ES_FAIL(ctx, ES_EINVAL, "store: row '%s' has scale %g (must be finite, > 0)", id,
+                r->scales[i]);
+    for (int64_t e = 0; e < s->nedges; e++)
+        if (!isfinite(r->lengths[e + i * s->nedges]))
+            ES_FAIL(ctx, ES_EINVAL, "store: row '%s' has a non-finite length at edge %lld", id,
+                    (long long)e);
+    for (int64_t c = 0; c < r->ncols; c++)
+        if (!r->labels[i * r->ncols + c])
+            ES_FAIL(ctx, ES_EINVAL, "store: row '%s' lacks a value for column '%s'", id,
+                    r->colnames[c]);
+    return ES_OK;
+}
+
+/* Everything checked before the first write, so that a refused batch
+ * leaves the store untouched. Ids are looked up in the store's map and in
+ * a map of the batch's own (keys borrowed from r->ids): linear in the rows,
+ * where comparing each new id with every stored and new one took over a
+ * minute for 10^5 rows. */
+static es_status validate_rows(es_ctx *ctx, const es_store *s, const es_store_rows *r)
+{
+    const bool lens = s->nedges > 0;   /* a store without edges ignores lengths/scales */
+    es__strmap batch;
+    es_status rc = ES_OK;
+    if (r->n < 0 || (r->n > 0 && (!r->ids || (lens && (!r->lengths || !r->scales)) || !r->xyz)) ||
+        r->ncols < 0 || (r->ncols > 0 && (!r->colnames || (r->n > 0 && !r->labels))))
+        ES_FAIL(ctx, ES_EINVAL, "store: incomplete rows to append");
+    for (int64_t c = 0; c < r->ncols; c++) {
+        if (es__h5_bad_name(r->colnames[c]))
+            ES_FAIL(ctx, ES_EINVAL, "store: bad label column name '%s' (empty, '.', '..' or "
+                    "containing '/')", r->colnames[c] ? r->colnames[c] : "(null)");
+        for (int64_t d = 0; d < c; d++)
+            if (!strcmp(r->colnames[c], r->colnames[d]))
+                ES_FAIL(ctx, ES_EINVAL, "store: label column '%s' given twice",
+                        r->colnames[c]);
+    }
+    if ((rc = es__strmap_init(ctx, &batch, r->n))) return rc;
+    for (int64_t i = 0; i < r->n && rc == ES_OK; i++) {
+        const char *id = r->ids[i];
+        int64_t first = -1;
+        if (!id || !*id)
+            rc = es__fail(ctx, ES_EINVAL, "store: row %lld has an empty id", (long long)i);
+        else if (es_store_find_row(s, id) >= 0)
+            rc = es__fail(ctx, ES_EEXIST, "store: id '%s' exists already in '%s'", id, s->path);
+        else if ((rc = es__strmap_put(ctx, &batch, id, i, &first)) == ES_OK && first >= 0)
+            rc = es__fail(ctx, ES_EEXIST, "store: id '%s' is given twice", id);
+        else if (rc == ES_OK)
+            rc = check_values(ctx, s, r, i);
+    }
+    es__strmap_clear(ctx, &batch);
+    return rc;
+}
+
+/* Add label columns the store does not have yet ("" in existing rows). */
+static es_status add_columns(es_ctx *ctx, es_store *s, const es_store_rows *r, hid_t g,
+                             hid_t t)
+{
+    es_status rc;
+    for (int64_t c = 0; c < r->ncols; c++) {
+        const char *name = r->colnames[c];
+        char **vals, ***labels, **names;
+        if (es_store_find_column(s, name) >= 0) continue;
+        if (!(names = es__realloc(ctx, s->colnames, (size_t)(s->ncols + 1) * sizeof *names)))
+            return ES_ENOMEM;
+        s->colnames = names;
+        if (!(labels = es__realloc(ctx, s->labels, (size_t)(s->ncols + 1) * sizeof *labels)))
+            return ES_ENOMEM;
+        s->labels = labels;
+        if (!(vals = es__alloc_array(ctx, s->cap ? s->cap : 1, sizeof *vals))) return ES_ENOMEM;
+        s->labels[s->ncols] = vals;
+        if (!(s->colnames[s->ncols] = es__strdup(ctx, name))) return ES_ENOMEM;
+        s->ncols++;
+        for (int64_t i = 0; i < s->nrows; i++)
+            if (!(vals[i] = es__strdup(ctx, ""))) return ES_ENOMEM;
+        if ((rc = es__h5_create_rows(ctx, g, name, t, 1, 0, 0, 16))) return rc;
+        if (s->nrows > 0 && (rc = es__h5_append_rows(ctx, g, name, t, s->nrows, vals))) return rc;
+    }
+    return es__h5_write_attr_strs(ctx, g, "columns", (const char *const *)s->colnames, s->ncols);
+}
+
+static es_status append_impl(es_ctx *ctx, es_store *s, const es_store_rows *r)
+{
+    es_status rc;
+    hid_t t = -1, g = -1;
+    const char **tmp = NULL;
+    int64_t n = r->n, n0 = s->nrows;
+    if ((rc = validate_rows(ctx, s, r))) return rc;
+    if (n == 0 && r->ncols == 0) return ES_OK;
+    if ((rc = es__store_begin_write(s))) return rc;
+    if ((rc = es__store_reserve_rows(s, n0 + n))) return rc;
+    /* From here a failure leaves the working copy half-written: mark it. */
+    if ((t = es__h5_str_type()) < 0 || (g = H5Gopen2(s->file, "/labels", H5P_DEFAULT)) < 0) {
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot open /labels");
+        goto done;
+    }
+    if ((rc = add_columns(ctx, s, r, g, t))) goto done;
+    if ((rc = es__store_reserve_rows(s, n0 + n))) goto done;
+    if (n == 0) goto done;
+    if ((s->nedges > 0 &&
+         ((rc = es__h5_append_rows(ctx, s->file, "/shapes/lengths", H5T_NATIVE_DOUBLE, n,
+                                   r->lengths)) ||
+          (rc = es__h5_append_rows(ctx, s->file, "/shapes/scales", H5T_NATIVE_DOUBLE, n,
+                                   r->scales)))) ||
+        (rc = es__h5_append_rows(ctx, s->file, "/shapes/positions", H5T_NATIVE_DOUBLE, n, r->xyz)))
+        goto done;
+    if (!(tmp = es__alloc_array(ctx, n, sizeof *tmp))) { rc = ES_ENOMEM; goto done; }
+    for (int64_t i = 0; i < n; i++)
+        tmp[i] = r->source_paths && r->source_paths[i] ? r->source_paths[i] : "";
+    if ((rc = es__h5_append_rows(ctx, s->file, "/shapes/ids", t, n, r->ids)) ||
+        (rc = es__h5_append_rows(ctx, s->file, "/shapes/source_paths", t, n, tmp)))
+        goto done;
+    for (int64_t i = 0; i < n; i++)
+        tmp[i] = r->content_hashes && r->content_hashes[i] ? r->content_hashes[i] : "";
+    if ((rc = es__h5_append_rows(ctx, s->file, "/shapes/content_hash", t, n, tmp))) goto done;
+    for (int64_t c = 0; c < s->ncols; c++) {
+        int64_t rc_col = -1;
+        for (int64_t k = 0; k < r->ncols; k++)
+            if (!strcmp(r->colnames[k], s->colnames[c])) rc_col = k;
+        for (int64_t i = 0; i < n; i++)
+            tmp[i] = rc_col >= 0 ? r->labels[i * r->ncols + rc_col] : "";
+        if ((rc = es__h5_append_rows(ctx, g, s->colnames[c], t, n, tmp))) goto done;
+        for (int64_t i = 0; i < n; i++)
+            if (!(s->labels[c][n0 + i] = es__strdup(ctx, tmp[i]))) { rc = ES_ENOMEM; goto done; }
+    }
+    for (int64_t i = 0; i < n; i++) {
+        const char *src = r->source_paths && r->source_paths[i] ? r->source_paths[i] : "";
+        const char *h = r->content_hashes && r->content_hashes[i] ? r->content_hashes[i] : "";
+        if (!(s->ids[n0 + i] = es__strdup(ctx, r->ids[i])) ||
+            !(s->sources[n0 + i] = es__strdup(ctx, src)) ||
+            !(s->hashes[n0 + i] = es__strdup(ctx, h))) {
+            rc = ES_ENOMEM;
+            break;
+        }
+        if ((rc = es__strmap_put(ctx, &s->id_rows, s->ids[n0 + i], n0 + i, NULL))) break;
+        s->nrows++;
+    }
+done:
+    if (rc != ES_OK) {
+        /* Keep the in-memory strings of unfinished rows from leaking. */
+        for (int64_t i = s->nrows; i < s->cap; i++) {
+            for (int64_t c = 0; c < s->ncols; c++) {
+                es__free(ctx, s->labels[c][i]);
+                s->labels[c][i] = NULL;
+            }
+            es__free(ctx, s->ids[i]);
+            es__free(ctx, s->sources[i]);
+            es__free(ctx, s->hashes[i]);
+            s->ids[i] = s->sources[i] = s->hashes[i] = NULL;
+        }
+        s->broken = true;
+    }
+    es__free(ctx, tmp);
+    es__h5_close(g);
+    es__h5_close(t);
+    return rc;
+}
+
+es_status es_store_append(es_ctx *ctx, es_store *store, const es_store_rows *rows)
+{
+    es_status rc;
+    if (!store || !rows) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument to es_store_append");
+    H5E_BEGIN_TRY { rc = append_impl(ctx, store, rows); } H5E_END_TRY
+    return rc;
+}
+
+es_status es_store_select(es_ctx *ctx, const es_store *s, const char *filter, int64_t **rows,
+                          int64_t *nrows)
+{
+    int64_t *out, n = 0, nterms = 0;
+    int64_t cols[32];
+    const char *vals[32];
+    size_t vlen[32];
+    *rows = NULL;
+    *nrows = 0;
+    if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    for (const char *p = filter; p && *p;) {
+        const char *comma = strchr(p, ','), *end = comma ? comma : p + strlen(p);
+        const char *eq = memchr(p, '=', (size_t)(end - p));
+        char name[256];
+        bool quoted = false;
+        if (eq && eq[1] == '"') {
+            /* col="value" may hold ',' (labels with commas) */
+            const char *close = strchr(eq + 2, '"');
+            if (!close || (close[1] && close[1] != ','))
+                ES_FAIL(ctx, ES_EFORMAT, "store: bad quoted value in filter '%s'", filter);
+            quoted = true;
+            end = close + 1;
+            comma = *end == ',' ? end : NULL;
+        }
+        if (!eq || eq == p)
+            ES_FAIL(ctx, ES_EFORMAT, "store: bad filter term '%.*s' (want column=value)",
+                    (int)(end - p), p);
+        if (nterms == 32) ES_FAIL(ctx, ES_ERANGE, "store: more than 32 filter terms");
+        snprintf(name, sizeof name, "%.*s", (int)(eq - p), p);
+        if ((cols[nterms] = es_store_find_column(s, name)) < 0) {
+            if (!strcmp(name, "id")) cols[nterms] = -2;
+            else
+                ES_FAIL(ctx, ES_ENOTFOUND, "store: no label column '%s' in '%s'", name,
+                        s->path);
+        }
+        vals[nterms] = eq + 1 + quoted;
+        vlen[nterms] = (size_t)(end - eq - 1) - 2 * (size_t)quoted;
+        nterms++;
+        p = comma ? comma + 1 : end;
+    }
+    if (!(out = es__alloc_array(ctx, s->nrows ? s->nrows : 1, sizeof *out))) return ES_ENOMEM;
+    for (int64_t i = 0; i < s->nrows; i++) {
+        bool ok = true;
+        for (int64_t k = 0; k < nterms && ok; k++) {
+            const char *v = cols[k] == -2 ? s->ids[i] : s->labels[cols[k]][i];
+            ok = strlen(v) == vlen[k] && !memcmp(v, vals[k], vlen[k]);
+        }
+        if (ok) out[n++] = i;
+    }
+    *rows = out;
+    *nrows = n;
+    return ES_OK;
+}
