@@ -485,6 +485,8 @@ static void test_alloc_sweep(void)
                          (long long)k, es_ctx_errmsg(ctx));
             ES_CHECK(rc == ES_OK ? lm != NULL : lm == NULL);
             if (rc == ES_OK) es_landmarks_free(lm);
+            ES_CHECK_MSG(fa.live == 0, "%s, allocation %lld: %lld blocks leaked", what[w],
+                         (long long)k, (long long)fa.live);
         }
         ES_CHECK(rc == ES_OK && k > 3);
     }
