@@ -2,19 +2,38 @@
  * numparse.c). */
 #include "core/text.h"
 
-#include <ctype.h>
 #include <math.h>
 
-int es__parse_finite(const char *s, double *out)
+/* The field s without the blanks around it: [*b, *e); false if nothing is left. */
+static bool trim_blanks(const char *s, const char **b, const char **e)
 {
-    const char *p = s, *end, *q;
-    double v;
+    const char *p = s, *end;
     while (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n') p++;
-    if (!*p) return -1;
+    if (!*p) return false;
     end = p + strlen(p);
     while (end > p && (end[-1] == ' ' || end[-1] == '\t' || end[-1] == '\r' || end[-1] == '\n'))
         end--;
+    *b = p;
+    *e = end;
+    return true;
+}
+
+int es__parse_finite(const char *s, double *out)
+{
+    const char *p, *end, *q;
+    double v;
+    if (!trim_blanks(s, &p, &end)) return -1;
     if (!(q = es__parse_double(p, end, &v)) || q != end || !isfinite(v)) return -1;
+    *out = v;
+    return 0;
+}
+
+int es__parse_int64_field(const char *s, int64_t *out)
+{
+    const char *p, *end, *q;
+    int64_t v;
+    if (!trim_blanks(s, &p, &end)) return -1;
+    if (!(q = es__parse_int64(p, end, &v)) || q != end) return -1;
     *out = v;
     return 0;
 }

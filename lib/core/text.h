@@ -33,6 +33,11 @@ static inline bool es__is_delim(char c)
  * field is not a finite number. */
 int es__parse_finite(const char *s, double *out);
 
+/* A whole field as an int64: optional blanks around one optionally signed
+ * decimal integer (es__parse_int64) and nothing else. 0 on success, -1 if
+ * the field is not such an integer or overflows int64. */
+int es__parse_int64_field(const char *s, int64_t *out);
+
 /* Length of the valid UTF-8 prefix of s[0..n) (n if all of it is valid):
  * shortest forms only, no surrogates, nothing past U+10FFFF. */
 size_t es__utf8_valid_prefix(const unsigned char *s, size_t n);

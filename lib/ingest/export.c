@@ -2,12 +2,12 @@
  * spreadsheets, R, pandas) and stored positions as mesh files. The CSV
  * prints %.17g so that every double reads back to the same bits. */
 #include "core/core_private.h"
+#include "core/files.h"
 #include "edgespace/es_ingest.h"
 #include "edgespace/es_io.h"
 #include "edgespace/es_store.h"
 #include "meshio/meshio_private.h"
 
-#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <sys/stat.h>
@@ -103,20 +103,14 @@ es_status es_export_meshes(es_ctx *ctx, es_store *s, const int64_t *rows, int64_
     double *xyz = NULL;
     es_status rc;
     const char *ext;
-    struct stat st;
     if (!s || !dir) ES_FAIL(ctx, ES_EINVAL, "export: NULL argument");
     switch (format) {
     case ES_FORMAT_PLY: case ES_FORMAT_PLY_ASCII: ext = "ply"; break;
     case ES_FORMAT_OFF: ext = "off"; break;
     default: ext = "obj"; format = ES_FORMAT_OBJ; break;
     }
-    if (stat(dir, &st) != 0) {
-        if (mkdir(dir, 0777) != 0)
-            ES_FAIL(ctx, ES_EIO, "export: cannot create directory '%s': %s", dir,
-                    strerror(errno));
-    } else if (!S_ISDIR(st.st_mode)) {
-        ES_FAIL(ctx, ES_EIO, "export: '%s' is not a directory", dir);
-    }
+    if ((rc = es__mkdir_p(ctx, dir)) != ES_OK)
+        return es__fail(ctx, rc, "export: %s", es_ctx_errmsg(ctx));
     if ((rc = row_list(ctx, s, rows, nrows, &list, &n, &own))) return rc;
     if (!(xyz = es__alloc_array(ctx, 3 * es_store_nverts(s), sizeof *xyz)) ||
         !(faces = es__alloc_array(ctx, 3 * es_store_nfaces(s), sizeof *faces))) {

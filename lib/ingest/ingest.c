@@ -11,6 +11,9 @@
  * phase 2 also leaves the old store intact.
  */
 #include "core/core_private.h"
+#include "core/files.h"
+#include "core/hash.h"
+#include "core/strmap.h"
 #include "mesh/mesh_private.h"
 #include "edgespace/es_geom.h"
 #include "edgespace/es_ingest.h"
@@ -18,14 +21,12 @@
 #include "edgespace/es_mesh.h"
 #include "edgespace/es_store.h"
 
-#include <errno.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <sys/mman.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 void es_ingest_opts_init(es_ingest_opts *opts)
@@ -37,13 +38,9 @@ void es_ingest_opts_init(es_ingest_opts *opts)
 
 void es_content_hash(const void *buf, size_t len, char out[25])
 {
-    const unsigned char *p = buf;
-    uint64_t h = 0xcbf29ce484222325ULL;
-    for (size_t i = 0; i < len; i++) {
-        h ^= p[i];
-        h *= 0x100000001b3ULL;
-    }
-    snprintf(out, 25, "fnv1a64:%016llx", (unsigned long long)h);
+    char hex[17];
+    es__hex16(es__fnv1a64(ES__FNV_OFFSET, buf, len), hex);
+    snprintf(out, 25, "fnv1a64:%s", hex);
 }
 
 /* One input: where to read it, its id and (manifest) label row. */
@@ -53,37 +50,12 @@ typedef struct input {
     const char *const *labels;  /* ncols values or NULL */
 } input;
 
-/* Read a whole file into *buf (grown as needed and reused across files, so
- * that one buffer's pages serve every input). */
+/* Read a whole mesh file into *buf (grown as needed and reused across
+ * files, so that one buffer's pages serve every input). A missing file is
+ * ES_ENOTFOUND; anything but a regular file is refused. */
 static es_status slurp(es_ctx *ctx, const char *path, char **buf, size_t *cap, size_t *len)
 {
-    FILE *f = fopen(path, "rb");
-    struct stat st;
-    *len = 0;
-    if (!f)
-        ES_FAIL(ctx, errno == ENOENT ? ES_ENOTFOUND : ES_EIO, "cannot open '%s': %s", path,
-                strerror(errno));
-    if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
-        fclose(f);
-        ES_FAIL(ctx, ES_EIO, "'%s' is not a regular file", path);
-    }
-    if ((size_t)st.st_size + 1 > *cap) {
-        char *p = es__realloc(ctx, *buf, (size_t)st.st_size + 1);
-        if (!p) {
-            fclose(f);
-            return ES_ENOMEM;
-        }
-        *buf = p;
-        *cap = (size_t)st.st_size + 1;
-    }
-    *len = fread(*buf, 1, (size_t)st.st_size, f);
-    if (ferror(f) || *len != (size_t)st.st_size) {
-        fclose(f);
-        ES_FAIL(ctx, ES_EIO, "cannot read '%s'", path);
-    }
-    (*buf)[*len] = '\0';
-    fclose(f);
-    return ES_OK;
+    return es__read_file_reuse(ctx, path, ES__READ_REGULAR | ES__READ_NOTFOUND, buf, cap, len);
 }
 
 /* Everything phase 1 produces, one slot per input (kept or not). */
@@ -651,6 +623,8 @@ es_status es_ingest_files(es_ctx *ctx, const char *store_path, int64_t nfiles,
     es_ingest_report dummy;
     input *in = NULL;
     char **ids = NULL;
+    es__strmap seen = {0};
+    int64_t k;
     es_status rc = ES_OK;
     if (!opts) {
         es_ingest_opts_init(&defaults);
@@ -660,7 +634,8 @@ es_status es_ingest_files(es_ctx *ctx, const char *store_path, int64_t nfiles,
     memset(report, 0, sizeof *report);
     if (nfiles < 1 || !files) ES_FAIL(ctx, ES_EINVAL, "ingest: no files given");
     if (!(in = es__alloc_array(ctx, nfiles, sizeof *in)) ||
-        !(ids = es__alloc_array(ctx, nfiles, sizeof *ids))) {
+        !(ids = es__alloc_array(ctx, nfiles, sizeof *ids)) ||
+        es__strmap_init(ctx, &seen, nfiles) != ES_OK) {
         rc = ES_ENOMEM;
         goto done;
     }
@@ -671,20 +646,20 @@ es_status es_ingest_files(es_ctx *ctx, const char *store_path, int64_t nfiles,
             rc = es__fail(ctx, ES_EINVAL, "ingest: cannot make an id from '%s'", files[i]);
             goto done;
         }
-        for (int64_t k = 0; k < i; k++)
-            if (!strcmp(ids[k], id)) {
-                rc = es__fail(ctx, ES_EINVAL, "ingest: '%s' and '%s' would both get the id "
-                              "'%s'; use a manifest with an 'id' column", files[k], files[i],
-                              id);
-                goto done;
-            }
         if (!(ids[i] = es__strdup(ctx, id))) { rc = ES_ENOMEM; goto done; }
+        if ((rc = es__strmap_put(ctx, &seen, ids[i], i, &k)) != ES_OK) goto done;
+        if (k >= 0) {
+            rc = es__fail(ctx, ES_EINVAL, "ingest: '%s' and '%s' would both get the id '%s'; "
+                          "use a manifest with an 'id' column", files[k], files[i], id);
+            goto done;
+        }
         in[i].id = ids[i];
         in[i].path = files[i];
         in[i].labels = NULL;
     }
     rc = ingest(ctx, store_path, nfiles, in, 0, NULL, opts, report);
 done:
+    es__strmap_clear(ctx, &seen);
     for (int64_t i = 0; ids && i < nfiles; i++) es__free(ctx, ids[i]);
     es__free(ctx, ids);
     es__free(ctx, in);

@@ -1,154 +1,23 @@
 /* lib/ingest/manifest.c — the CSV manifest of an ingest (datasets-spec/
- * manifest-format.md), parsed with libcsv.
+ * manifest-format.md).
  *
- * libcsv does the RFC 4180 work (quoted fields with commas, doubled quotes
- * and newlines; CR, LF and CRLF record ends; blank lines). It does not
- * report positions, so the buffer is fed one physical line at a time and
- * each record remembers the line it started on: every message names the
- * manifest and a line. A leading UTF-8 byte-order mark is skipped, and every
- * field must be valid UTF-8 (the store keeps labels as UTF-8 strings).
+ * The table comes from core/csv_table.h in strict mode with UTF-8 checked
+ * (the store keeps labels as UTF-8 strings): RFC 4180 quoting, CR, LF and
+ * CRLF record ends, blank lines skipped, a leading byte-order mark dropped,
+ * and the line every record starts on, so that every message names the
+ * manifest and a line. This file adds the manifest's own rules: a header
+ * with unique names and a `file` column, one field per column in every row,
+ * and unique row ids.
  */
 #include "core/core_private.h"
+#include "core/csv_table.h"
+#include "core/files.h"
+#include "core/strmap.h"
 #include "edgespace/es_ingest.h"
-
-#include <csv.h>
-#include <errno.h>
-#include <stdio.h>
-#include <stdlib.h>
-
-typedef struct mstate {
-    es_ctx *ctx;
-    const char *name;
-    es_status rc;
-    int64_t line;          /* physical line being fed (1-based) */
-    int64_t rec_line;      /* line where the current record started */
-    int64_t field_line;    /* line where the record's last complete field ended */
-    char **fields;         /* current record */
-    int64_t nf, capf;
-    es_manifest *m;
-    int64_t capr;          /* rows allocated in m->cells / m->lines */
-    bool have_header;
-} mstate;
-
-/* Length of the valid UTF-8 prefix of s[0..n) (n if all valid). */
-static size_t utf8_valid_prefix(const unsigned char *s, size_t n)
-{
-    size_t i = 0;
-    while (i < n) {
-        unsigned c = s[i];
-        size_t k;
-        uint32_t cp;
-        if (c < 0x80) { i++; continue; }
-        if (c >= 0xc2 && c <= 0xdf) { k = 1; cp = c & 0x1f; }
-        else if (c >= 0xe0 && c <= 0xef) { k = 2; cp = c & 0x0f; }
-        else if (c >= 0xf0 && c <= 0xf4) { k = 3; cp = c & 0x07; }
-        else return i;
-        for (size_t j = 1; j <= k; j++) {
-            if (i + j >= n || (s[i + j] & 0xc0) != 0x80) return i;
-            cp = (cp << 6) | (s[i + j] & 0x3f);
-        }
-        if ((k == 2 && (cp < 0x800 || (cp >= 0xd800 && cp <= 0xdfff))) ||
-            (k == 3 && (cp < 0x10000 || cp > 0x10ffff)))
-            return i;
-        i += k + 1;
-    }
-    return n;
-}
-
-static void on_field(void *s, size_t len, void *data)
-{
-    mstate *st = data;
-    es_ctx *ctx = st->ctx;
-    char *f;
-    size_t ok;
-    if (st->rc) return;
-    st->field_line = st->line;
-    if ((ok = utf8_valid_prefix(s, s ? len : 0)) < (s ? len : 0)) {
-        st->rc = es__fail(ctx, ES_EFORMAT, "manifest '%s' line %lld, field %lld: invalid "
-                          "UTF-8 at byte %zu", st->name, (long long)st->rec_line,
-                          (long long)st->nf + 1, ok + 1);
-        return;
-    }
-    if (st->nf == st->capf) {
-        int64_t cap = st->capf ? 2 * st->capf : 16;
-        char **p = es__realloc(ctx, st->fields, (size_t)cap * sizeof *p);
-        if (!p) { st->rc = ES_ENOMEM; return; }
-        st->fields = p;
-        st->capf = cap;
-    }
-    if (!(f = es__malloc(ctx, len + 1))) { st->rc = ES_ENOMEM; return; }
-    if (len) memcpy(f, s, len);
-    f[len] = '\0';
-    st->fields[st->nf++] = f;
-}
-
-static void drop_fields(mstate *st)
-{
-    for (int64_t i = 0; i < st->nf; i++) es__free(st->ctx, st->fields[i]);
-    st->nf = 0;
-}
-
-static void on_record(int c, void *data)
-{
-    mstate *st = data;
-    es_ctx *ctx = st->ctx;
-    es_manifest *m = st->m;
-    (void)c;
-    if (st->rc) { drop_fields(st); return; }
-    if (st->nf == 0 || (st->nf == 1 && !st->fields[0][0])) { drop_fields(st); return; }
-    if (!st->have_header) {
-        m->ncols = st->nf;
-        m->colnames = st->fields;
-        st->fields = NULL;
-        st->nf = st->capf = 0;
-        st->have_header = true;
-        return;
-    }
-    if (st->nf != m->ncols) {
-        st->rc = es__fail(ctx, ES_EFORMAT, "manifest '%s' line %lld: %lld fields, but the "
-                          "header has %lld", st->name, (long long)st->rec_line,
-                          (long long)st->nf, (long long)m->ncols);
-        drop_fields(st);
-        return;
-    }
-    if (m->nrows == st->capr) {
-        int64_t cap = st->capr ? 2 * st->capr : 64, cells;
-        char **p;
-        int64_t *l;
-        size_t bytes;
-        if (!es__mul_i64(cap, m->ncols, &cells) ||
-            !es__mul_size((size_t)cells, sizeof *p, &bytes)) {
-            st->rc = es__fail(ctx, ES_ENOMEM, "manifest '%s': too large", st->name);
-            drop_fields(st);
-            return;
-        }
-        if (!(p = es__realloc(ctx, m->cells, bytes))) { st->rc = ES_ENOMEM; drop_fields(st); return; }
-        m->cells = p;
-        if (!(l = es__realloc(ctx, m->lines, (size_t)cap * sizeof *l))) {
-            st->rc = ES_ENOMEM;
-            drop_fields(st);
-            return;
-        }
-        m->lines = l;
-        st->capr = cap;
-    }
-    memcpy(m->cells + m->nrows * m->ncols, st->fields, (size_t)m->ncols * sizeof(char *));
-    m->lines[m->nrows] = st->rec_line;
-    m->nrows++;
-    st->nf = 0;
-}
 
 void es_id_from_path(const char *path, char *buf, size_t n)
 {
-    const char *base = strrchr(path, '/'), *dot;
-    size_t len;
-    base = base ? base + 1 : path;
-    dot = strrchr(base, '.');
-    len = dot && dot != base ? (size_t)(dot - base) : strlen(base);
-    if (!n) return;
-    if (len >= n) len = n - 1;
-    memcpy(buf, base, len);
-    buf[len] = '\0';
+    es__path_stem(path, buf, n);
 }
 
 void es_manifest_free(es_ctx *ctx, es_manifest *m)
@@ -213,26 +82,61 @@ static es_status check(es_ctx *ctx, es_manifest *m, const char *name)
         }
         if (!(m->ids[r] = es__strdup(ctx, id))) return ES_ENOMEM;
     }
-    /* Ids name rows everywhere: refuse repeats (O(n^2) compares; a manifest
-     * holds thousands of rows at most). */
-    for (int64_t r = 1; r < m->nrows; r++)
-        for (int64_t q = 0; q < r; q++)
-            if (!strcmp(m->ids[q], m->ids[r]))
-                ES_FAIL(ctx, ES_EFORMAT, "manifest '%s' line %lld: id '%s' repeats line %lld%s",
-                        name, (long long)m->lines[r], m->ids[r], (long long)m->lines[q],
-                        m->id_col < 0 ? " (ids are file names without extension; add an "
-                        "'id' column)" : "");
+    /* Ids name rows everywhere: refuse repeats, naming the first line */
+    es__strmap seen;
+    es_status rc = es__strmap_init(ctx, &seen, m->nrows);
+    for (int64_t r = 0; r < m->nrows && rc == ES_OK; r++) {
+        int64_t q;
+        if ((rc = es__strmap_put(ctx, &seen, m->ids[r], r, &q)) == ES_OK && q >= 0)
+            rc = es__fail(ctx, ES_EFORMAT, "manifest '%s' line %lld: id '%s' repeats line "
+                          "%lld%s", name, (long long)m->lines[r], m->ids[r],
+                          (long long)m->lines[q], m->id_col < 0 ? " (ids are file names "
+                          "without extension; add an 'id' column)" : "");
+    }
+    es__strmap_clear(ctx, &seen);
+    return rc;
+}
+
+/* Move the table's fields into m: the header into colnames, the other
+ * records into cells, each checked to have the header's field count. */
+static es_status take_table(es_ctx *ctx, es__csv_table *t, es_manifest *m, const char *name)
+{
+    if (t->nrecords == 0) return ES_OK;   /* no header: check() says so */
+    m->ncols = es__csv_nfields(t, 0);
+    for (int64_t r = 1; r < t->nrecords; r++)
+        if (es__csv_nfields(t, r) != m->ncols)
+            ES_FAIL(ctx, ES_EFORMAT, "manifest '%s' line %lld: %lld fields, but the header "
+                    "has %lld", name, (long long)t->line[r], (long long)es__csv_nfields(t, r),
+                    (long long)m->ncols);
+    /* the records are contiguous in t->fields: header first, then the rows */
+    int64_t nrows = t->nrecords - 1, ncells = nrows * m->ncols;
+    char **colnames = es__alloc_array(ctx, m->ncols, sizeof *colnames);
+    char **cells = es__alloc_array(ctx, ncells + 1, sizeof *cells);
+    int64_t *lines = es__alloc_array(ctx, nrows + 1, sizeof *lines);
+    if (!colnames || !cells || !lines) {
+        es__free(ctx, colnames);
+        es__free(ctx, cells);
+        es__free(ctx, lines);
+        return ES_ENOMEM;
+    }
+    memcpy(colnames, t->fields, (size_t)m->ncols * sizeof *colnames);
+    memcpy(cells, t->fields + m->ncols, (size_t)ncells * sizeof *cells);
+    memcpy(lines, t->line + 1, (size_t)nrows * sizeof *lines);
+    /* the strings are m's now: the table's clear must not free them */
+    memset(t->fields, 0, (size_t)(m->ncols + ncells) * sizeof *t->fields);
+    m->colnames = colnames;
+    m->cells = cells;
+    m->lines = lines;
+    m->nrows = nrows;
     return ES_OK;
 }
 
 es_status es_manifest_parse(es_ctx *ctx, const char *name, const char *dir, const char *buf,
                             size_t len, es_manifest **out)
 {
-    struct csv_parser p;
-    mstate st;
+    es__csv_table t;
     es_manifest *m;
-    es_status rc = ES_OK;
-    size_t pos = 0;
+    es_status rc;
     *out = NULL;
     if (!name) name = "(memory)";
     if (!(m = es__calloc(ctx, 1, sizeof *m))) return ES_ENOMEM;
@@ -240,50 +144,13 @@ es_status es_manifest_parse(es_ctx *ctx, const char *name, const char *dir, cons
         es_manifest_free(ctx, m);
         return ES_ENOMEM;
     }
-    memset(&st, 0, sizeof st);
-    st.ctx = ctx;
-    st.name = name;
-    st.m = m;
-    st.line = 1;
-    if (csv_init(&p, CSV_STRICT | CSV_STRICT_FINI | CSV_APPEND_NULL) != 0) {
-        es_manifest_free(ctx, m);
-        ES_FAIL(ctx, ES_ENOMEM, "manifest '%s': cannot start the CSV parser", name);
+    if ((rc = es__csv_parse(ctx, "manifest", name, buf, len, ES__CSV_STRICT | ES__CSV_UTF8,
+                            &t)) == ES_OK) {
+        rc = take_table(ctx, &t, m, name);
+        es__csv_table_clear(ctx, &t);
     }
-    if (len >= 3 && !memcmp(buf, "\xef\xbb\xbf", 3)) pos = 3;
-    while (pos < len && !st.rc) {
-        /* one physical line: up to LF, CRLF or a lone CR (all record ends) */
-        size_t e = pos;
-        bool eol = false;
-        while (e < len && buf[e] != '\n' && buf[e] != '\r') e++;
-        if (e < len) {
-            eol = true;
-            e += buf[e] == '\r' && e + 1 < len && buf[e + 1] == '\n' ? 2 : 1;
-        }
-        size_t seg = e - pos;
-        /* between records (libcsv's ROW_NOT_BEGUN state is 0), a record
-         * that starts now starts on this line, even if its first field is
-         * quoted over several lines */
-        if (p.pstate == 0) st.rec_line = st.line;
-        if (csv_parse(&p, buf + pos, seg, on_field, on_record, &st) != seg && !st.rc) {
-            st.rc = es__fail(ctx, ES_EFORMAT, "manifest '%s' line %lld: malformed CSV (%s; "
-                             "a quote inside an unquoted field, or text after a closing "
-                             "quote)", name, (long long)st.line, csv_strerror(csv_error(&p)));
-        }
-        pos += seg;
-        if (eol) st.line++;
-    }
-    /* an open quoted field began right after the record's last complete
-     * field (on the line of its comma), or with the record */
-    if (!st.rc && csv_fini(&p, on_field, on_record, &st) != 0 && !st.rc)
-        st.rc = es__fail(ctx, ES_EFORMAT, "manifest '%s' line %lld: unterminated quoted field "
-                         "(opened on line %lld)", name, (long long)st.line,
-                         (long long)(st.nf ? st.field_line : st.rec_line));
-    csv_free(&p);
-    drop_fields(&st);
-    es__free(ctx, st.fields);
-    rc = st.rc;
-    if (!rc) rc = check(ctx, m, name);
-    if (rc) {
+    if (rc == ES_OK) rc = check(ctx, m, name);
+    if (rc != ES_OK) {
         es_manifest_free(ctx, m);
         return rc;
     }
@@ -293,46 +160,15 @@ es_status es_manifest_parse(es_ctx *ctx, const char *name, const char *dir, cons
 
 es_status es_manifest_read(es_ctx *ctx, const char *path, es_manifest **out)
 {
-    FILE *f;
-    char *buf = NULL, *dir;
-    size_t cap = 0, len = 0;
+    char *buf, *dir;
+    size_t len;
     es_status rc;
-    const char *slash;
     *out = NULL;
     if (!path) ES_FAIL(ctx, ES_EINVAL, "manifest: NULL path");
-    if (!(f = fopen(path, "rb")))
-        ES_FAIL(ctx, errno == ENOENT ? ES_ENOTFOUND : ES_EIO, "manifest '%s': cannot open: %s",
-                path, strerror(errno));
-    for (;;) {
-        size_t r;
-        if (len == cap) {
-            char *p;
-            cap = cap ? 2 * cap : 1 << 16;
-            if (!(p = es__realloc(ctx, buf, cap))) {
-                fclose(f);
-                es__free(ctx, buf);
-                return ES_ENOMEM;
-            }
-            buf = p;
-        }
-        r = fread(buf + len, 1, cap - len, f);
-        len += r;
-        if (r == 0) break;
-    }
-    if (ferror(f)) {
-        fclose(f);
-        es__free(ctx, buf);
-        ES_FAIL(ctx, ES_EIO, "manifest '%s': read error", path);
-    }
-    fclose(f);
-    slash = strrchr(path, '/');
-    if (!slash) dir = es__strdup(ctx, ".");
-    else if (slash == path) dir = es__strdup(ctx, "/");
-    else if ((dir = es__malloc(ctx, (size_t)(slash - path) + 1))) {
-        memcpy(dir, path, (size_t)(slash - path));
-        dir[slash - path] = '\0';
-    }
-    if (!dir) {
+    /* not ES__READ_REGULAR: a manifest may come through a pipe */
+    if ((rc = es__read_file(ctx, path, ES__READ_NOTFOUND, &buf, &len)) != ES_OK)
+        return es__fail(ctx, rc, "manifest: %s", es_ctx_errmsg(ctx));
+    if (!(dir = es__path_dir(ctx, path))) {
         es__free(ctx, buf);
         return ES_ENOMEM;
     }

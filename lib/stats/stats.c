@@ -11,6 +11,7 @@
  * the variance accurate when the differences are small against the lengths.
  */
 #include "stats/stats_pkg.h"
+#include "core/strmap.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -129,58 +130,46 @@ es_status es_mean(es_ctx *ctx, const es_source *src, double *mean)
 }
 
 /* ---- string keys ----------------------------------------------------------
- * A small open-addressing hash from string to slot index, enough for group
- * labels and pairing keys (FNV-1a). */
+ * Group labels and pairing keys numbered 0, 1, ... in order of first
+ * appearance: core's string map holds key -> number, keys[] the names. */
 
-typedef struct strmap {
-    int64_t cap;        /* power of two */
-    int64_t *slot;      /* cap entries: index into keys, or -1 */
-    const char **keys;  /* borrowed */
-    int64_t n;
-} strmap;
+typedef struct keyset {
+    es__strmap map;
+    const char **keys;  /* borrowed, in order of first appearance */
+} keyset;
 
-static uint64_t fnv1a(const char *s)
+static es_status keyset_init(es_ctx *ctx, keyset *s, int64_t maxn)
 {
-    uint64_t h = 1469598103934665603ull;
-    for (; *s; s++) h = (h ^ (unsigned char)*s) * 1099511628211ull;
-    return h;
-}
-
-static es_status strmap_init(es_ctx *ctx, strmap *m, int64_t maxn)
-{
-    m->cap = 16;
-    while (m->cap < 2 * maxn) m->cap *= 2;
-    m->n = 0;
-    m->slot = es__alloc_array(ctx, m->cap, sizeof *m->slot);
-    m->keys = es__alloc_array(ctx, maxn > 0 ? maxn : 1, sizeof *m->keys);
-    if (!m->slot || !m->keys) return ES_ENOMEM;
-    for (int64_t i = 0; i < m->cap; i++) m->slot[i] = -1;
-    return ES_OK;
-}
-
-static void strmap_clear(es_ctx *ctx, strmap *m)
-{
-    es__free(ctx, m->slot);
-    es__free(ctx, (void *)m->keys);
-}
-
-/* Index of key, inserting it (capacity is sized by strmap_init). */
-static int64_t strmap_get(strmap *m, const char *key)
-{
-    int64_t i = (int64_t)(fnv1a(key) & (uint64_t)(m->cap - 1));
-    while (m->slot[i] >= 0) {
-        if (!strcmp(m->keys[m->slot[i]], key)) return m->slot[i];
-        i = (i + 1) & (m->cap - 1);
+    s->keys = es__alloc_array(ctx, maxn > 0 ? maxn : 1, sizeof *s->keys);
+    if (!s->keys) {
+        memset(&s->map, 0, sizeof s->map);
+        return ES_ENOMEM;
     }
-    m->keys[m->n] = key;
-    m->slot[i] = m->n;
-    return m->n++;
+    return es__strmap_init(ctx, &s->map, maxn);
+}
+
+static void keyset_clear(es_ctx *ctx, keyset *s)
+{
+    es__strmap_clear(ctx, &s->map);
+    es__free(ctx, (void *)s->keys);
+    s->keys = NULL;
+}
+
+/* The number of key, numbering it if new (at most keyset_init's maxn keys,
+ * so the map never grows and cannot fail). */
+static int64_t keyset_index(es_ctx *ctx, keyset *s, const char *key)
+{
+    int64_t n = s->map.n, prev;
+    es__strmap_put(ctx, &s->map, key, n, &prev);
+    if (prev >= 0) return prev;
+    s->keys[n] = key;
+    return n;
 }
 
 es_status es_groups_from_labels(es_ctx *ctx, const char *const *labels, int64_t n,
                                 int64_t **group, const char ***names, int64_t *ngroups)
 {
-    strmap m;
+    keyset s;
     es_status rc;
     *group = NULL;
     *names = NULL;
@@ -188,16 +177,16 @@ es_status es_groups_from_labels(es_ctx *ctx, const char *const *labels, int64_t 
     if (n < 0 || (n > 0 && !labels)) ES_FAIL(ctx, ES_EINVAL, "groups: no labels");
     int64_t *g = es__alloc_array(ctx, n > 0 ? n : 1, sizeof *g);
     if (!g) return ES_ENOMEM;
-    if ((rc = strmap_init(ctx, &m, n)) != ES_OK) {
-        strmap_clear(ctx, &m);
+    if ((rc = keyset_init(ctx, &s, n)) != ES_OK) {
+        keyset_clear(ctx, &s);
         es__free(ctx, g);
         return rc;
     }
-    for (int64_t i = 0; i < n; i++) g[i] = labels[i] ? strmap_get(&m, labels[i]) : -1;
-    es__free(ctx, m.slot);
+    for (int64_t i = 0; i < n; i++) g[i] = labels[i] ? keyset_index(ctx, &s, labels[i]) : -1;
     *group = g;
-    *names = m.keys;
-    *ngroups = m.n;
+    *names = s.keys;
+    *ngroups = s.map.n;
+    es__strmap_clear(ctx, &s.map);
     return ES_OK;
 }
 
@@ -228,8 +217,8 @@ static const char *row_name(const char *const *ids, int64_t i, char *buf, size_t
 static es_status make_pairs(es_ctx *ctx, int64_t N, const char *const *keys, const int *role,
                             const char *const *ids, es_diff *d)
 {
-    strmap m;
-    es_status rc = strmap_init(ctx, &m, N);
+    keyset m;
+    es_status rc = keyset_init(ctx, &m, N);
     int64_t *from = es__alloc_array(ctx, N > 0 ? N : 1, sizeof *from);
     int64_t *to = es__alloc_array(ctx, N > 0 ? N : 1, sizeof *to);
     if (rc != ES_OK || !from || !to) {
@@ -243,7 +232,7 @@ static es_status make_pairs(es_ctx *ctx, int64_t N, const char *const *keys, con
             rc = es__fail(ctx, ES_EINVAL, "diff: row %lld has role %d", (long long)i, role[i]);
             goto done;
         }
-        int64_t k = strmap_get(&m, keys[i]);
+        int64_t k = keyset_index(ctx, &m, keys[i]);
         int64_t *slot = role[i] == ES_DIFF_FROM ? &from[k] : &to[k];
         if (*slot >= 0) {
             char b1[32], b2[32];
@@ -256,7 +245,7 @@ static es_status make_pairs(es_ctx *ctx, int64_t N, const char *const *keys, con
         *slot = i;
     }
     int64_t P = 0, U = 0;
-    for (int64_t k = 0; k < m.n; k++) {
+    for (int64_t k = 0; k < m.map.n; k++) {
         if (from[k] >= 0 && to[k] >= 0) P++;
         else U++;
     }
@@ -273,7 +262,7 @@ static es_status make_pairs(es_ctx *ctx, int64_t N, const char *const *keys, con
         goto done;
     }
     P = U = 0;
-    for (int64_t k = 0; k < m.n; k++) {
+    for (int64_t k = 0; k < m.map.n; k++) {
         if (from[k] >= 0 && to[k] >= 0) {
             d->pair_from[P] = from[k];
             d->pair_to[P++] = to[k];
@@ -290,7 +279,7 @@ static es_status make_pairs(es_ctx *ctx, int64_t N, const char *const *keys, con
     d->npairs = P;
     d->nunpaired = U;
 done:
-    strmap_clear(ctx, &m);
+    keyset_clear(ctx, &m);
     es__free(ctx, from);
     es__free(ctx, to);
     return rc;

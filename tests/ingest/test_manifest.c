@@ -2,6 +2,7 @@
  * CRLF, BOM, ids, and one error per kind of bad file, each naming its line. */
 #include "core/core_private.h"
 #include "es_test.h"
+#include "es_test_alloc.h"
 #include "es_test_files.h"
 #include "edgespace/es_ingest.h"
 
@@ -13,6 +14,34 @@ static es_status parse(es_ctx *ctx, const char *text, es_manifest **m)
 static const char *cell(const es_manifest *m, int64_t r, int64_t c)
 {
     return m->cells[r * m->ncols + c];
+}
+
+/* Every allocation of a parse may fail: ES_ENOMEM, no manifest, nothing
+ * leaked (the table's strings change hands on success). */
+static void test_alloc_sweep(void)
+{
+    es_ctx *ctx = NULL;
+    failing_alloc fa = {0, 0, 0};
+    es_allocator a = {fa_malloc, fa_realloc, fa_free, &fa};
+    const char *text = "id,file,g\nx1,a.obj,p\nx2,\"b,c.obj\",q\nx3,d.obj,r\n";
+    es_status rc = ES_ENOMEM;
+    int64_t k;
+    if (es_ctx_new(&ctx) != ES_OK) { ES_CHECK(0); return; }
+    es_ctx_set_allocator(ctx, &a);
+    for (k = 1; k < 300 && rc == ES_ENOMEM; k++) {
+        es_manifest *m = (es_manifest *)1;
+        fa.count = 0;
+        fa.fail_at = k;
+        rc = es_manifest_parse(ctx, "m.csv", "/d", text, strlen(text), &m);
+        ES_CHECK_MSG(rc == ES_OK || rc == ES_ENOMEM, "allocation %lld: %s", (long long)k,
+                     es_ctx_errmsg(ctx));
+        ES_CHECK(rc == ES_OK ? m && m->nrows == 3 && !strcmp(m->ids[1], "x2") : m == NULL);
+        if (rc == ES_OK) es_manifest_free(ctx, m);
+        ES_CHECK_MSG(fa.live == 0, "allocation %lld: %lld blocks leaked", (long long)k,
+                     (long long)fa.live);
+    }
+    ES_CHECK(rc == ES_OK && k > 10);
+    es_ctx_free(ctx);
 }
 
 int main(void)
@@ -166,5 +195,6 @@ int main(void)
         }
     }
     es_ctx_free(ctx);
+    test_alloc_sweep();
     ES_TEST_END();
 }

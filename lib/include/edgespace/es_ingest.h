@@ -107,7 +107,7 @@ ES_API es_status es_export_lengths_csv(es_ctx *ctx, es_store *store, const int64
                                        int64_t nrows, int raw, const char *path);
 /* Write each row's stored positions as a mesh file DIR/<id>.<ext> (ext from
  * format: obj, ply or off; ES_FORMAT_AUTO means OBJ). The directory is
- * created if absent. */
+ * created, with any missing parents, if absent. */
 ES_API es_status es_export_meshes(es_ctx *ctx, es_store *store, const int64_t *rows,
                                   int64_t nrows, const char *dir, es_mesh_format format);
 
