@@ -7,7 +7,7 @@
  * its normalized edge lengths (es_edge_lengths, es_lengths_normalize;
  * Section 4, eq. 12 of Rojas et al.). Any failure returns before the store
  * is touched. Phase 2 appends all rows in one es_store_append and commits,
- * which replaces the store by an atomic rename (store.c), so a kill during
+ * which replaces the store by an atomic rename (lib/store/store_publish.c), so a kill during
  * phase 2 also leaves the old store intact.
  */
 #include "core/core_private.h"
