@@ -69,7 +69,9 @@ int main(void)
     static const char *files[] = {"summary.csv", "pairs.csv", "group_means.csv",
                                   "heatmap_lengths.svg", "heatmap_procrustes.svg",
                                   "pairs_scatter.svg"};
-    for (int i = 0; i < 6; i++) ES_CHECK_MSG(exists(out, files[i]), "%s missing", files[i]);
+    /* the figures only in a build with figures (cairo) */
+    for (int i = 0; i < (ES_HAVE_FIGURES ? 6 : 3); i++)
+        ES_CHECK_MSG(exists(out, files[i]), "%s missing", files[i]);
     ES_RUN(&r, dir, "info", store);
     ES_CHECK(r.status == 0 && strstr(r.out, "compare") && strstr(r.out, "gpa"));
 

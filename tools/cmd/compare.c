@@ -85,6 +85,8 @@ int cmd_compare(int argc, char **argv)
     if (rc == ES_OK && figures)
         rc = es_figure_compare(ctx, s, gpa, by, &o, name, out, cmd, &r);
     else
+#else
+    (void)figures;   /* a build without figures writes the tables only */
 #endif
     if (rc == ES_OK)
         rc = es_study_compare(ctx, s, gpa, by, &o, name, out, cmd, &r);
