@@ -25,16 +25,21 @@ typedef struct es__canvas {
     es__canvas_kind kind;
     const char *path;           /* borrowed from the caller */
     int width, height;
+    es__file_replace out;       /* the part file that replaces path when complete */
+    es_ctx *ctx;                /* whose allocator made out.tmp */
 } es__canvas;
 
 /* Open a canvas for `path` (format from its extension), size width x height,
- * painted white, font "sans-serif". On failure nothing is left open. */
+ * painted white, font "sans-serif". The figure is written to a part file
+ * beside path that replaces it only when complete (es__replace_begin), so a
+ * failed figure leaves the old file. On failure nothing is left open. */
 es_status es__canvas_open(es_ctx *ctx, const char *path, int width, int height,
                           es__canvas *cv);
 /* Write the file (PNG) or finish it (SVG, PDF), then release everything.
  * Reports drawing or writing errors as ES_EIO naming the path. */
 es_status es__canvas_close(es_ctx *ctx, es__canvas *cv);
-/* Release without reporting (on an error path). NULL members: no-op. */
+/* Release without reporting (on an error path; the part file is removed).
+ * NULL members: no-op. */
 void es__canvas_discard(es__canvas *cv);
 
 /* Text anchored at (x, y): ha 0 left, 0.5 centre, 1 right; va 0 top,

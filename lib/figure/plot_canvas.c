@@ -202,6 +202,13 @@ static int ends_with(const char *s, const char *suffix)
     return a >= b && strcasecmp(s + a - b, suffix) == 0;
 }
 
+/* cairo's stream output into the part file. */
+static cairo_status_t write_part(void *closure, const unsigned char *data, unsigned int n)
+{
+    FILE *f = closure;
+    return fwrite(data, 1, n, f) == n ? CAIRO_STATUS_SUCCESS : CAIRO_STATUS_WRITE_ERROR;
+}
+
 es_status es__canvas_open(es_ctx *ctx, const char *path, int width, int height,
                           es__canvas *cv)
 {
@@ -211,21 +218,22 @@ es_status es__canvas_open(es_ctx *ctx, const char *path, int width, int height,
         ES_FAIL(ctx, ES_EINVAL, "plot: '%s': size %d x %d is outside 16..16384", path,
                 width, height);
     cv->path = path;
+    cv->ctx = ctx;
     cv->width = width;
     cv->height = height;
-    if (ends_with(path, ".png")) {
-        cv->kind = ES__CANVAS_PNG;
+    if (ends_with(path, ".png")) cv->kind = ES__CANVAS_PNG;
+    else if (ends_with(path, ".svg")) cv->kind = ES__CANVAS_SVG;
+    else if (ends_with(path, ".pdf")) cv->kind = ES__CANVAS_PDF;
+    else ES_FAIL(ctx, ES_EINVAL, "plot: '%s': unknown output format (use .png, .svg or .pdf)",
+                 path);
+    es_status rc = es__replace_begin(ctx, path, &cv->out);
+    if (rc != ES_OK) return es__fail(ctx, rc, "plot: %s", es_ctx_errmsg(ctx));
+    if (cv->kind == ES__CANVAS_PNG)
         cv->surface = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width, height);
-    } else if (ends_with(path, ".svg")) {
-        cv->kind = ES__CANVAS_SVG;
-        cv->surface = cairo_svg_surface_create(path, width, height);
-    } else if (ends_with(path, ".pdf")) {
-        cv->kind = ES__CANVAS_PDF;
-        cv->surface = cairo_pdf_surface_create(path, width, height);
-    } else {
-        ES_FAIL(ctx, ES_EINVAL, "plot: '%s': unknown output format (use .png, .svg or .pdf)",
-                path);
-    }
+    else if (cv->kind == ES__CANVAS_SVG)
+        cv->surface = cairo_svg_surface_create_for_stream(write_part, cv->out.f, width, height);
+    else
+        cv->surface = cairo_pdf_surface_create_for_stream(write_part, cv->out.f, width, height);
     cairo_status_t st = cairo_surface_status(cv->surface);
     if (st != CAIRO_STATUS_SUCCESS) {
         es__canvas_discard(cv);
@@ -245,7 +253,9 @@ es_status es__canvas_open(es_ctx *ctx, const char *path, int width, int height,
     return ES_OK;
 }
 
-void es__canvas_discard(es__canvas *cv)
+/* Release the drawing objects (the stream surfaces write their last bytes
+ * when destroyed, so this comes before the part file is closed). */
+static void release(es__canvas *cv)
 {
     if (cv->cr) cairo_destroy(cv->cr);
     if (cv->surface) cairo_surface_destroy(cv->surface);
@@ -253,23 +263,34 @@ void es__canvas_discard(es__canvas *cv)
     cv->surface = NULL;
 }
 
+void es__canvas_discard(es__canvas *cv)
+{
+    release(cv);
+    if (cv->out.f) es__replace_end(cv->ctx, &cv->out, ES_EIO);   /* the old file stays */
+}
+
 es_status es__canvas_close(es_ctx *ctx, es__canvas *cv)
 {
     cairo_status_t st = cairo_status(cv->cr);
     if (st == CAIRO_STATUS_SUCCESS) {
         cairo_surface_flush(cv->surface);
-        if (cv->kind == ES__CANVAS_PNG) st = cairo_surface_write_to_png(cv->surface, cv->path);
+        if (cv->kind == ES__CANVAS_PNG)
+            st = cairo_surface_write_to_png_stream(cv->surface, write_part, cv->out.f);
         else {
             cairo_surface_finish(cv->surface);
             st = cairo_surface_status(cv->surface);
         }
     }
-    es__canvas_discard(cv);
-    if (st == CAIRO_STATUS_NO_MEMORY) ES_FAIL(ctx, ES_ENOMEM, "plot: '%s': out of memory", cv->path);
-    if (st != CAIRO_STATUS_SUCCESS)
-        ES_FAIL(ctx, ES_EIO, "plot: cannot write '%s': %s", cv->path,
-                cairo_status_to_string(st));
-    return ES_OK;
+    release(cv);
+    es_status rc = st == CAIRO_STATUS_SUCCESS ? ES_OK
+                 : st == CAIRO_STATUS_NO_MEMORY
+                     ? es__fail(ctx, ES_ENOMEM, "plot: '%s': out of memory", cv->path)
+                     : es__fail(ctx, ES_EIO, "plot: cannot write '%s': %s", cv->path,
+                                cairo_status_to_string(st));
+    /* publish the part file only when the whole figure is in it */
+    if ((rc = es__replace_end(ctx, &cv->out, rc)) != ES_OK && st == CAIRO_STATUS_SUCCESS)
+        return es__fail(ctx, rc, "plot: %s", es_ctx_errmsg(ctx));
+    return rc;
 }
 
 /* ---- text ------------------------------------------------------------------ */

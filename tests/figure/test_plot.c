@@ -720,6 +720,34 @@ static void test_cli(void)
     ES_CHECK(run(cmd) == 0);
 }
 
+/* A figure replaces a file only once complete: written over an old file it
+ * replaces it, a figure that fails leaves it, and no part file stays
+ * behind in either case. */
+static void test_replaced_whole(es_ctx *ctx)
+{
+    const char *path = tp_path("replace", "fig.svg");
+    double x[3] = {0, 1, 2}, y[3] = {1, 0, 2};
+    es_scatter_spec sp;
+    es_test_write_file(path, "old");
+    es_scatter_spec_init(&sp);
+    sp.n = 3, sp.x = x, sp.y = y;
+    ES_CHECK_OK(ctx, es_plot_scatter(ctx, &sp, path, NULL));
+    size_t n = 0;
+    char *text = es_test_slurp(path, &n);
+    ES_CHECK_MSG(text && n > 100 && strstr(text, "<svg"), "the figure did not replace the file");
+    free(text);
+    es_test_write_file(path, "old");
+    sp.frame.width = 5;   /* refused: too small */
+    ES_CHECK_FAILS(ctx, es_plot_scatter(ctx, &sp, path, NULL), ES_EINVAL, "size");
+    text = es_test_slurp(path, &n);
+    ES_CHECK_MSG(text && n == 3 && !memcmp(text, "old", 3), "a failed figure changed the file");
+    free(text);
+    char dir[4200];
+    snprintf(dir, sizeof dir, "%s", path);
+    *strrchr(dir, '/') = 0;
+    ES_CHECK_MSG(es_test_count_entries(dir, ".part") == 0, "a part file stayed in %s", dir);
+}
+
 int main(void)
 {
     es_ctx *ctx = NULL;
@@ -735,6 +763,7 @@ int main(void)
     test_alloc_failures(ctx);
     test_table(ctx);
     test_cli();
+    test_replaced_whole(ctx);
     es_ctx_free(ctx);
     ES_TEST_END();
 }

@@ -762,6 +762,12 @@ static void test_render_files(es_ctx *ctx)
     }
     ES_CHECK_MSG(total > 20 && nomem > total / 2, "%lld of %lld failed allocations reported",
                  (long long)nomem, (long long)total);
+    {   /* every failed figure took its part file with it */
+        char dir[4200];
+        snprintf(dir, sizeof dir, "%s", png);
+        *strrchr(dir, '/') = 0;
+        ES_CHECK_MSG(es_test_count_entries(dir, ".part") == 0, "a part file stayed in %s", dir);
+    }
     tm_free(&sq);
     free(val);
     es_mesh_free(mesh);
