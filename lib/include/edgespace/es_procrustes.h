@@ -142,9 +142,6 @@ ES_API es_status es_gpa_tangent(es_ctx *ctx, int64_t k, int d, es_mat aligned,
 ES_API es_status es_gpa_pca(es_ctx *ctx, es_mat tan, int64_t npc, double *sdev,
                             double *percent, es_mat loadings, es_mat scores);
 
-/* ---- GPA of a store's vertex positions ---------------------------------- */
-
-
 #ifdef __cplusplus
 }
 #endif
