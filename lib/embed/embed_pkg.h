@@ -50,6 +50,10 @@ struct es_embedder {
     int64_t progress_total; /* progress steps of the solve running (0: none) */
     double *ltarget, *lpath, *res, *grad, *diag, *pcg, *jw, *fanwork, *fanr, *fanth, *fanal, *vclos, *verr;
     int have_vertex_results;
+    /* the bending prior (bending.c, prior.c), made on the first prior solve */
+    int64_t *flap;          /* 6E: c, d, edges ac, bc, ad, bd of each interior edge's faces */
+    double *omega, *prior_alpha, *vdev;   /* E, E, V (vdev: distance from the prior) */
+    int have_deviation;
     int64_t nfactor;        /* numeric factorizations in the last solve */
 };
 
@@ -120,10 +124,64 @@ es_status es__stage_frames(es_embedder *emb, const double *alpha);
 /* Stage 3: positions xyz (3 x V) from the frames and edge lengths len. */
 es_status es__stage_positions(es_embedder *emb, const double *len, double *xyz);
 
+/* The bending prior's term of stage 4 (bending.c):
+ *   mu * sum_e omega_e wrap(alpha_e(x) - alpha_prior_e)^2
+ * over interior edges, wrap to (-pi, pi]. Its Gauss-Newton matrix couples
+ * the four vertices a, b, c, d of the edge's two faces; (c, d) is no mesh
+ * edge, so its block is left out and the (c, c) and (d, d) blocks are
+ * doubled instead: g g^T + u u^T with u = (0, 0, g_c, -g_d) is positive
+ * semi-definite, bounds g g^T from above, and fits the vertex-adjacency
+ * pattern the embedder analysed once. */
+typedef struct es__bend_prior {
+    const double *alpha;   /* E: prior dihedrals (compared modulo 2 pi) */
+    const double *omega;   /* E: per-edge weights >= 0 (0: not in the term) */
+    const int64_t *flap;   /* 6E (embedder's flap) */
+    double mu;             /* weight of the term now */
+    double decay;          /* mu factor per LM iteration (1: constant) */
+} es__bend_prior;
+
+/* Signed bending angle (es_geom.h convention) of edge (a, b), c the third
+ * vertex of the face holding a->b and d that of the face holding b->a, and
+ * its gradient g (12: d/da, d/db, d/dc, d/dd). Returns 0, or -1 on a
+ * degenerate flap (g zero). */
+int es__dihedral_grad(const double *pa, const double *pb, const double *pc, const double *pd,
+                      double *alpha, double *g);
+/* The term's value at xyz. */
+double es__bend_cost(const es_embedder *emb, const es__bend_prior *bp, const double *xyz);
+/* Add the term's half-gradient to g and its Gauss-Newton blocks to emb->H3. */
+void es__bend_assemble(es_embedder *emb, const double *xyz, const es__bend_prior *bp, double *g);
+/* emb->flap, made once per embedder. */
+es_status es__bend_flaps(es_embedder *emb);
+/* omega (E): the discrete-shells weight 3 l_e^2 / (A_f + A_g) from lengths L
+ * normalized to mean 1, divided by 1 + (sd_e / s0)^2 when sd is given, s0 =
+ * sd_floor x the median sd over interior edges. */
+void es__bend_weights(const es_embedder *emb, const double *L, const double *sd,
+                      double sd_floor, double *omega);
+
 /* Stage 4: Levenberg-Marquardt on the relative edge-length residuals
- * against L, xyz in place; *iters grows by the iterations run. */
-es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz, int max_iter,
-                           double rtol, double tol, int verbose, int64_t *iters);
+ * against L (plus the bending prior's term when bp is given), xyz in place;
+ * *iters grows by the iterations run. */
+es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz,
+                           es__bend_prior *bp, int max_iter, double rtol, double tol,
+                           int verbose, int64_t *iters);
+
+/* What a prior solve asks of the driver (solve.c) beyond es_embed_solve. */
+typedef struct es__solve_ext {
+    const double *start_xyz;  /* refine from these positions (scaled to the target's
+                                 sum) instead of stages 1-3 */
+    int start_auto;           /* with init_alpha: also stages 2-3 from it when the
+                                 positions are more than start_max_rms off the
+                                 lengths, and keep the closer start */
+    double start_max_rms;
+    const double *align_ref;  /* align the output to this (3 x V) */
+    es__bend_prior *bp;       /* NULL: lengths only */
+} es__solve_ext;
+
+/* es_embed_solve with the extensions; start_xyz and align_ref must not
+ * alias xyz. */
+es_status es__embed_solve_ext(es_ctx *ctx, es_embedder *emb, const double *target,
+                              double scale, const double *init_alpha, const es__solve_ext *ext,
+                              const es_embed_opts *opts, double *xyz, es_embed_report *report);
 
 /* ---- vertex figures (closure.c) ----------------------------------------- */
 

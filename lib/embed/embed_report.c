@@ -59,19 +59,34 @@ es_status es_embed_length_error(es_ctx *ctx, const es_mesh *mesh, const double *
 
 const char *es_embed_report_format(const es_embed_report *r, char *buf, size_t n)
 {
+    char verdict[160] = "", shape[256] = "";
+    int k;
     if (!buf || !n) return buf;
-    snprintf(buf, n,
-             "edge lengths: RMS ratio %.3g%%, max %.3g%% (edge %lld), p99 %.3g%%%s\n"
-             "closure energy: %.4g (initial) -> %.4g (stage 1%s) -> %.4g (output)\n"
-             "iterations: stage 1 %lld, refinement %lld%s; target faces violating the "
-             "triangle inequality: %lld\n"
-             "time: dihedrals %.3f s, frames %.3f s, positions %.3f s, refinement %.3f s, "
-             "total %.3f s\n",
-             100 * r->rms_ratio, 100 * r->max_rel, (long long)r->worst_edge, 100 * r->p99_rel,
-             r->realized ? "" : "  [NOT REALIZED: best effort]", r->closure_before,
-             r->closure_stage1, r->used_stage1 ? "" : ", not used", r->closure_after,
-             (long long)r->dihedral_iters, (long long)r->refine_iters,
-             r->used_continuation ? " (continuation)" : "", (long long)r->n_bad_faces,
-             r->t_dihedral, r->t_frames, r->t_positions, r->t_refine, r->t_total);
+    /* not realized: either the target cannot be realized (a face breaks the
+     * triangle inequality) or the best compromise stays above the bar */
+    if (!r->realized && r->n_bad_faces > 0)
+        snprintf(verdict, sizeof verdict, "  [NOT REALIZABLE: %lld target faces violate the "
+                 "triangle inequality]", (long long)r->n_bad_faces);
+    else if (!r->realized)
+        snprintf(verdict, sizeof verdict, "  [NOT REALIZED: best compromise]");
+    if (r->has_prior)
+        snprintf(shape, sizeof shape, "shape: bending %.3f x the prior's; %.3g %% of the bbox "
+                 "diagonal from the prior's realization (max %.3g %%)\n", r->bend_ratio,
+                 100 * r->prior_rms, 100 * r->prior_max);
+    k = snprintf(buf, n,
+                 "edge lengths: RMS ratio %.3g%%, max %.3g%% (edge %lld), p99 %.3g%%%s\n"
+                 "%s"
+                 "closure energy: %.4g (initial) -> %.4g (stage 1%s) -> %.4g (output)\n"
+                 "iterations: stage 1 %lld, refinement %lld%s; target faces violating the "
+                 "triangle inequality: %lld\n"
+                 "time: dihedrals %.3f s, frames %.3f s, positions %.3f s, refinement %.3f s, "
+                 "total %.3f s\n",
+                 100 * r->rms_ratio, 100 * r->max_rel, (long long)r->worst_edge,
+                 100 * r->p99_rel, verdict, shape, r->closure_before, r->closure_stage1,
+                 r->used_stage1 ? "" : ", not used", r->closure_after,
+                 (long long)r->dihedral_iters, (long long)r->refine_iters,
+                 r->used_continuation ? " (continuation)" : "", (long long)r->n_bad_faces,
+                 r->t_dihedral, r->t_frames, r->t_positions, r->t_refine, r->t_total);
+    (void)k;
     return buf;
 }

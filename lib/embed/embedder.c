@@ -369,7 +369,7 @@ void es_embedder_free(es_embedder *emb)
                     emb->xyz_try, emb->xyz_best, emb->init_copy, emb->ltarget, emb->lpath,
                     emb->res, emb->grad, emb->diag, emb->pcg,
                     emb->jw, emb->fanwork, emb->fanr, emb->fanth, emb->fanal, emb->vclos,
-                    emb->verr};
+                    emb->verr, emb->flap, emb->omega, emb->prior_alpha, emb->vdev};
     for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++) es__free(ctx, bufs[i]);
     es__free(ctx, emb);
 }
@@ -385,4 +385,9 @@ const double *es_embedder_vertex_closure(const es_embedder *emb)
 const double *es_embedder_vertex_edge_error(const es_embedder *emb)
 {
     return emb && emb->have_vertex_results ? emb->verr : NULL;
+}
+
+const double *es_embedder_vertex_deviation(const es_embedder *emb)
+{
+    return emb && emb->have_deviation ? emb->vdev : NULL;
 }

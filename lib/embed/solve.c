@@ -34,6 +34,12 @@ void es_embed_opts_init(es_embed_opts *o)
     o->realized_rtol = 1e-2;
     o->verbose = 0;
     o->blas_threads = 1;
+    /* measured on face-study (tools/bench/bench_prior.c) */
+    o->prior_mu = 2e-3;
+    o->prior_decay = 0.8;
+    o->prior_sd_floor = 0.7;
+    o->prior_start_max_rms = 0.04;
+    o->prior_bend_closed = 0;
 }
 
 static double now_s(void)
@@ -131,7 +137,7 @@ static es_status run_continuation(es_embedder *emb, const es_embed_opts *o, cons
         double s = (double)step / (double)n;
         double *lp = emb->alpha_try;   /* scratch E */
         for (int64_t e = 0; e < ne; e++) lp[e] = (1 - s) * emb->lpath[e] + s * L[e];
-        rc = es__stage_refine(emb, lp, xyz, step == n ? o->refine_max_iter : 4,
+        rc = es__stage_refine(emb, lp, xyz, NULL, step == n ? o->refine_max_iter : 4,
                               step == n ? o->refine_rtol : 1e-3, o->refine_tol, o->verbose,
                               iters);
         if (rc != ES_OK) return rc;
@@ -158,9 +164,38 @@ static es_status linear_stages(es_embedder *emb, const double *alpha, const doub
     return ES_OK;
 }
 
+/* Stage 4 from positions: xyz = start scaled to the target's sum, or, when
+ * ext->start_auto and those positions are more than start_max_rms off the
+ * lengths (a vertex blend of rows whose parts rotate far apart, e.g. two
+ * poses of a cat: 6-8 %; a blend of faces: 0.7-2.2 %), the stages 2-3 mesh
+ * of alpha if that is closer. */
+static es_status positions_start(es_embedder *emb, const es__solve_ext *ext, const double *alpha,
+                                 const double *L, double *xyz, es_embed_report *rep)
+{
+    int64_t n3 = 3 * emb->nv;
+    double s0 = 0, mx;
+    es_status rc;
+    edge_lengths_of(emb, ext->start_xyz, emb->lpath);
+    for (int64_t e = 0; e < emb->ne; e++) s0 += emb->lpath[e];
+    for (int64_t i = 0; i < n3; i++)
+        xyz[i] = ext->start_xyz[i] * (s0 > 0 ? rep->scale / s0 : 1.0);
+    quick_metrics(emb, xyz, L, &rep->rms_ratio_linear, &mx);
+    if (ext->start_auto && alpha && rep->rms_ratio_linear > ext->start_max_rms) {
+        double r2, m2, *lx = emb->xyz_best;
+        if ((rc = linear_stages(emb, alpha, L, lx, rep)) != ES_OK) return rc;
+        quick_metrics(emb, lx, L, &r2, &m2);
+        if (all_finite(lx, n3) && r2 < rep->rms_ratio_linear) {
+            memcpy(xyz, lx, (size_t)n3 * sizeof *xyz);
+            rep->rms_ratio_linear = r2;
+        }
+    }
+    return ES_OK;
+}
+
 static es_status embed_solve(es_embedder *emb, const double *target, double scale,
                              const double *init_alpha, const double *init_xyz,
-                             const es_embed_opts *opts, double *xyz, es_embed_report *report)
+                             const es__solve_ext *ext, const es_embed_opts *opts, double *xyz,
+                             es_embed_report *report)
 {
     es_ctx *ctx;
     es_embed_opts dflt;
@@ -183,7 +218,9 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
         o = &dflt;
     }
     if (!target || !xyz) ES_FAIL(ctx, ES_EINVAL, "embed: NULL target or output");
-    if (!init_alpha && !init_xyz)
+    const double *start = ext && ext->start_xyz ? ext->start_xyz : NULL;
+    es__bend_prior *bp = ext ? ext->bp : NULL;
+    if (!init_alpha && !init_xyz && !start)
         ES_FAIL(ctx, ES_EINVAL, "embed: need initial dihedrals or initial positions");
     if (!(isfinite(scale) && scale >= 0))
         ES_FAIL(ctx, ES_EINVAL, "embed: scale %g is not finite and >= 0", scale);
@@ -217,7 +254,7 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
     if (init_alpha) {
         for (int64_t e = 0; e < ne; e++) alpha[e] = emb->eb[e] ? 0.0 : init_alpha[e];
     } else {
-        dihedrals_of(emb, init_xyz, alpha);
+        dihedrals_of(emb, init_xyz ? init_xyz : start, alpha);
     }
     rep.closure_before = es__closure_eval(emb, alpha, 0, NULL);
     emb->have_vertex_results = 0;
@@ -233,7 +270,22 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
      * one iteration gave no better result after the refinement (cactus
      * midpoints, 5K and 21K vertices: RMS ratio 0.0183 % / 0.0097 % with it,
      * 0.0170 % / 0.0093 % without). So the linear stages run once. */
-    if (!(o->continuation_steps > 0 && init_xyz) || o->try_both) {
+    if (start) {
+        /* from given positions (a prior's realization): stage 4 alone */
+        emb->progress_total = 1 + (o->refine_max_iter > 0 ? o->refine_max_iter : 0);
+        es__progress(ctx, "embedding", 0, emb->progress_total);
+        if ((rc = positions_start(emb, ext, init_alpha ? alpha : NULL, L, xyz, &rep)) != ES_OK)
+            return rc;
+        es__progress(ctx, "embedding", 1, emb->progress_total);
+        t1 = now_s();
+        if (o->refine_max_iter > 0 &&
+            (rc = es__stage_refine(emb, L, xyz, bp, o->refine_max_iter, o->refine_rtol,
+                                   o->refine_tol, o->verbose, &rep.refine_iters)) != ES_OK)
+            return rc;
+        rep.t_refine = now_s() - t1;
+        es__progress(ctx, "embedding", emb->progress_total, emb->progress_total);
+        emb->progress_total = 0;
+    } else if (!(o->continuation_steps > 0 && init_xyz) || o->try_both) {
         double mx;
         int mode = o->dihedral_mode;
         if (emb->nvar == 0 || o->dihedral_max_iter <= 0) mode = ES_EMBED_DIHEDRAL_OFF;
@@ -269,7 +321,7 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
         quick_metrics(emb, xyz, L, &rep.rms_ratio_linear, &mx);
         t1 = now_s();
         if (o->refine_max_iter > 0 &&
-            (rc = es__stage_refine(emb, L, xyz, o->refine_max_iter, o->refine_rtol, o->refine_tol,
+            (rc = es__stage_refine(emb, L, xyz, bp, o->refine_max_iter, o->refine_rtol, o->refine_tol,
                                o->verbose, &rep.refine_iters)) != ES_OK)
             return rc;
         rep.t_refine = now_s() - t1;
@@ -278,7 +330,7 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
         have_dihedral_result = 1;
     }
     /* continuation path */
-    if (o->continuation_steps > 0 && init_xyz) {
+    if (o->continuation_steps > 0 && init_xyz && !start) {
         double *cx = have_dihedral_result ? emb->xyz_best : xyz;
         int64_t it = 0;
         t1 = now_s();
@@ -305,7 +357,7 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
         if (emb->vweight[v] == 0) xyz[3 * v] = xyz[3 * v + 1] = xyz[3 * v + 2] = 0;
 
     /* alignment */
-    ref = init_xyz ? init_xyz : es_mesh_xyz(emb->mesh);
+    ref = ext && ext->align_ref ? ext->align_ref : init_xyz ? init_xyz : es_mesh_xyz(emb->mesh);
     if (o->align && ref) {
         double r;
         if ((rc = es_kabsch_align_parts(ctx, nv, xyz, ref, emb->vweight,
@@ -360,9 +412,12 @@ extern int openblas_get_num_threads(void) __attribute__((weak));
 #define ES_HAVE_BLAS_THREADS 1
 #endif
 
-es_status es_embed_solve(es_ctx *ctx, es_embedder *emb, const double *target, double scale,
-                         const double *init_alpha, const double *init_xyz,
-                         const es_embed_opts *opts, double *xyz, es_embed_report *report)
+/* Both entry points: the BLAS threads, the aliasing of init_xyz with the
+ * output, the progress bar and the caller's context. */
+static es_status solve_wrapped(es_ctx *ctx, es_embedder *emb, const double *target,
+                               double scale, const double *init_alpha, const double *init_xyz,
+                               const es__solve_ext *ext, const es_embed_opts *opts, double *xyz,
+                               es_embed_report *report)
 {
     es_status rc;
     if (!emb) ES_FAIL(ctx, ES_EINVAL, "embed: no embedder");
@@ -385,7 +440,7 @@ es_status es_embed_solve(es_ctx *ctx, es_embedder *emb, const double *target, do
         else had = 0;
     }
 #endif
-    rc = embed_solve(emb, target, scale, init_alpha, init_xyz, opts, xyz, report);
+    rc = embed_solve(emb, target, scale, init_alpha, init_xyz, ext, opts, xyz, report);
     if (emb->progress_total) {   /* failed part way: close the bar */
         es__progress(emb->ctx, "embedding", emb->progress_total, emb->progress_total);
         emb->progress_total = 0;
@@ -398,4 +453,18 @@ es_status es_embed_solve(es_ctx *ctx, es_embedder *emb, const double *target, do
     /* the embedder works on its own context; the caller's gets the message */
     if (rc != ES_OK && ctx && ctx != emb->ctx) es__fail(ctx, rc, "%s", es_ctx_errmsg(emb->ctx));
     return rc;
+}
+
+es_status es_embed_solve(es_ctx *ctx, es_embedder *emb, const double *target, double scale,
+                         const double *init_alpha, const double *init_xyz,
+                         const es_embed_opts *opts, double *xyz, es_embed_report *report)
+{
+    return solve_wrapped(ctx, emb, target, scale, init_alpha, init_xyz, NULL, opts, xyz, report);
+}
+
+es_status es__embed_solve_ext(es_ctx *ctx, es_embedder *emb, const double *target,
+                              double scale, const double *init_alpha, const es__solve_ext *ext,
+                              const es_embed_opts *opts, double *xyz, es_embed_report *report)
+{
+    return solve_wrapped(ctx, emb, target, scale, init_alpha, NULL, ext, opts, xyz, report);
 }

@@ -9,7 +9,8 @@
  * curvature of the stretched edges' residuals, in H3's pattern, solved by
  * CG on a lagged factor while that converges and by refactorization
  * otherwise. Rigid motions (and, on open meshes, flexes) are held by the
- * damping, so the result stays near the stage-3 mesh.
+ * damping, so the result stays near the stage-3 mesh; with a prior, the
+ * bending term (bending.c) holds the flexes near the data's dihedrals.
  */
 #include "embed/embed_pkg.h"
 
@@ -29,8 +30,18 @@ static double length_cost(const es_embedder *emb, const double *xyz, const doubl
     return c;
 }
 
-es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz, int max_iter,
-                           double rtol, double tol, int verbose, int64_t *iters)
+/* The cost with the bending prior's term when bp is active. */
+static double refine_cost(const es_embedder *emb, const double *xyz, const double *L,
+                          const es__bend_prior *bp)
+{
+    double c = length_cost(emb, xyz, L);
+    if (bp) c += es__bend_cost(emb, bp, xyz);
+    return c;
+}
+
+es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz,
+                           es__bend_prior *bp, int max_iter, double rtol, double tol,
+                           int verbose, int64_t *iters)
 {
     double hist[4] = {0, 0, 0, 0}, c_prev = 0;
     const int pcg_max = 12, pcg_give_up = 2;
@@ -39,10 +50,20 @@ es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz, int m
     double *x = emb->H3->x, *g = emb->grad, *dg = emb->diag, *step = emb->pcg + 4 * n3;
     double *hd = step + n3, lambda = 1e-4, c, ctol = tol * tol * (double)ne;
     int have_factor = 0;
-    c = length_cost(emb, xyz, L);
+    /* mu decays within the run (bp->decay < 1): the cost changes from one
+     * iteration to the next, so it is evaluated afresh and the relative
+     * stopping rule waits for the iterations to end */
+    const int annealing = bp && bp->decay > 0 && bp->decay < 1;
+    if (bp && !(bp->mu > 0)) bp = NULL;
+    c = refine_cost(emb, xyz, L, bp);
     for (int it = 0; it < max_iter && c > ctol; it++) {
         double c_new = c, mean = 0, pred, rho = 0;
         int accepted = 0, st, used = -1;
+        if (bp && annealing && it > 0) {
+            bp->mu *= bp->decay;
+            c = refine_cost(emb, xyz, L, bp);
+            c_prev = 0;
+        }
         memset(x, 0, emb->H3->nzmax * sizeof(double));
         memset(g, 0, (size_t)n3 * sizeof(double));
         for (int64_t e = 0; e < ne; e++) {
@@ -79,6 +100,7 @@ es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz, int m
                     }
             }
         }
+        if (bp) es__bend_assemble(emb, xyz, bp, g);
         for (int64_t i = 0; i < n3; i++) {
             dg[i] = x[es__pos_diag(emb->H3, 3, emb->nlow, i / 3, (int)(i % 3), (int)(i % 3))];
             mean += dg[i];
@@ -122,7 +144,7 @@ es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz, int m
             if (st == 0) {
                 double *xt = emb->xyz_try;
                 for (int64_t i = 0; i < n3; i++) xt[i] = xyz[i] + step[i];
-                c_new = length_cost(emb, xt, L);
+                c_new = refine_cost(emb, xt, L, bp);
                 es__sym_matvec(emb->H3, step, hd);
                 pred = -2.0 * es__dot(g, step, n3) - es__dot(step, hd, n3);
                 rho = pred > 0 ? (c - c_new) / pred : -1;
@@ -148,7 +170,7 @@ es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz, int m
                     for (double t = 0.5; t > 0.1 && !accepted; t *= 0.5) {
                         double pt = -2.0 * t * gs - t * t * shs;
                         for (int64_t i = 0; i < n3; i++) xt[i] = xyz[i] + t * step[i];
-                        c_new = length_cost(emb, xt, L);
+                        c_new = refine_cost(emb, xt, L, bp);
                         rho = pt > 0 ? (c - c_new) / pt : -1;
                         if (isfinite(c_new) && c_new < c && rho > 0.25) {
                             memcpy(xyz, xt, (size_t)n3 * sizeof *xyz);
@@ -173,7 +195,7 @@ es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz, int m
          * failure D: an absolute rule stops too early or too late) */
         hist[it % 4] = c_new;
         c_prev = c;
-        if (it >= 3 && hist[(it - 3) % 4] - c_new < 3.0 * rtol * c_new) {
+        if (it >= 3 && !annealing && hist[(it - 3) % 4] - c_new < 3.0 * rtol * c_new) {
             c = c_new;
             break;
         }

@@ -1,16 +1,18 @@
 /* lib/study/embed_point.c — one point of a store's space embedded as a
- * mesh: the point resolved, the start chosen (the nearest row, a named row,
- * the circular mean of rows' dihedrals, or a given mesh), the solve, the
- * mesh and residual files, and the stored result with its provenance. */
+ * mesh: the point resolved with its row weights, the prior those weights
+ * give (or an explicit start: the nearest row, a named row, the circular
+ * mean of rows' dihedrals, a given mesh), the solve, the mesh and residual
+ * files, and the stored result with its provenance. */
 #include "study/study_pkg.h"
 #include "edgespace/es_io.h"
 
+#include <math.h>
 #include <stdio.h>
 
 void es_study_embed_opts_init(es_study_embed_opts *o)
 {
     memset(o, 0, sizeof *o);
-    o->init = "nearest";
+    o->init = "prior";
     es_embed_opts_init(&o->embed);
 }
 
@@ -24,7 +26,7 @@ static es_status choose_start(es_ctx *ctx, es_store *s, const es_mesh *mesh, con
 {
     es_status rc;
     *init_row = -1;
-    if (!init || !strcmp(init, "nearest")) {
+    if (!strcmp(init, "nearest")) {
         double d;
         if ((rc = es_study_nearest_row(ctx, s, target, NULL, 0, init_row, &d)) != ES_OK)
             return rc;
@@ -47,27 +49,53 @@ static es_status choose_start(es_ctx *ctx, es_store *s, const es_mesh *mesh, con
         if ((rc = es_mesh_read_positions(ctx, mesh, init + 5, init_xyz)) != ES_OK) return rc;
         snprintf(desc, ndesc, "mesh %s", init + 5);
     } else {
-        ES_FAIL(ctx, ES_EINVAL, "--init wants nearest, row:ID, mean[:FILTER] or mesh:FILE "
-                "(got '%s')", init);
+        ES_FAIL(ctx, ES_EINVAL, "--init wants prior, nearest, row:ID, mean[:FILTER] or "
+                "mesh:FILE (got '%s')", init);
     }
     if (*init_row >= 0) return es_store_read_positions(ctx, s, *init_row, init_xyz);
     return ES_OK;
 }
 
-/* Per vertex of the output, its vertex-figure closure energy and the mean
- * relative error of its edges; the closure comes first because render
- * --scalars colours by the first column. */
+/* Per vertex of the output, its vertex-figure closure energy, the mean
+ * relative error of its edges and (with a prior) its distance from the
+ * prior's realization as a fraction of the bounding-box diagonal; the
+ * closure comes first because render --scalars colours by the first
+ * column. */
 static es_status write_residuals(es_ctx *ctx, const char *path, const es_embedder *emb,
                                  int64_t nv)
 {
     const double *closure = es_embedder_vertex_closure(emb);
     const double *edge_error = es_embedder_vertex_edge_error(emb);
+    const double *dev = es_embedder_vertex_deviation(emb);
     es__table_out t;
     es_status rc = es__table_begin(ctx, path, &t);
     if (rc != ES_OK) return rc;
-    fputs("closure,edge_error\n", t.f);
-    for (int64_t v = 0; v < nv; v++) fprintf(t.f, "%.17g,%.17g\n", closure[v], edge_error[v]);
+    fputs(dev ? "closure,edge_error,deviation\n" : "closure,edge_error\n", t.f);
+    for (int64_t v = 0; v < nv; v++) {
+        fprintf(t.f, "%.17g,%.17g", closure[v], edge_error[v]);
+        if (dev) fprintf(t.f, ",%.17g", dev[v]);
+        fputc('\n', t.f);
+    }
     return es__table_end(ctx, &t, ES_OK);
+}
+
+/* The prior of the point's row weights: its realization, dihedrals and
+ * spread, and what the report says it started from. */
+static es_status point_prior(es_ctx *ctx, es_store *s, const es_mesh *mesh, const double *w,
+                             double *xyz, double *alpha, double *sd, char *desc, size_t ndesc)
+{
+    es_study_rows *rows = NULL;
+    int64_t n = es_store_nrows(s), used = 0, top = 0;
+    es_status rc = es_study_rows_load(ctx, s, mesh, &rows);
+    if (rc == ES_OK) rc = es_study_prior(ctx, rows, w, xyz, alpha, sd);
+    es_study_rows_free(rows);
+    for (int64_t i = 0; i < n; i++) {
+        used += w[i] != 0;
+        if (fabs(w[i]) > fabs(w[top])) top = i;
+    }
+    snprintf(desc, ndesc, "prior of %lld row%s (weight %.3g on %s), store frame", (long long)used,
+             used == 1 ? "" : "s", w[top], es_store_row_id(s, top));
+    return rc;
 }
 
 es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o, double *xyz_out,
@@ -75,8 +103,10 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
 {
     es_mesh *mesh = NULL;
     es_embedder *emb = NULL;
-    double *target = NULL, *xyz = NULL, *init_xyz = NULL, *alpha = NULL, own;
-    int64_t init_row = -1, *sel = NULL, nsel = 0, ne, nv;
+    double *target = NULL, *xyz = NULL, *init_xyz = NULL, *alpha = NULL, *sd = NULL, *w = NULL;
+    double own;
+    int64_t init_row = -1, *sel = NULL, nsel = 0, ne, nv, n = es_store_nrows(s);
+    const int prior = !o || !o->init || !strcmp(o->init, "prior");
     es_status rc;
     memset(res, 0, sizeof *res);
     if (!o || !o->point) ES_FAIL(ctx, ES_EINVAL, "embed: no point given");
@@ -87,20 +117,42 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
     xyz = xyz_out ? xyz_out : es__alloc_array(ctx, 3 * nv, sizeof *xyz);
     init_xyz = es__alloc_array(ctx, 3 * nv, sizeof *init_xyz);
     alpha = es__alloc_array(ctx, ne, sizeof *alpha);
-    if (!target || !xyz || !init_xyz || !alpha) {
+    sd = es__alloc_array(ctx, ne, sizeof *sd);
+    w = es__alloc_array(ctx, n > 0 ? n : 1, sizeof *w);
+    if (!target || !xyz || !init_xyz || !alpha || !sd || !w) {
         rc = ES_ENOMEM;
         goto done;
     }
     /* the target: at the point's own scale unless opts->scale gives one */
-    if ((rc = es_study_point_lengths(ctx, s, o->point, o->pca_name, target, &own)) != ES_OK)
+    if ((rc = es_study_point_weights(ctx, s, o->point, o->pca_name, target, &own,
+                                     prior ? w : NULL)) != ES_OK)
         goto done;
     res->scale = o->scale > 0 ? o->scale : own;
-    if ((rc = choose_start(ctx, s, mesh, o->init, target, init_xyz, alpha, &init_row, &sel,
-                           &nsel, res->init, sizeof res->init)) != ES_OK ||
-        (rc = es_embedder_new(ctx, mesh, &emb)) != ES_OK ||
-        (rc = es_embed_solve(ctx, emb, target, res->scale, sel ? alpha : NULL, init_xyz,
-                             &o->embed, xyz, &res->report)) != ES_OK ||
-        (o->output && (rc = es_mesh_write(ctx, o->output, ES_FORMAT_AUTO, mesh, xyz, NULL))) ||
+    if (prior) {
+        es_embed_prior pr = {init_xyz, alpha, sd};
+        if ((rc = point_prior(ctx, s, mesh, w, init_xyz, alpha, sd, res->init,
+                              sizeof res->init)) != ES_OK ||
+            (rc = es_embedder_new(ctx, mesh, &emb)) != ES_OK ||
+            (rc = es_embed_prior_solve(ctx, emb, target, res->scale, &pr, &o->embed, xyz,
+                                       &res->report)) != ES_OK)
+            goto done;
+        /* provenance: the rows the prior drew on */
+        for (int64_t i = 0; i < n; i++) nsel += w[i] != 0;
+        if (nsel && !(sel = es__alloc_array(ctx, nsel, sizeof *sel))) {
+            rc = ES_ENOMEM;
+            goto done;
+        }
+        for (int64_t i = 0, j = 0; i < n; i++)
+            if (w[i] != 0) sel[j++] = i;
+    } else if ((rc = choose_start(ctx, s, mesh, o->init, target, init_xyz, alpha, &init_row,
+                                  &sel, &nsel, res->init, sizeof res->init)) != ES_OK ||
+               (rc = es_embedder_new(ctx, mesh, &emb)) != ES_OK ||
+               (rc = es_embed_solve(ctx, emb, target, res->scale, sel ? alpha : NULL, init_xyz,
+                                    &o->embed, xyz, &res->report)) != ES_OK) {
+        goto done;
+    }
+    if (
+(o->output && (rc = es_mesh_write(ctx, o->output, ES_FORMAT_AUTO, mesh, xyz, NULL))) ||
         (o->residuals && (rc = write_residuals(ctx, o->residuals, emb, nv)) != ES_OK))
         goto done;
     if (o->name) {
@@ -124,5 +176,7 @@ done:
     if (xyz != xyz_out) es__free(ctx, xyz);
     es__free(ctx, init_xyz);
     es__free(ctx, alpha);
+    es__free(ctx, sd);
+    es__free(ctx, w);
     return rc;
 }

@@ -90,7 +90,9 @@ es_status es_study_store_embedding(es_ctx *ctx, es_store *store, const char *nam
         {"dihedral_iters", (double)r->dihedral_iters}, {"refine_iters", (double)r->refine_iters},
         {"t_dihedral", r->t_dihedral}, {"t_frames", r->t_frames},
         {"t_positions", r->t_positions}, {"t_refine", r->t_refine}, {"t_total", r->t_total},
-        {"scale", r->scale}};
+        {"scale", r->scale}, {"has_prior", r->has_prior}, {"bend_out", r->bend_out},
+        {"bend_prior", r->bend_prior}, {"bend_ratio", r->bend_ratio},
+        {"prior_rms", r->prior_rms}, {"prior_max", r->prior_max}};
     if (!es_embedder_vertex_closure(emb))
         ES_FAIL(ctx, ES_EINVAL, "embed: store result: the embedder has not solved yet");
     if ((rc = es_store_result_begin(ctx, store, "embed", name, prov)) != ES_OK) return rc;
@@ -100,7 +102,10 @@ es_status es_study_store_embedding(es_ctx *ctx, es_store *store, const char *nam
         (rc = es_store_put_vector(ctx, store, P("vertex_closure"),
                                   es_embedder_vertex_closure(emb), nv)) != ES_OK ||
         (rc = es_store_put_vector(ctx, store, P("vertex_edge_error"),
-                                  es_embedder_vertex_edge_error(emb), nv)) != ES_OK)
+                                  es_embedder_vertex_edge_error(emb), nv)) != ES_OK ||
+        (es_embedder_vertex_deviation(emb) &&
+         (rc = es_store_put_vector(ctx, store, P("vertex_deviation"),
+                                   es_embedder_vertex_deviation(emb), nv)) != ES_OK))
         return rc;
     tn = es__alloc_array(ctx, ne, sizeof *tn);
     if (!tn) return ES_ENOMEM;

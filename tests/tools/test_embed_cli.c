@@ -85,8 +85,8 @@ int main(void)
         ES_CHECK_MSG(r.status == 0 && strstr(r.out, "t = 0.5") && strstr(r.out, "walk_NN"),
                      "interp between points: %d %s %s", r.status, r.out, r.err);
         check_frames_do_not_jump(dir, "walk", 1, 3);
-        /* the frame at the row end starts from that row's dihedrals (recorded)
-         * and is that row again */
+        /* the frame at the row end is that row's prior alone (recorded) and
+         * is that row again */
         {
             es_ctx *c2 = NULL;
             es_mesh *m2 = NULL;
@@ -111,7 +111,7 @@ int main(void)
             if (st)
                 ES_CHECK_OK(c2, es_store_get_attr(c2, st, "embed/walk_02", "init", init,
                                                   sizeof init));
-            ES_CHECK_MSG(strstr(init, "dihedrals of row:mesh-2"), "walk_02 init: '%s'", init);
+            ES_CHECK_MSG(strstr(init, "prior of 1 rows"), "walk_02 init: '%s'", init);
             es_store_close(st);
             free(xw);
             es_mesh_free(m2);
@@ -245,7 +245,11 @@ int main(void)
         snprintf(pat, sizeof pat, "%s/seq_%%02d.obj", dir);
     }
     ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out);
-    ES_CHECK_MSG(r.status == 0 && strstr(r.out, "nearest row mesh-2"), "embed nearest: %s", r.out);
+    ES_CHECK_MSG(r.status == 0 && strstr(r.out, "prior of 1 row (weight 1 on mesh-2)") &&
+                 strstr(r.out, "shape: bending"), "embed with the prior: %s", r.out);
+    ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out, "--init", "nearest");
+    ES_CHECK_MSG(r.status == 0 && strstr(r.out, "nearest row mesh-2") &&
+                 !strstr(r.out, "shape: bending"), "embed nearest: %s", r.out);
     /* per-vertex residuals as CSV, drawn by render --scalars */
     {
         char res[4300], png[4300];
@@ -258,11 +262,12 @@ int main(void)
                      r.err);
         char *text = es_test_slurp(res, &n), *line = text ? strchr(text, '\n') : NULL;
         int rows = 0, bad = 0;
-        ES_CHECK(text && !strncmp(text, "closure,edge_error\n", 19));
+        ES_CHECK(text && !strncmp(text, "closure,edge_error,deviation\n", 29));
         while (line && line[1]) {
             char *end;
             double a = strtod(line + 1, &end), b = end && *end == ',' ? strtod(end + 1, &end) : -1;
-            bad += !(a >= 0 && b >= 0 && isfinite(a) && isfinite(b));
+            double c = end && *end == ',' ? strtod(end + 1, &end) : -1;
+            bad += !(a >= 0 && b >= 0 && c >= 0 && isfinite(a) && isfinite(b) && isfinite(c));
             rows++;
             line = strchr(line + 1, '\n');
         }

@@ -12,10 +12,13 @@
 static const char usage[] =
     "usage: edgespace embed STORE --point SPEC -o OUT [options]\n"
     "\n"
-    "Realize a point of edge-length space as a mesh (dihedral solve, frames and\n"
-    "positions by sparse least squares, Gauss-Newton refinement of the lengths),\n"
-    "print the quality report and store it with per-vertex residuals under\n"
-    "/analysis/embed/NAME.\n"
+    "Realize a point of edge-length space as a mesh, print the quality report\n"
+    "and store it with per-vertex residuals under /analysis/embed/NAME. Every\n"
+    "point is a combination of stored rows; by default the same row weights\n"
+    "applied to the rows (GPA-aligned) and their dihedrals give a prior that\n"
+    "starts the solve, keeps the surface near the data's bending where the\n"
+    "lengths leave it free (open meshes), and puts the output in the store's\n"
+    "frame (the first row's pose), so outputs of nearby points overlay.\n"
     "\n"
     "  -p, --point SPEC     row:ID (a stored row's lengths), NAME (a stored point,\n"
     "                       /analysis/point/NAME), or an expression such as\n"
@@ -24,21 +27,22 @@ static const char usage[] =
     "  -o, --output OUT     mesh file (.obj, .ply, .off)\n"
     "      --pca NAME       the PCA whose components pc:K in SPEC means (needed when\n"
     "                       several are stored and none is named 'default')\n"
-    "  -i, --init HOW       nearest (default: the stored row nearest in edge-length\n"
+    "  -i, --init HOW       prior (default, see above); or an explicit start without\n"
+    "                       the prior: nearest (the stored row nearest in edge-length\n"
     "                       distance), row:ID, mean[:FILTER] (circular mean of the\n"
     "                       dihedrals of the selected rows), or mesh:FILE (a mesh with\n"
     "                       the store's face list: its dihedrals, and the output is\n"
-    "                       aligned to it; the previous frame of a walk of points,\n"
-    "                       e.g. \"mean + T*pc:1\", keeps the frames from jumping)\n"
+    "                       aligned to it)\n"
     "  -s, --scale S        sum of edge lengths of the output (default: the point's\n"
     "                       scale, else the mean scale of the store)\n"
     "  -n, --name NAME      result name in the store (default: the output's base name)\n"
     "      --no-store       do not write the report into the store\n"
     "      --refine-iters N refinement iterations (default 12; more for accuracy,\n"
     "                       0 for the linear stages only)\n"
-    "      --residuals CSV  per-vertex closure energy and mean relative edge error of\n"
-    "                       the output (header closure,edge_error; one row per vertex;\n"
-    "                       render MESH --scalars CSV draws the closure as a heat map)\n"
+    "      --residuals CSV  per vertex of the output: closure energy, mean relative\n"
+    "                       edge error and, with the prior, distance from the prior's\n"
+    "                       realization / bbox diagonal (header closure,edge_error\n"
+    "                       [,deviation]; render MESH --scalars CSV draws the first)\n"
     "      --paper          the published method's stages only (stage 1 always, no\n"
     "                       refinement), for comparison\n"
     "  -h, --help           show this help\n"
@@ -93,9 +97,11 @@ int cmd_embed(int argc, char **argv)
     }
     if (optind != argc - 1) return cli_usage_error("embed", "give exactly one STORE");
     if (!o.point || !o.output) return cli_usage_error("embed", "--point and --output are required");
-    if (strcmp(o.init, "nearest") && strncmp(o.init, "row:", 4) && strncmp(o.init, "mesh:", 5) &&
+    if (strcmp(o.init, "prior") && strcmp(o.init, "nearest") && strncmp(o.init, "row:", 4) &&
+        strncmp(o.init, "mesh:", 5) &&
         !(!strncmp(o.init, "mean", 4) && (o.init[4] == 0 || o.init[4] == ':')))
-        return cli_usage_error("embed", "--init wants nearest, row:ID, mean[:FILTER] or mesh:FILE");
+        return cli_usage_error("embed", "--init wants prior, nearest, row:ID, mean[:FILTER] or "
+                               "mesh:FILE");
     if (!o.name) {
         es_id_from_path(o.output, namebuf, sizeof namebuf);   /* its base name */
         o.name = namebuf;

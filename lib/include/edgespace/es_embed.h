@@ -84,6 +84,23 @@ typedef struct es_embed_opts {
     double bad_face_rtol;     /* triangle-inequality tolerance of the report (1e-12) */
     double realized_rtol;     /* report.realized = max relative error <= this (1e-2) */
     int verbose;              /* 1: one note per iteration to the log callback (0) */
+    /* es_embed_prior_solve only (measured on face-study, tools/bench/bench_prior.c): */
+    double prior_mu;          /* weight of the bending term relative to the length term at
+                                 the first refinement iteration (default 2e-3); 0: the
+                                 prior only starts and frames the solve */
+    double prior_decay;       /* mu factor per refinement iteration (default 0.8: 2e-3 to
+                                 1.7e-4 over 12 iterations; it never reaches 0 on an open
+                                 mesh, whose flexes the lengths leave free) */
+    double prior_sd_floor;    /* each edge's weight is divided by 1 + (sd_e / s0)^2, s0 =
+                                 this x the median sd (the rows' disagreement; default 0.7;
+                                 0: sd ignored) */
+    double prior_start_max_rms; /* start from the prior's positions unless they are more
+                                 than this RMS ratio off the lengths; then the closer of
+                                 them and stages 2-3 on the prior's dihedrals (default
+                                 0.04) */
+    int prior_bend_closed;    /* 1: the bending term on closed meshes too (default 0: a
+                                 closed mesh is rigid for its lengths, which decide alone
+                                 after the prior's start, as es_interp_embed does) */
     int blas_threads;         /* OpenBLAS threads during the solve, the caller's setting
                                  restored after; 0 leaves it alone (default 1: the
                                  factorizations' dense blocks are small, and 2 threads
@@ -110,7 +127,17 @@ typedef struct es_embed_report {
     int64_t worst_edge;       /* edge of max_rel */
     int64_t n_bad_faces;      /* target faces violating the triangle inequality */
     double scale;             /* sum of the output's target lengths */
-    int realized;             /* 1 if max_rel <= opts.realized_rtol */
+    int realized;             /* 1 if max_rel <= opts.realized_rtol and no target face
+                                 violates the triangle inequality */
+    /* shape against the prior (es_embed_prior_solve; has_prior 0 otherwise) */
+    int has_prior;
+    double bend_out;          /* mean |bending angle| over interior edges, output */
+    double bend_prior;        /* the same of the prior's realization */
+    double bend_ratio;        /* bend_out / bend_prior: > 1 means creases the data lack */
+    double prior_rms;         /* RMS vertex distance from the prior's realization (scaled
+                                 to the output's size, rigidly aligned), as a fraction of
+                                 its bounding-box diagonal */
+    double prior_max;         /* the largest such distance */
 } es_embed_report;
 
 /* Make an embedder for `mesh` (borrowed; must outlive the embedder).
@@ -151,6 +178,10 @@ ES_API es_status es_embed_solve(es_ctx *ctx, es_embedder *emb, const double *tar
  * edges around the vertex. */
 ES_API const double *es_embedder_vertex_closure(const es_embedder *emb);
 ES_API const double *es_embedder_vertex_edge_error(const es_embedder *emb);
+/* After es_embed_prior_solve (NULL otherwise): each vertex's distance from
+ * the prior's realization, as a fraction of its bounding-box diagonal (the
+ * per-vertex values behind report.prior_rms, for a heat map). */
+ES_API const double *es_embedder_vertex_deviation(const es_embedder *emb);
 ES_API const es_mesh *es_embedder_mesh(const es_embedder *emb);
 
 /* Closure energy E(alpha) = sum_v ||P_v - I||_F^2 (eq. 2-3) with corner
@@ -180,6 +211,59 @@ ES_API es_status es_kabsch_align(es_ctx *ctx, int64_t nverts, double *xyz, const
 ES_API es_status es_kabsch_align_parts(es_ctx *ctx, int64_t nverts, double *xyz,
                                        const double *ref, const double *w, const int64_t *part,
                                        double *rms);
+
+/* ---- a prior from the data -------------------------------------------------
+ * Where the lengths leave a surface free (every open mesh: faces with eye and
+ * mouth holes and a neck boundary) the solve above bends it into shapes no
+ * input has. Every point of a study is a combination of stored rows with
+ * row weights w (es_point_eval_rows); the same weights applied to the rows
+ * give a prior:
+ *   xyz   = sum_i w_i X_i, X_i the rows' positions after GPA without scaling:
+ *           the prior's own realization, which starts the solve and frames
+ *           its output (one frame for every point of a store);
+ *   alpha = c + sum_i w_i wrap(alpha_i - c), c the circular mean of the
+ *           rows' dihedrals weighted by |w_i| (for two rows the shortest arc,
+ *           as es_interp_targets);
+ *   sd    = the |w_i|-weighted RMS of wrap(alpha_i - c): how much the rows
+ *           that make the point disagree at each edge.
+ * es_embed_prior_solve realizes target lengths near that prior: on an open
+ * mesh it starts from xyz scaled to the target's length sum and refines
+ *   F(x) = sum_e ((|x_a - x_b| - l_e) / l_e)^2
+ *        + mu_k sum_e omega_e wrap(alpha_e(x) - alpha_e)^2,
+ *   mu_k = prior_mu prior_decay^k at refinement iteration k,
+ *   omega_e = [3 l_e^2 / (A_f + A_g)] / mean(...) / (1 + (sd_e / s0)^2),
+ * the discrete-shells bending weight (Grinspun et al. 2003) over interior
+ * edges, the bending angle of es_geom.h. On a closed mesh (rigid for its
+ * lengths) the term is off and the solve is the dihedral path from alpha
+ * (what es_interp_embed does). The output is rigidly aligned to xyz.
+ * Measured on face-study (81 rows, 3 subjects held out): held-out faces from
+ * their lengths 0.13 % of the bbox diagonal from the real mesh (0.50 % from
+ * the nearest row's start), means 0.11 % from the Procrustes mean (0.49 %),
+ * bending ratio 1.00-1.05 (1.29-1.48), at the same cost per embedding. */
+typedef struct es_embed_prior {
+    const double *xyz;      /* 3 x V: the prior's realization (required); must not be
+                               the output array */
+    const double *alpha;    /* E: prior dihedrals (NULL: those of xyz) */
+    const double *sd;       /* E: the rows' spread per edge (NULL: none) */
+} es_embed_prior;
+
+/* Embed target lengths (E; scale as es_embed_solve) near a prior. The
+ * report adds the shape against the prior (has_prior = 1), and
+ * es_embedder_vertex_deviation the per-vertex distances. Errors as
+ * es_embed_solve, and ES_EINVAL without prior positions. */
+ES_API es_status es_embed_prior_solve(es_ctx *ctx, es_embedder *emb, const double *target,
+                                      double scale, const es_embed_prior *prior,
+                                      const es_embed_opts *opts, double *xyz,
+                                      es_embed_report *report);
+
+/* The prior of row weights w (n rows): xyz (3 x V) from aligned[i] (3 x V
+ * each, GPA-aligned without scaling), alpha and sd (E) from alpha_rows[i]
+ * (E each, the rows' dihedrals). Any output may be NULL (then its inputs
+ * may be too). Rows of weight 0 are not read. */
+ES_API es_status es_embed_prior_from_rows(es_ctx *ctx, int64_t nverts, int64_t nedges,
+                                          int64_t n, const double *const *aligned,
+                                          const double *const *alpha_rows, const double *w,
+                                          double *xyz, double *alpha, double *sd);
 
 /* One-line and multi-line text of a report (for commands and notebooks):
  * writes at most n bytes with NUL, returns buf. */

@@ -243,23 +243,44 @@ ES_API es_status es_study_mean_dihedrals(es_ctx *ctx, es_store *store, const es_
 
 /* Store an embedding as /analysis/embed/<name>: datasets positions (V x 3),
  * target_lengths (E, normalized), vertex_closure and vertex_edge_error
- * (V, for heat maps, from the embedder's last solve), and the report as
- * attributes (closure_before, closure_after, rms_ratio, max_rel, p99_rel,
- * n_bad_faces, realized, iterations, seconds per stage, init). Commit is
- * the caller's. */
+ * (V, for heat maps, from the embedder's last solve), vertex_deviation (V,
+ * after a prior solve: distance from the prior's realization / bbox
+ * diagonal), and the report as attributes (closure_before, closure_after,
+ * rms_ratio, max_rel, p99_rel, n_bad_faces, realized, iterations, seconds
+ * per stage, has_prior, bend_out, bend_prior, bend_ratio, prior_rms,
+ * prior_max, init). Commit is the caller's. */
 ES_API es_status es_study_store_embedding(es_ctx *ctx, es_store *store, const char *name,
                                        const es_provenance *prov, const es_embedder *emb,
                                        const double *target, const double *xyz,
                                        const es_embed_report *rep, const char *init);
 
+/* The store's rows ready to serve as the embedding's prior (es_embed.h):
+ * every row's positions aligned by GPA without scaling into the store's
+ * frame (the Procrustes mean moved onto row 0, so outputs stand where the
+ * first shape stands and outputs of nearby points overlay), and every row's
+ * dihedrals. N x (3V + E) doubles; made once per command. */
+typedef struct es_study_rows es_study_rows;
+ES_API es_status es_study_rows_load(es_ctx *ctx, es_store *store, const es_mesh *mesh,
+                                    es_study_rows **out);
+ES_API void es_study_rows_free(es_study_rows *rows);
+/* The prior of row weights w (es_store_nrows entries, as es_study_point_weights
+ * gives them): realization xyz (3 x V, in the store's frame), dihedrals alpha
+ * and their spread sd (E each). Any output may be NULL. */
+ES_API es_status es_study_prior(es_ctx *ctx, const es_study_rows *rows, const double *w,
+                                double *xyz, double *alpha, double *sd);
+
 /* What es_study_embed does: embed one point of the store's space. */
 typedef struct es_study_embed_opts {
     const char *point;      /* as es_study_point_lengths reads it (required) */
     const char *pca_name;   /* the PCA of pc:K in the point (NULL: the only one) */
-    const char *init;       /* "nearest" (NULL: the stored row nearest in edge-length
-                               distance), "row:ID", "mean[:FILTER]" (circular mean of
-                               the rows' dihedrals) or "mesh:FILE" (a mesh of this
-                               topology; the output is aligned to it) */
+    const char *init;       /* NULL or "prior" (the default): the prior of the point's
+                               row weights (es_study_prior, es_embed_prior_solve), the
+                               output in the store's frame; explicit overrides, from
+                               es_embed_solve without a prior: "nearest" (the stored row
+                               nearest in edge-length distance), "row:ID",
+                               "mean[:FILTER]" (circular mean of the rows' dihedrals) or
+                               "mesh:FILE" (a mesh of this topology; the output is
+                               aligned to it) */
     double scale;           /* > 0: embed at this sum of lengths (0: the point's) */
     const char *output;     /* mesh file to write (OBJ/PLY/OFF by extension), or NULL */
     const char *residuals;  /* CSV of per-vertex closure and edge error, or NULL */
