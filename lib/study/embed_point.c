@@ -79,6 +79,25 @@ static es_status write_residuals(es_ctx *ctx, const char *path, const es_embedde
     return es__table_end(ctx, &t, ES_OK);
 }
 
+/* 1 if the point is one mesh's lengths (a row or a file, coefficient 1):
+ * exactly realizable. */
+static int one_mesh(es_ctx *ctx, const char *spec)
+{
+    es_point_expr *x = NULL;
+    double coef = 0;
+    es_point_leaf kind = ES_POINT_MEAN;
+    int one = 0;
+    if (!strncmp(spec, "row:", 4) || !strncmp(spec, "file:", 5)) {
+        if (es_point_parse(ctx, spec, &x) == ES_OK && es_point_expr_nterms(x) == 1) {
+            es_point_expr_term(x, 0, &coef, &kind, NULL, NULL);
+            one = coef == 1 && (kind == ES_POINT_ROW || kind == ES_POINT_FILE);
+        }
+        es_point_expr_free(x);
+        es_ctx_clear_error(ctx);
+    }
+    return one;
+}
+
 /* The prior of the point's row weights: its realization, dihedrals and
  * spread, and what the report says it started from. */
 static es_status point_prior(es_ctx *ctx, es_store *s, const es_mesh *mesh, const double *w,
@@ -130,10 +149,12 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
     res->scale = o->scale > 0 ? o->scale : own;
     if (prior) {
         es_embed_prior pr = {init_xyz, alpha, sd};
+        es_embed_opts eo = o->embed;
+        eo.prior_exact = one_mesh(ctx, o->point);
         if ((rc = point_prior(ctx, s, mesh, w, init_xyz, alpha, sd, res->init,
                               sizeof res->init)) != ES_OK ||
             (rc = es_embedder_new(ctx, mesh, &emb)) != ES_OK ||
-            (rc = es_embed_prior_solve(ctx, emb, target, res->scale, &pr, &o->embed, xyz,
+            (rc = es_embed_prior_solve(ctx, emb, target, res->scale, &pr, &eo, xyz,
                                        &res->report)) != ES_OK)
             goto done;
         /* provenance: the rows the prior drew on */

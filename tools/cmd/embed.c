@@ -37,6 +37,8 @@ static const char usage[] =
     "                       scale, else the mean scale of the store)\n"
     "  -n, --name NAME      result name in the store (default: the output's base name)\n"
     "      --no-store       do not write the report into the store\n"
+    "      --bending W      weight of the prior's bending term against the lengths\n"
+    "                       (default 0.002; 0: the prior only starts and frames it)\n"
     "      --refine-iters N refinement iterations (default 12; more for accuracy,\n"
     "                       0 for the linear stages only)\n"
     "      --residuals CSV  per vertex of the output: closure energy, mean relative\n"
@@ -56,7 +58,7 @@ int cmd_embed(int argc, char **argv)
         {"init", required_argument, NULL, 'i'},  {"scale", required_argument, NULL, 's'},
         {"name", required_argument, NULL, 'n'},  {"no-store", no_argument, NULL, 'N'},
         {"paper", no_argument, NULL, 'P'},       {"help", no_argument, NULL, 'h'},
-        {"refine-iters", required_argument, NULL, 'R'},
+        {"refine-iters", required_argument, NULL, 'R'}, {"bending", required_argument, NULL, 'B'},
         {"residuals", required_argument, NULL, 'r'}, {"pca", required_argument, NULL, 'c'},
         {NULL, 0, NULL, 0}};
     char namebuf[256], text[1024], *cmd = NULL;
@@ -86,6 +88,13 @@ int cmd_embed(int argc, char **argv)
             o.embed.dihedral_mode = ES_EMBED_DIHEDRAL_ON;
             o.embed.refine_max_iter = 0;
             break;
+        case 'B': {
+            double mu;
+            if (cli_parse_double(optarg, &mu) || !(mu >= 0))
+                return cli_usage_error("embed", "--bending wants a weight >= 0");
+            o.embed.prior_mu = mu;
+            break;
+        }
         case 'R':
             if (cli_parse_i64(optarg, &iters) || iters < 0 || iters > 100000)
                 return cli_usage_error("embed", "--refine-iters wants a count >= 0");

@@ -37,6 +37,8 @@ static const char usage[] =
     "                        one integer conversion, e.g. 'cat_%02d.obj' (%% for %)\n"
     "  -n, --name NAME       result name in the store (default: output base name)\n"
     "      --no-store        do not write reports into the store\n"
+    "      --bending W      weight of the prior's bending term against the lengths\n"
+    "                       (default 0.002; 0: the prior only starts and frames it)\n"
     "      --refine-iters N  refinement iterations per frame (default 12)\n"
     "  -h, --help            show this help\n"
     "\n"
@@ -78,7 +80,7 @@ int cmd_interp(int argc, char **argv)
         {"t1", required_argument, NULL, '1'},   {"weights", required_argument, NULL, 'w'},
         {"output", required_argument, NULL, 'o'}, {"name", required_argument, NULL, 'n'},
         {"no-store", no_argument, NULL, 'N'},   {"help", no_argument, NULL, 'h'},
-        {"refine-iters", required_argument, NULL, 'R'}, {"pca", required_argument, NULL, 'c'},
+        {"refine-iters", required_argument, NULL, 'R'}, {"bending", required_argument, NULL, 'B'}, {"pca", required_argument, NULL, 'c'},
         {NULL, 0, NULL, 0}};
     es_study_interp_opts o;
     int c, store_it = 1;
@@ -108,6 +110,13 @@ int cmd_interp(int argc, char **argv)
         case 'o': o.output = optarg; break;
         case 'n': o.name = optarg; break;
         case 'N': store_it = 0; break;
+        case 'B': {
+            double mu;
+            if (cli_parse_double(optarg, &mu) || !(mu >= 0))
+                return cli_usage_error("interp", "--bending wants a weight >= 0");
+            o.embed.prior_mu = mu;
+            break;
+        }
         case 'R':
             if (cli_parse_i64(optarg, &iters) || iters < 0 || iters > 100000)
                 return cli_usage_error("interp", "--refine-iters wants a count >= 0");

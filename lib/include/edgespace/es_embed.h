@@ -86,10 +86,13 @@ typedef struct es_embed_opts {
     int verbose;              /* 1: one note per iteration to the log callback (0) */
     /* es_embed_prior_solve only (measured on face-study, tools/bench/bench_prior.c): */
     double prior_mu;          /* weight of the bending term relative to the length term at
-                                 the first refinement iteration (default 2e-3); 0: the
-                                 prior only starts and frames the solve */
-    double prior_decay;       /* mu factor per refinement iteration (default 0.8: 2e-3 to
-                                 1.7e-4 over 12 iterations; it never reaches 0 on an open
+                                 the first refinement iteration (default 2.5e-3: on
+                                 face-study's PC +-2 sd points the largest that keeps the
+                                 length RMS under 0.05 % and the smallest that keeps the
+                                 bending under 1.1 x the prior's); 0: the prior only
+                                 starts and frames the solve */
+    double prior_decay;       /* mu factor per refinement iteration (default 0.8: 2.5e-3 to
+                                 2.1e-4 over 12 iterations; it never reaches 0 on an open
                                  mesh, whose flexes the lengths leave free) */
     double prior_sd_floor;    /* each edge's weight is divided by 1 + (sd_e / s0)^2, s0 =
                                  this x the median sd (the rows' disagreement; default 0.7;
@@ -98,6 +101,13 @@ typedef struct es_embed_opts {
                                  than this RMS ratio off the lengths; then the closer of
                                  them and stages 2-3 on the prior's dihedrals (default
                                  0.04) */
+    int prior_exact;          /* 1: the target is one real mesh's lengths (exactly
+                                 realizable): after the run with the bending term, refine
+                                 on (up to 3 x refine_max_iter) with the term held at 4e-4
+                                 of prior_mu, so the lengths decide the last digits
+                                 (default 0: averaged or extrapolated lengths, which only
+                                 crumpling realizes exactly; es_study_embed sets it for a
+                                 point that is one row or one mesh file) */
     int prior_bend_closed;    /* 1: the bending term on closed meshes too (default 0: a
                                  closed mesh is rigid for its lengths, which decide alone
                                  after the prior's start, as es_interp_embed does) */
