@@ -137,7 +137,8 @@ typedef struct es__bend_prior {
     const double *omega;   /* E: per-edge weights >= 0 (0: not in the term) */
     const int64_t *flap;   /* 6E (embedder's flap) */
     double mu;             /* weight of the term now */
-    double decay;          /* mu factor per LM iteration (1: constant) */
+    double decay;          /* mu factor per LM iteration (1: constant) ... */
+    double mu_min;         /* ... down to this weight, where it holds */
 } es__bend_prior;
 
 /* Signed bending angle (es_geom.h convention) of edge (a, b), c the third

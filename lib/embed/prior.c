@@ -172,7 +172,7 @@ es_status es_embed_prior_solve(es_ctx *ctx, es_embedder *emb, const double *targ
     for (int64_t e = 0; e < emb->ne && !open; e++) open = emb->eb[e];
     bend = opts->prior_mu > 0 && (open || opts->prior_bend_closed);
     bp = (es__bend_prior){emb->prior_alpha, emb->omega, emb->flap, opts->prior_mu,
-                          opts->prior_decay};
+                          opts->prior_decay, opts->prior_mu * opts->prior_mu_floor};
     memset(&ext, 0, sizeof ext);
     ext.bp = bend ? &bp : NULL;
     /* a closed mesh without the term: the dihedral path from the prior's

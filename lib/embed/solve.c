@@ -37,6 +37,7 @@ void es_embed_opts_init(es_embed_opts *o)
     /* measured on face-study (tools/bench/bench_prior.c) */
     o->prior_mu = 2.5e-3;
     o->prior_decay = 0.8;
+    o->prior_mu_floor = 0.07;   /* 0.8^12: where 12 iterations end */
     o->prior_sd_floor = 0.7;
     o->prior_start_max_rms = 0.04;
     o->prior_exact = 0;
@@ -293,7 +294,7 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
          * all 0.178 % on faces that were at 0.11 %) */
         if (bp && o->prior_exact && o->refine_max_iter > 0) {
             es__bend_prior hold = *bp;
-            hold.mu = 4e-4 * o->prior_mu;
+            hold.mu = hold.mu_min = 4e-4 * o->prior_mu;
             hold.decay = 1;
             if ((rc = es__stage_refine(emb, L, xyz, &hold, 3 * o->refine_max_iter,
                                        o->refine_rtol, o->refine_tol, o->verbose,

@@ -49,20 +49,22 @@ es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz,
     int64_t nv = emb->nv, n3 = 3 * nv, ne = emb->ne;
     double *x = emb->H3->x, *g = emb->grad, *dg = emb->diag, *step = emb->pcg + 4 * n3;
     double *hd = step + n3, lambda = 1e-4, c, ctol = tol * tol * (double)ne;
-    int have_factor = 0;
-    /* mu decays within the run (bp->decay < 1): the cost changes from one
-     * iteration to the next, so it is evaluated afresh and the relative
-     * stopping rule waits for the iterations to end */
-    const int annealing = bp && bp->decay > 0 && bp->decay < 1;
+    int have_factor = 0, it_hold = 0;
+    /* mu decays within the run (bp->decay < 1) down to bp->mu_min: while it
+     * does, the cost changes from one iteration to the next, so it is
+     * evaluated afresh and the relative stopping rule waits */
+    int annealing = bp && bp->decay > 0 && bp->decay < 1 && bp->mu > bp->mu_min;
     if (bp && !(bp->mu > 0)) bp = NULL;
     c = refine_cost(emb, xyz, L, bp);
     for (int it = 0; it < max_iter && c > ctol; it++) {
         double c_new = c, mean = 0, pred, rho = 0;
         int accepted = 0, st, used = -1;
         if (bp && annealing && it > 0) {
-            bp->mu *= bp->decay;
+            bp->mu = fmax(bp->mu * bp->decay, bp->mu_min);
+            annealing = bp->mu > bp->mu_min;
             c = refine_cost(emb, xyz, L, bp);
             c_prev = 0;
+            if (!annealing) it_hold = it;   /* the stopping rule counts from here */
         }
         memset(x, 0, emb->H3->nzmax * sizeof(double));
         memset(g, 0, (size_t)n3 * sizeof(double));
@@ -195,7 +197,8 @@ es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz,
          * failure D: an absolute rule stops too early or too late) */
         hist[it % 4] = c_new;
         c_prev = c;
-        if (it >= 3 && !annealing && hist[(it - 3) % 4] - c_new < 3.0 * rtol * c_new) {
+        if (it >= it_hold + 3 && !annealing &&
+            hist[(it - 3) % 4] - c_new < 3.0 * rtol * c_new) {
             c = c_new;
             break;
         }

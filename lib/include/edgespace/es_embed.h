@@ -91,9 +91,13 @@ typedef struct es_embed_opts {
                                  length RMS under 0.05 % and the smallest that keeps the
                                  bending under 1.1 x the prior's); 0: the prior only
                                  starts and frames the solve */
-    double prior_decay;       /* mu factor per refinement iteration (default 0.8: 2.5e-3 to
-                                 2.1e-4 over 12 iterations; it never reaches 0 on an open
-                                 mesh, whose flexes the lengths leave free) */
+    double prior_decay;       /* mu factor per refinement iteration (default 0.8) ... */
+    double prior_mu_floor;    /* ... down to this fraction of prior_mu, where it holds
+                                 (default 0.07 = 0.8^12: 2.5e-3 to 1.7e-4 over the default
+                                 12 iterations, then constant, however many follow): it
+                                 never reaches 0 on an open mesh, whose flexes the lengths
+                                 leave free and whose averaged noisy lengths only crumpling
+                                 realizes exactly */
     double prior_sd_floor;    /* each edge's weight is divided by 1 + (sd_e / s0)^2, s0 =
                                  this x the median sd (the rows' disagreement; default 0.7;
                                  0: sd ignored) */
@@ -240,7 +244,7 @@ ES_API es_status es_kabsch_align_parts(es_ctx *ctx, int64_t nverts, double *xyz,
  * mesh it starts from xyz scaled to the target's length sum and refines
  *   F(x) = sum_e ((|x_a - x_b| - l_e) / l_e)^2
  *        + mu_k sum_e omega_e wrap(alpha_e(x) - alpha_e)^2,
- *   mu_k = prior_mu prior_decay^k at refinement iteration k,
+ *   mu_k = prior_mu max(prior_decay^k, prior_mu_floor) at iteration k,
  *   omega_e = [3 l_e^2 / (A_f + A_g)] / mean(...) / (1 + (sd_e / s0)^2),
  * the discrete-shells bending weight (Grinspun et al. 2003) over interior
  * edges, the bending angle of es_geom.h. On a closed mesh (rigid for its
