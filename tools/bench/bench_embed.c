@@ -4,8 +4,10 @@
  * energy beside each time. Three cases per mesh: the midpoint t = 0.5 of a
  * real pair (es_interp_embed: the hard, inconsistent case), the same
  * midpoint through the published method's stages only (stage 1 always, no
- * refinement; a comparison in the same run), and the round trip of one
- * shape's own lengths and dihedrals (consistent input).
+ * refinement; a comparison in the same run), the same midpoint near the
+ * prior of the two shapes (es_embed_prior_solve, what `edgespace embed`
+ * and `interp` do; its CPU time over es_interp_embed's is printed), and the
+ * round trip of one shape's own lengths and dihedrals (consistent input).
  * Wall and process CPU time are printed: on a shared machine the wall time
  * includes waiting for a core.
  *
@@ -127,6 +129,32 @@ static void run(es_ctx *ctx, const char *dir, const char *a, const char *b, int 
         if (es_interp_embed(ctx, emb, 2, in, w, NULL, NULL, out, &r, NULL)) goto fail;
         print_row(dir, "midpoint t=0.5", nv, bench_wall_s() - w0, bench_process_cpu_s() - c0,
                   tw_new, &r, 0);
+        double cpu_interp = bench_process_cpu_s() - c0;
+        /* the same midpoint near the prior of the two shapes (b aligned onto
+         * a, their dihedrals): the study's path */
+        {
+            double *bb = malloc(3 * (size_t)nv * sizeof *bb), rms;
+            double *prior = malloc((3 * (size_t)nv + 2 * (size_t)ne) * sizeof *prior);
+            double *a2 = malloc(2 * (size_t)ne * sizeof *a2);
+            memcpy(bb, xyz + 3 * nv, 3 * (size_t)nv * sizeof *bb);
+            es_kabsch_align(ctx, nv, bb, xyz, NULL, &rms);
+            es_dihedral_angles(ctx, mesh, xyz, a2);
+            es_dihedral_angles(ctx, mesh, bb, a2 + ne);
+            const double *rows[2] = {xyz, bb}, *alr[2] = {a2, a2 + ne};
+            es_embed_prior pr = {prior, prior + 3 * nv, prior + 3 * nv + ne};
+            es_embed_prior_from_rows(ctx, nv, ne, 2, rows, alr, w, prior, prior + 3 * nv,
+                                     prior + 3 * nv + ne);
+            es_interp_targets(ctx, mesh, 2, in, w, len, NULL, NULL);
+            w0 = bench_wall_s();
+            c0 = bench_process_cpu_s();
+            if (es_embed_prior_solve(ctx, emb, len, 0, &pr, NULL, out, &r)) goto fail;
+            double cpu_prior = bench_process_cpu_s() - c0;
+            print_row(dir, "prior t=0.5", nv, bench_wall_s() - w0, cpu_prior, tw_new, &r, 0);
+            printf("%-22s %-19s %7lld  prior / interp CPU %.2f; bending %.3f x the prior's, "
+                   "%.3g %% bbox from it\n", dir, "  ratio", (long long)nv, cpu_prior / cpu_interp,
+                   r.bend_ratio, 100 * r.prior_rms);
+            free(bb), free(prior), free(a2);
+        }
         /* the published method's stages on the same midpoint, in the same
          * run: stage 1 always (LM here, not the paper's L-BFGS), no refinement */
         es_embed_opts_init(&paper);
