@@ -52,10 +52,12 @@ void *es__alloc_array(es_ctx *ctx, int64_t n, size_t size);
  * begin opens a part file beside path (through a symlink, beside its target;
  * with the old file's mode); write to w.f; end closes it and renames it over
  * the file if rc is ES_OK and the writes succeeded, else removes it. end
- * returns rc or the write error. */
+ * returns rc or the write error. A FIFO or character device at path (a pipe,
+ * /dev/null, /dev/full) is written in place, never replaced by a file; a
+ * directory, block device or socket is refused (ES_EIO). */
 typedef struct es__file_replace {
     FILE *f;
-    char *tmp;          /* the part file */
+    char *tmp;          /* the part file (NULL when written in place) */
     char *target;       /* the symlink's resolution, or NULL */
     const char *path;   /* as given (for messages) */
 } es__file_replace;
