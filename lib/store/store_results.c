@@ -60,6 +60,31 @@ static void full_path(char *buf, size_t n, const char *rel)
     snprintf(buf, n, "/analysis/%s", rel);
 }
 
+/* The name must be free unless the handle replaces results. */
+static es_status check_free(es_ctx *ctx, es_store *s, const char *kind, const char *name,
+                            bool *exists)
+{
+    char full[600];
+    if (es__h5_bad_name(kind) || es__h5_bad_name(name) || strlen(kind) > 120 || strlen(name) > 120)
+        ES_FAIL(ctx, ES_EINVAL, "store: bad result kind/name '%s/%s'", kind ? kind : "",
+                name ? name : "");
+    snprintf(full, sizeof full, "/analysis/%s/%s", kind, name);
+    *exists = link_exists(s->file, full);
+    if (*exists && s->mode != ES_STORE_REPLACE)
+        ES_FAIL(ctx, ES_EEXIST, "store: result %s/%s exists already in '%s' (give another name, "
+                "or --replace to replace it)", kind, name, s->path);
+    return ES_OK;
+}
+
+es_status es_store_result_check(es_ctx *ctx, es_store *s, const char *kind, const char *name)
+{
+    es_status rc;
+    bool exists;
+    if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    H5E_BEGIN_TRY { rc = check_free(ctx, s, kind, name, &exists); } H5E_END_TRY
+    return rc;
+}
+
 static es_status result_begin_impl(es_ctx *ctx, es_store *s, const char *kind, const char *name,
                                    const es_provenance *prov)
 {
@@ -69,9 +94,8 @@ static es_status result_begin_impl(es_ctx *ctx, es_store *s, const char *kind, c
     time_t now = time(NULL);
     struct tm tmv;
     int64_t *all = NULL;
-    if (es__h5_bad_name(kind) || es__h5_bad_name(name) || strlen(kind) > 120 || strlen(name) > 120)
-        ES_FAIL(ctx, ES_EINVAL, "store: bad result kind/name '%s/%s'", kind ? kind : "",
-                name ? name : "");
+    bool exists;
+    if ((rc = check_free(ctx, s, kind, name, &exists))) return rc;
     if (!prov || !prov->command) ES_FAIL(ctx, ES_EINVAL, "store: a result needs provenance");
     if (prov->rows)
         for (int64_t i = 0; i < prov->nrows; i++)
@@ -80,7 +104,7 @@ static es_status result_begin_impl(es_ctx *ctx, es_store *s, const char *kind, c
                         (long long)prov->rows[i]);
     if ((rc = es__store_begin_write(s))) return rc;
     snprintf(full, sizeof full, "/analysis/%s/%s", kind, name);
-    if (link_exists(s->file, full) && H5Ldelete(s->file, full, H5P_DEFAULT) < 0) {
+    if (exists && H5Ldelete(s->file, full, H5P_DEFAULT) < 0) {
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot replace %s", full);
         goto fail;
     }
@@ -310,27 +334,41 @@ static es_status get_impl(es_ctx *ctx, es_store *s, const char *path, int rank, 
                           size_t elem, void **data, int64_t *d0, int64_t *d1)
 {
     hsize_t dims[2] = {0, 1};
-    hid_t ds = -1;
+    hid_t ds = -1, t = -1;
     int64_t total;
+    uint64_t need;
     es_status rc = get_open(ctx, s, path, rank, dims, &ds);
     *data = NULL;
     if (rc) return rc;
-    if (!es__mul_i64((int64_t)dims[0], (int64_t)dims[1], &total)) {
-        H5Dclose(ds);
-        ES_FAIL(ctx, ES_ERANGE, "store: %s is too large", path);
+    /* a number dataset whose storage holds all of it: a crafted dataspace
+     * must not size an allocation the file cannot fill */
+    if ((t = H5Dget_type(ds)) < 0 ||
+        (H5Tget_class(t) != H5T_FLOAT && H5Tget_class(t) != H5T_INTEGER)) {
+        rc = es__fail(ctx, ES_EFORMAT, "store: '%s': /analysis/%s is not numbers", s->path, path);
+        goto done;
+    }
+    if (!es__mul_i64((int64_t)dims[0], (int64_t)dims[1], &total) || total < 0 ||
+        __builtin_mul_overflow((uint64_t)total, (uint64_t)H5Tget_size(t), &need) ||
+        es__h5_covered_bytes(ds, rank, H5Tget_size(t)) < need) {
+        rc = es__fail(ctx, ES_EFORMAT, "store: '%s' is corrupt: /analysis/%s claims more values "
+                      "than the file holds", s->path, path);
+        goto done;
     }
     if (!(*data = es__alloc_array(ctx, total ? total : 1, elem))) {
-        H5Dclose(ds);
-        return ES_ENOMEM;
+        rc = ES_ENOMEM;
+        goto done;
     }
     if (total > 0 && H5Dread(ds, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, *data) < 0) {
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot read %s", path);
         es__free(ctx, *data);
         *data = NULL;
+        goto done;
     }
-    H5Dclose(ds);
     *d0 = (int64_t)dims[0];
     if (d1) *d1 = (int64_t)dims[1];
+done:
+    es__h5_close(t);
+    H5Dclose(ds);
     return rc;
 }
 
@@ -392,7 +430,12 @@ static es_status get_attr_impl(es_ctx *ctx, es_store *s, const char *path, const
         H5Oclose(obj);
         ES_FAIL(ctx, ES_ENOTFOUND, "store: %s has no attribute '%s'", full, key);
     }
-    rc = es__h5_read_attr_text(ctx, obj, key, buf, n);
+    {
+        es__h5_raw *raw = NULL;
+        if ((rc = es__h5_raw_open(ctx, obj, s->path, &raw)) == ES_OK)
+            rc = es__h5_read_attr_text(ctx, raw, obj, key, buf, n);
+        es__h5_raw_close(raw);
+    }
     H5Oclose(obj);
     return rc;
 }
