@@ -178,8 +178,11 @@ static es_status parse_rows(es_ctx *ctx, es_store *s, const es_study_interp_opts
         } else {
             id = (k ? o->to : o->from) + 4;
         }
-        if (rc == ES_OK && (in->rows[k] = es_store_find_row(s, id)) < 0)
-            rc = es__fail(ctx, ES_ENOTFOUND, "no row '%s' in the store", id);
+        if (rc == ES_OK && (in->rows[k] = es_store_find_row(s, id)) < 0) {
+            char hint[400];
+            es_store_value_hint(s, -1, id, hint, sizeof hint);
+            rc = es__fail(ctx, ES_ENOTFOUND, "no row '%s' in the store%s", id, hint);
+        }
     }
     if (rc == ES_OK && n < 2)
         rc = es__fail(ctx, ES_EINVAL, "--weights wants two or more rows");
@@ -352,6 +355,13 @@ es_status es_study_interp(es_ctx *ctx, es_store *store, const es_study_interp_op
                 "integer conversion, like 'out_%%02d.obj'");
     if (o->name) snprintf(wk.name, sizeof wk.name, "%s", o->name);
     else default_name(o->output, wk.name, sizeof wk.name);
+    /* every frame's result name is free (or replaced) before a frame is written */
+    for (int64_t i = 0; o->command && i < (o->weights ? 1 : o->steps); i++) {
+        char rn[300];
+        if (!o->weights && o->steps > 1) snprintf(rn, sizeof rn, "%s_%02lld", wk.name, (long long)i);
+        else snprintf(rn, sizeof rn, "%s", wk.name);
+        if ((rc = es_store_result_check(ctx, store, "embed", rn)) != ES_OK) return rc;
+    }
     if ((rc = es_store_mesh(ctx, store, &mesh)) != ES_OK) return rc;
     wk.mesh = mesh;
     if (!(res = es__alloc_array(ctx, 3 * es_mesh_nverts(mesh), sizeof *res))) rc = ES_ENOMEM;
