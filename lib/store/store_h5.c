@@ -298,16 +298,18 @@ done:
 
 uint64_t es__h5_covered_bytes(hid_t ds, int rank, uint64_t elem)
 {
-    hid_t dcpl = H5Dget_create_plist(ds);
+    hid_t dcpl = H5Dget_create_plist(ds), sp = H5Dget_space(ds);
     hsize_t cd[3] = {1, 1, 1}, nchunks = 0;
     uint64_t have = H5Dget_storage_size(ds), per = elem;
+    /* (1.10.8's H5Dget_num_chunks refuses H5S_ALL: the dataset's space) */
     if (dcpl >= 0 && H5Pget_nfilters(dcpl) > 0 && H5Pget_layout(dcpl) == H5D_CHUNKED &&
-        rank >= 1 && rank <= 3 && H5Pget_chunk(dcpl, rank, cd) == rank &&
-        H5Dget_num_chunks(ds, H5S_ALL, &nchunks) >= 0) {
+        rank >= 1 && rank <= 3 && H5Pget_chunk(dcpl, rank, cd) == rank && sp >= 0 &&
+        H5Dget_num_chunks(ds, sp, &nchunks) >= 0) {
         for (int k = 0; k < rank; k++)
             if (__builtin_mul_overflow(per, (uint64_t)cd[k], &per)) per = UINT64_MAX;
         if (__builtin_mul_overflow(per, (uint64_t)nchunks, &have)) have = UINT64_MAX;
     }
+    es__h5_close(sp);
     es__h5_close(dcpl);
     return have;
 }

@@ -170,7 +170,7 @@ static es_status parse_gcol(es__h5_raw *r, gcol *g)
         else need = len > g->size ? UINT64_MAX : objhdr + align8(len);
         if (need < objhdr || need > g->size - p)
             ES_FAIL(r->ctx, ES_EFORMAT, "store: '%s' is corrupt: object %u of the global heap "
-                    "collection at %llu has size %llu, past the collection's %llu bytes",
+                    "collection at %llu has size %llu, which does not fit its %llu bytes",
                     r->path, idx, (unsigned long long)g->addr, (unsigned long long)len,
                     (unsigned long long)g->size);
         if (idx > 0) {
