@@ -20,15 +20,21 @@
 
 #define CACHE_BYTES (16u << 20)
 
-/* HDF5's description of the cause, on one line: a crafted file can make
- * it quote anything, and a message is one line of text. */
+/* HDF5's description of the cause. */
 static herr_t walk_cb(unsigned n, const H5E_error2_t *err, void *data)
 {
     char *buf = data;
-    if (n == 0 && err->desc) {
-        snprintf(buf, 200, "%s", err->desc);
-        for (char *p = buf; *p; p++)
-            if ((unsigned char)*p < 0x20 || *p == 0x7f) *p = ' ';
+    const char *en;
+    if (n != 0 || !err->desc) return 0;
+    /* the file drivers' "file write failed: time = ..., filename = ...,
+     * file descriptor = 5, errno = 28, error message = ..." says, to a
+     * user, what failed and the system's reason */
+    if ((en = strstr(err->desc, "errno = ")) && strchr(err->desc, ':')) {
+        int e = atoi(en + 8);
+        snprintf(buf, 200, "%.*s: %s", (int)(strchr(err->desc, ':') - err->desc), err->desc,
+                 strerror(e));
+    } else {
+        snprintf(buf, 200, "%s", err->desc);   /* es__fail keeps it on one line */
     }
     return 0;
 }
