@@ -38,4 +38,18 @@ extern const int crafted_nmutations;
  * refused to write it (the variant cannot be made). */
 int crafted_apply(const char *path, int k, uint32_t param);
 
+/* 1 if a failure message is one line a user can act on: non-empty, no
+ * newline, no HDF5 error-stack text or internal function names. */
+int crafted_message_ok(const char *msg);
+
+/* Read everything a command might from an open store (es_edgespace.h is
+ * included by the caller): lengths, scales, positions, faces, edges, the
+ * mesh, a selection, the base's result datasets and attributes, the list
+ * of results, every label. Each call may fail, but only with a clean
+ * message: returns 0, or -1 at the first failure whose message is not
+ * crafted_message_ok (the context holds it). */
+struct es_ctx;
+struct es_store;
+int crafted_read_all(struct es_ctx *ctx, struct es_store *s);
+
 #endif
