@@ -36,6 +36,11 @@ es_status es__fail(es_ctx *ctx, es_status code, const char *fmt, ...) ES__PRINTF
 void es__warn(es_ctx *ctx, const char *fmt, ...) ES__PRINTF(2, 3);
 void es__info(es_ctx *ctx, const char *fmt, ...) ES__PRINTF(2, 3);
 
+/* The context's log callback, so that a caller can put another in its place
+ * for a while (ingest collects its threads' warnings to replay them in
+ * input order) and restore it. */
+void es__ctx_get_log(const es_ctx *ctx, es_log_fn *fn, void **userdata);
+
 /* Progress callback (no-op without one). */
 void es__progress(es_ctx *ctx, const char *what, int64_t done, int64_t total);
 

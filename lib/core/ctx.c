@@ -64,6 +64,12 @@ void es_ctx_free(es_ctx *ctx) { free(ctx); }
 const char *es_ctx_errmsg(const es_ctx *ctx) { return ctx ? ctx->errmsg : ""; }
 void es_ctx_clear_error(es_ctx *ctx) { ctx->errmsg[0] = '\0'; }
 
+void es__ctx_get_log(const es_ctx *ctx, es_log_fn *fn, void **userdata)
+{
+    *fn = ctx ? ctx->log_fn : NULL;
+    *userdata = ctx ? ctx->log_ud : NULL;
+}
+
 void es_ctx_set_log(es_ctx *ctx, es_log_fn fn, void *userdata)
 {
     ctx->log_fn = fn;

@@ -381,9 +381,15 @@ static es_status run_phase1(es_ctx *ctx, job *j, int64_t first)
     pthread_t tid[16];
     bool started[16] = {false};
     es_status rc = ES_OK;
+    es_log_fn user_log;
+    void *user_ud;
     atomic_store(&j->next, first);
     atomic_store(&j->done, first);
     memset(w, 0, sizeof w);
+    /* the caller's thread collects its warnings too, so that all of them
+     * come back in input order (its own used to come first) */
+    es__ctx_get_log(ctx, &user_log, &user_ud);
+    es_ctx_set_log(ctx, on_worker_log, &w[0]);
     for (int64_t t = 0; t < nt; t++) {
         w[t].j = j;
         w[t].main = t == 0;
@@ -405,6 +411,7 @@ static es_status run_phase1(es_ctx *ctx, job *j, int64_t first)
         pthread_join(tid[t], NULL);
         es_ctx_free(w[t].ctx);
     }
+    es_ctx_set_log(ctx, user_log, user_ud);
     if (j->err_index < j->n) rc = es__fail(ctx, j->err_rc, "%s", j->err_msg);
     return rc;
 }
