@@ -14,7 +14,8 @@
  *     at moments spread over a run and the moment its working copy appears:
  *     the store is unchanged or complete, never between;
  *   - export to a device (/dev/full) fails with the device's error and
- *     leaves the node a device; a directory is refused. */
+ *     leaves the node a device; a directory is refused;
+ *   - a misspelt label column, value or row id names the closest ones. */
 #include "edgespace/edgespace.h"
 #include "es_test.h"
 #include "es_test_files.h"
@@ -325,6 +326,36 @@ static void test_devices(void)
     }
 }
 
+/* A misspelt label column, value or row id names the closest ones. */
+static void test_misspelt(void)
+{
+    char err[4096];
+    static const struct { const char *args[12], *want; } cases[] = {
+        {{"mean", NULL, "--by", "gpr", "--no-store"}, "no label column 'gpr' (did you mean 'grp'?)"},
+        {{"mean", NULL, "--where", "subjcet=s1", "--no-store"},
+         "no label column 'subjcet' in"},
+        {{"mean", NULL, "--where", "grp=aa", "--no-store"}, "no row has grp='aa' (did you mean "
+         "'a' or 'b'?)"},
+        {{"diff", NULL, "--pair-by", "subject", "--column", "grp", "--from", "a", "--to", "c"},
+         "no rows with grp=c (did you mean 'a' or 'b'?)"},
+        {{"diff", NULL, "--pair-by", "subjects", "--column", "grp", "--from", "a", "--to", "b"},
+         "no label column 'subjects' (did you mean 'subject'?)"},
+        {{"point", NULL, "row:m3"}, "no row with id 'm3' (did you mean 'm03'"},
+        {{"embed", NULL, "--point", "row:m03", "--init", "row:mo3", "--no-store", "-o", "x.obj"},
+         "no row 'mo3' in the store (did you mean 'm03'"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        const char *args[14];
+        int n = 0;
+        for (; n < 12 && (n < 2 || cases[i].args[n]); n++)
+            args[n] = n == 1 ? store : cases[i].args[n];
+        args[n] = NULL;
+        int st = run(args, 0, err, sizeof err);
+        ES_CHECK_MSG(st == 1 && strstr(err, cases[i].want), "%s: %d %s", cases[i].args[0], st,
+                     err);
+    }
+}
+
 int main(void)
 {
     es_ctx *ctx = NULL;
@@ -360,6 +391,7 @@ int main(void)
     test_full_disk(base, nbase, manifest);
     test_kills(ctx, base, nbase);
     test_devices();
+    test_misspelt();
     free(base);
     es_ctx_free(ctx);
     ES_TEST_END();
