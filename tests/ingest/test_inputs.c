@@ -14,19 +14,12 @@
 #include "edgespace/edgespace.h"
 #include "es_test.h"
 #include "es_test_files.h"
+#include "es_test_run.h"
 
 #include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
 
 static const char *dir;
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static void write_bytes(const char *path, const char *b, size_t n)
 {
@@ -93,10 +86,10 @@ static void test_fifo_in_manifest(es_ctx *ctx)
     }
     es_test_write_file(in_dir("fifo.csv", m, sizeof m), "file\npipe.obj\n");
     in_dir("fifo.h5", store, sizeof store);
-    double t = now();
+    double t = es_test_now();
     ES_CHECK_FAILS(ctx, es_ingest_manifest(ctx, store, m, NULL, &rep), ES_EIO,
                    "pipe.obj' is not a regular file");
-    ES_CHECK(now() - t < 5 && access(store, F_OK) != 0);
+    ES_CHECK(es_test_now() - t < 5 && access(store, F_OK) != 0);
     remove(p);
 }
 
@@ -175,9 +168,9 @@ static double ingest_copies(es_ctx *ctx, int n)
     }
     fclose(f);
     es_ctx_set_log(ctx, keep, &w);
-    double t = now();
+    double t = es_test_now();
     ES_CHECK_OK(ctx, es_ingest_manifest(ctx, store, m, NULL, &rep));
-    t = now() - t;
+    t = es_test_now() - t;
     es_ctx_set_log(ctx, NULL, NULL);
     ES_CHECK(rep.rows_added == n);
     int64_t same = 0, flat = 0, last = -1, ordered = 1;

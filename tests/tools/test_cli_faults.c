@@ -25,25 +25,11 @@
 #include <errno.h>
 #include <sys/mount.h>
 #include <sys/resource.h>
-#include <time.h>
 
 enum { NMESH = 12, NU = 40, NV = 40 };
 
 static const char *dir;
 static char store[4200], o[4300], e[4300];
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static void sleep_s(double s)
-{
-    struct timespec ts = {(time_t)s, (long)((s - (double)(time_t)s) * 1e9)};
-    while (nanosleep(&ts, &ts) != 0) {}
-}
 
 static void put_bytes(const char *path, const char *b, size_t n)
 {
@@ -52,8 +38,8 @@ static void put_bytes(const char *path, const char *b, size_t n)
     if (f) fclose(f);
 }
 
-/* Start `edgespace args...`; with fsize > 0, every write past fsize bytes
- * of a file fails (EFBIG; SIGXFSZ ignored, so it is an error, not a kill). */
+/* Start `edgespace args...` (argv[0] added), writes limited to fsize bytes
+ * (0: no limit). */
 static pid_t spawn(const char *const *args, rlim_t fsize)
 {
     const char *argv[32];
@@ -61,22 +47,7 @@ static pid_t spawn(const char *const *args, rlim_t fsize)
     argv[n++] = es_test_edgespace();
     for (; args[n - 1] && n < 31; n++) argv[n] = args[n - 1];
     argv[n] = NULL;
-    pid_t pid = fork();
-    if (pid == 0) {
-        int fo = open(o, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        int fe = open(e, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (fo < 0 || fe < 0) _exit(126);
-        dup2(fo, 1);
-        dup2(fe, 2);
-        if (fsize > 0) {
-            struct rlimit rl = {fsize, fsize};
-            signal(SIGXFSZ, SIG_IGN);
-            setrlimit(RLIMIT_FSIZE, &rl);
-        }
-        execv(es_test_edgespace(), (char *const *)argv);
-        _exit(127);
-    }
-    return pid;
+    return es_test_spawn_limited(argv, o, e, (unsigned long long)fsize);
 }
 
 static int run(const char *const *args, rlim_t fsize, char *err, size_t n)
@@ -253,9 +224,9 @@ static void test_kills(es_ctx *ctx, const char *base, size_t nbase)
         }
         size_t nb0;
         char *b0 = es_test_slurp(store, &nb0);
-        double T = now();
+        double T = es_test_now();
         ES_CHECK(es_test_wait(spawn(args, 0)) == 0);
-        T = now() - T;
+        T = es_test_now() - T;
         static const double at[] = {0.1, 0.3, 0.5, 0.7, 0.85, 0.95, 1.0, -1, -2, -3};
         for (size_t k = 0; k < sizeof at / sizeof at[0] && b0; k++) {
             put_bytes(store, b0, nb0);
@@ -263,13 +234,13 @@ static void test_kills(es_ctx *ctx, const char *base, size_t nbase)
             char mine[64];
             snprintf(mine, sizeof mine, ".tmp-%ld-", (long)pid);
             if (at[k] >= 0) {
-                sleep_s(at[k] * T);
+                es_test_sleep(at[k] * T);
             } else {
                 /* the moment its working copy appears, then a little later */
-                double t0 = now();
-                while (es_test_count_entries(dir, mine) == 0 && now() - t0 < 2 * T + 5)
-                    sleep_s(0.0002);
-                if (at[k] < -1) sleep_s(at[k] == -2 ? 0.002 : 0.02);
+                double t0 = es_test_now();
+                while (es_test_count_entries(dir, mine) == 0 && es_test_now() - t0 < 2 * T + 5)
+                    es_test_sleep(0.0002);
+                if (at[k] < -1) es_test_sleep(at[k] == -2 ? 0.002 : 0.02);
             }
             kill(pid, SIGKILL);
             int st = es_test_wait(pid);
