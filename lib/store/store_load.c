@@ -309,6 +309,22 @@ static es_status check_shapes(es_store *s, es__h5_raw *raw, int64_t *n)
     return ES_OK;
 }
 
+/* The groups every open looks names up in: the root, then each of the
+ * store's groups, each checked before HDF5 searches it (store_groups.c). */
+static es_status check_groups(es_store *s, es__h5_raw *raw)
+{
+    static const char *const names[] = {"/topology", "/shapes", "/labels", "/analysis"};
+    es_status rc = es__h5_check_group(raw, s->file, "/");
+    for (size_t i = 0; rc == ES_OK && i < sizeof names / sizeof names[0]; i++) {
+        hid_t g;
+        if (H5Lexists(s->file, names[i], H5P_DEFAULT) <= 0) continue;   /* said later */
+        if ((g = H5Gopen2(s->file, names[i], H5P_DEFAULT)) < 0) continue;
+        rc = es__h5_check_group(raw, g, names[i]);
+        H5Gclose(g);
+    }
+    return rc;
+}
+
 es_status es__store_load(es_store *s)
 {
     es_ctx *ctx = s->ctx;
@@ -318,7 +334,7 @@ es_status es__store_load(es_store *s)
     hid_t g;
     char fp[64];
     if ((rc = es__h5_raw_open(ctx, s->file, s->path, &raw))) return rc;
-    if ((rc = load_kind(s, raw))) goto done;
+    if ((rc = check_groups(s, raw)) || (rc = load_kind(s, raw))) goto done;
     if ((g = H5Gopen2(s->file, "/topology", H5P_DEFAULT)) < 0) {
         rc = es__h5_fail(ctx, ES_EFORMAT, "store: '%s' has no /topology", s->path);
         goto done;

@@ -115,6 +115,29 @@ es_status es__h5_read_strings(es_ctx *ctx, es__h5_raw *raw, hid_t loc, const cha
  * strings, each and the array allocated through ctx. */
 es_status es__h5_read_attr_strings(es_ctx *ctx, es__h5_raw *raw, hid_t obj, const char *key,
                                    char ***out, int64_t *n);
+/* Raw access for the structure checks (store_groups.c): n bytes at a file
+ * address, bounded by the file; little-endian numbers; the sizes of
+ * addresses and lengths. */
+es_status es__h5_raw_read(es__h5_raw *raw, uint64_t addr, uint64_t n, void *buf,
+                          const char *what);
+uint64_t es__h5_le(const uint8_t *p, unsigned n);
+unsigned es__h5_raw_addr_size(const es__h5_raw *raw);
+unsigned es__h5_raw_length_size(const es__h5_raw *raw);
+es_ctx *es__h5_raw_ctx(const es__h5_raw *raw);
+const char *es__h5_raw_path(const es__h5_raw *raw);
+/* Each message of an object header: return 0 to go on, 1 to stop (ES_OK),
+ * -1 if it is malformed (ES_EFORMAT). ES_ENOTFOUND when no call stopped. */
+typedef int (*es__h5_msg_fn)(void *ud, unsigned type, const uint8_t *msg, uint64_t n);
+es_status es__h5_raw_messages(es__h5_raw *raw, uint64_t oaddr, es__h5_msg_fn fn, void *ud);
+/* The object header address of an open object (group, dataset, file: its
+ * root group). */
+es_status es__h5_object_addr(es_ctx *ctx, hid_t obj, uint64_t *addr);
+/* Check the symbol table of an old-style group (its v1 B-tree, symbol
+ * nodes and local heap; store_groups.c) before HDF5 looks anything up in
+ * it: libhdf5 1.10 follows a local heap free list that loops until memory
+ * runs out (24 GB for three changed bytes) and B-tree children without
+ * bound. A group with links in its header (new style) has nothing to check. */
+es_status es__h5_check_group(es__h5_raw *raw, hid_t group, const char *name);
 /* A string attribute, or one integer or real as text, into buf[n],
  * truncated; ES_ENOTFOUND if absent. */
 es_status es__h5_read_attr_text(es_ctx *ctx, es__h5_raw *raw, hid_t obj, const char *key,

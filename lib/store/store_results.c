@@ -38,21 +38,41 @@ static int split_path(es_ctx *ctx, const char *path, char parts[8][128], es_stat
     return n;
 }
 
-static bool link_exists(hid_t file, const char *full)
+/* Whether every component of full exists. Each group below /analysis is
+ * checked (store_groups.c) before HDF5 looks the next name up in it: a
+ * result's groups come from the file like everything else. ES_OK with
+ * *exists, or the check's refusal. */
+static es_status find_link(es_ctx *ctx, es_store *s, const char *full, bool *exists)
 {
     char buf[1200];
     size_t n = strlen(full);
-    if (n >= sizeof buf) return false;
+    int depth = 0;
+    es__h5_raw *raw = NULL;
+    es_status rc = ES_OK;
+    *exists = false;
+    if (n >= sizeof buf) return ES_OK;
     memcpy(buf, full, n + 1);
-    for (char *p = buf + 1;; p++) {
-        if (*p == '/' || *p == '\0') {
-            char save = *p;
-            *p = '\0';
-            if (H5Lexists(file, buf, H5P_DEFAULT) <= 0) return false;
-            if (!save) return true;
-            *p = save;
+    for (char *p = buf + 1; rc == ES_OK; p++) {
+        if (*p != '/' && *p != '\0') continue;
+        char save = *p;
+        *p = '\0';
+        if (H5Lexists(s->file, buf, H5P_DEFAULT) <= 0) break;
+        if (!save) {
+            *exists = true;
+            break;
         }
+        if (++depth >= 2) {   /* /analysis itself was checked at open */
+            hid_t g = H5Gopen2(s->file, buf, H5P_DEFAULT);
+            if (g >= 0) {
+                if (raw || (rc = es__h5_raw_open(ctx, g, s->path, &raw)) == ES_OK)
+                    rc = es__h5_check_group(raw, g, buf);
+                H5Gclose(g);
+            }
+        }
+        *p = save;
     }
+    es__h5_raw_close(raw);
+    return rc;
 }
 
 static void full_path(char *buf, size_t n, const char *rel)
@@ -69,7 +89,8 @@ static es_status check_free(es_ctx *ctx, es_store *s, const char *kind, const ch
         ES_FAIL(ctx, ES_EINVAL, "store: bad result kind/name '%s/%s'", kind ? kind : "",
                 name ? name : "");
     snprintf(full, sizeof full, "/analysis/%s/%s", kind, name);
-    *exists = link_exists(s->file, full);
+    es_status rc;
+    if ((rc = find_link(ctx, s, full, exists))) return rc;
     if (*exists && s->mode != ES_STORE_REPLACE)
         ES_FAIL(ctx, ES_EEXIST, "store: result %s/%s exists already in '%s' (give another name, "
                 "or --replace to replace it)", kind, name, s->path);
@@ -171,16 +192,19 @@ static es_status put_prepare(es_ctx *ctx, es_store *s, const char *path, char *f
 {
     char parts[8][128], group[600];
     es_status rc;
+    bool e;
     int np = split_path(ctx, path, parts, &rc);
     if (np < 0) return rc;
     if (np < 3) ES_FAIL(ctx, ES_EINVAL, "store: '%s' is not kind/name/dataset", path);
     if ((rc = es__store_begin_write(s))) return rc;
     snprintf(group, sizeof group, "/analysis/%s/%s", parts[0], parts[1]);
-    if (!link_exists(s->file, group))
+    if ((rc = find_link(ctx, s, group, &e))) return rc;
+    if (!e)
         ES_FAIL(ctx, ES_ENOTFOUND, "store: result %s/%s was not begun "
                 "(es_store_result_begin)", parts[0], parts[1]);
     full_path(full, n, path);
-    if (link_exists(s->file, full) && H5Ldelete(s->file, full, H5P_DEFAULT) < 0) {
+    if ((rc = find_link(ctx, s, full, &e))) return rc;
+    if (e && H5Ldelete(s->file, full, H5P_DEFAULT) < 0) {
         s->broken = true;
         return es__h5_fail(ctx, ES_EIO, "store: cannot replace %s", full);
     }
@@ -281,14 +305,15 @@ static es_status put_attr_impl(es_ctx *ctx, es_store *s, const char *path, const
     char parts[8][128], full[700];
     es_status rc;
     hid_t obj;
+    bool e;
     int np = split_path(ctx, path, parts, &rc);
     if (np < 0) return rc;
     if (np < 2 || !key || !*key || !value)
         ES_FAIL(ctx, ES_EINVAL, "store: bad attribute '%s' on '%s'", key ? key : "", path);
     if ((rc = es__store_begin_write(s))) return rc;
     full_path(full, sizeof full, path);
-    if (!link_exists(s->file, full))
-        ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
+    if ((rc = find_link(ctx, s, full, &e))) return rc;
+    if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
     if ((obj = H5Oopen(s->file, full, H5P_DEFAULT)) < 0)
         return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
     rc = es__h5_write_attr_str(ctx, obj, key, value);
@@ -313,9 +338,11 @@ static es_status get_open(es_ctx *ctx, es_store *s, const char *path, int rank, 
     char parts[8][128], full[700];
     es_status rc;
     hid_t sp;
+    bool e;
     if (split_path(ctx, path, parts, &rc) < 0) return rc;
     full_path(full, sizeof full, path);
-    if (!link_exists(s->file, full)) ES_FAIL(ctx, ES_ENOTFOUND, "store: no dataset %s", full);
+    if ((rc = find_link(ctx, s, full, &e))) return rc;
+    if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no dataset %s", full);
     if ((*ds = H5Dopen2(s->file, full, H5P_DEFAULT)) < 0)
         return es__h5_fail(ctx, ES_EFORMAT, "store: %s is not a dataset", full);
     sp = H5Dget_space(*ds);
@@ -421,9 +448,11 @@ static es_status get_attr_impl(es_ctx *ctx, es_store *s, const char *path, const
     char parts[8][128], full[700];
     es_status rc;
     hid_t obj;
+    bool e;
     if (split_path(ctx, path, parts, &rc) < 0) return rc;
     full_path(full, sizeof full, path);
-    if (!link_exists(s->file, full)) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
+    if ((rc = find_link(ctx, s, full, &e))) return rc;
+    if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
     if ((obj = H5Oopen(s->file, full, H5P_DEFAULT)) < 0)
         return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
     if (H5Aexists(obj, key) <= 0) {
@@ -455,7 +484,10 @@ int es_store_has(es_store *s, const char *path)
     int r = 0;
     if (!s || !path || !*path) return 0;
     full_path(full, sizeof full, path);
-    H5E_BEGIN_TRY { r = link_exists(s->file, full) ? 1 : 0; } H5E_END_TRY
+    H5E_BEGIN_TRY {
+        bool e = false;
+        r = find_link(s->ctx, s, full, &e) == ES_OK && e;
+    } H5E_END_TRY
     return r;
 }
 
@@ -487,9 +519,23 @@ static es_status list_impl(es_ctx *ctx, es_store *s, const char *kind, char ***n
     if (kind && *kind && es__h5_bad_name(kind))
         ES_FAIL(ctx, ES_EINVAL, "store: bad result kind '%s'", kind);
     snprintf(full, sizeof full, "/analysis%s%s", kind && *kind ? "/" : "", kind ? kind : "");
-    if (!link_exists(s->file, full)) return ES_OK;
-    if ((g = H5Gopen2(s->file, full, H5P_DEFAULT)) < 0)
-        return es__h5_fail(ctx, ES_EFORMAT, "store: %s is not a group", full);
+    {
+        bool e;
+        es__h5_raw *raw = NULL;
+        es_status rc;
+        if ((rc = find_link(ctx, s, full, &e))) return rc;
+        if (!e) return ES_OK;
+        if ((g = H5Gopen2(s->file, full, H5P_DEFAULT)) < 0)
+            return es__h5_fail(ctx, ES_EFORMAT, "store: %s is not a group", full);
+        /* the group listed is searched by HDF5 too */
+        if (kind && *kind && ((rc = es__h5_raw_open(ctx, g, s->path, &raw)) ||
+                              (rc = es__h5_check_group(raw, g, full)))) {
+            es__h5_raw_close(raw);
+            H5Gclose(g);
+            return rc;
+        }
+        es__h5_raw_close(raw);
+    }
     if (H5Literate(g, H5_INDEX_NAME, H5_ITER_INC, NULL, list_cb, &l) < 0) {
         es_status rc = l.rc ? l.rc : es__h5_fail(ctx, ES_EIO, "store: cannot list %s", full);
         H5Gclose(g);

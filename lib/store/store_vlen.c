@@ -113,6 +113,24 @@ done:
 }
 
 unsigned es__h5_raw_vlen_size(const es__h5_raw *r) { return 8 + r->sa; }
+
+es_status es__h5_object_addr(es_ctx *ctx, hid_t obj, uint64_t *addr)
+{
+#if H5_VERSION_GE(1, 12, 0)
+    H5O_info2_t oi;
+    haddr_t a = HADDR_UNDEF;
+    if (H5Oget_info3(obj, &oi, H5O_INFO_BASIC) < 0 ||
+        H5VLnative_token_to_addr(obj, oi.token, &a) < 0)
+        return es__h5_fail(ctx, ES_EFORMAT, "store: cannot find an object header");
+    *addr = a;
+#else
+    H5O_info_t oi;
+    if (H5Oget_info2(obj, &oi, H5O_INFO_BASIC) < 0)
+        return es__h5_fail(ctx, ES_EFORMAT, "store: cannot find an object header");
+    *addr = oi.addr;
+#endif
+    return ES_OK;
+}
 uint64_t es__h5_raw_file_size(const es__h5_raw *r) { return r->eof; }
 
 void es__h5_raw_close(es__h5_raw *r)
@@ -437,47 +455,32 @@ done:
     return rc;
 }
 
-/* ---- attributes: the raw value from the object header ------------------ */
+/* ---- object headers and attributes ---------------------------------------- */
 
 /* A chunk of an object header to scan: its messages lie in [addr, addr+len). */
 typedef struct ochunk { uint64_t addr, len; } ochunk;
 
-/* The value bytes of attribute `key` in the attribute message msg[0..n). 0
- * if the name differs, 1 with *data and *dlen if it matches, -1 if malformed. */
-static int attr_value(const uint8_t *m, uint64_t n, const char *key, const uint8_t **data,
-                      uint64_t *dlen)
+es_status es__h5_raw_read(es__h5_raw *r, uint64_t addr, uint64_t n, void *buf, const char *what)
 {
-    uint64_t p, nsz, tsz, ssz;
-    size_t klen = strlen(key);
-    if (n < 9 || m[0] < 1 || m[0] > 3) return -1;
-    nsz = le(m + 2, 2);
-    tsz = le(m + 4, 2);
-    ssz = le(m + 6, 2);
-    p = m[0] == 3 ? 9 : 8;
-    if (nsz == 0 || nsz > n - p) return -1;
-    if (nsz - 1 < klen || memcmp(m + p, key, klen) || m[p + klen] != '\0') return 0;
-    if (m[0] > 1 && (m[1] & 3)) return -1;   /* shared datatype or dataspace */
-    if (m[0] == 1) p += align8(nsz) + align8(tsz) + align8(ssz);
-    else p += nsz + tsz + ssz;
-    if (p > n) return -1;
-    *data = m + p;
-    *dlen = n - p;
-    return 1;
+    return raw_read(r, addr, n, buf, what);
 }
 
+uint64_t es__h5_le(const uint8_t *p, unsigned n) { return le(p, n); }
+unsigned es__h5_raw_addr_size(const es__h5_raw *r) { return r->sa; }
+unsigned es__h5_raw_length_size(const es__h5_raw *r) { return r->ss; }
+es_ctx *es__h5_raw_ctx(const es__h5_raw *r) { return r->ctx; }
+const char *es__h5_raw_path(const es__h5_raw *r) { return r->path; }
+
 /* Walk the messages of the object header at oaddr (version 1, or 2 with
- * its "OHDR"/"OCHK" chunks; IV.A.1) for the attribute message of key and
- * copy its value into *val (*vlen bytes). ES_ENOTFOUND if no compact
- * attribute message has that name (dense attribute storage). */
-static es_status header_attr(es__h5_raw *r, uint64_t oaddr, const char *key, uint8_t **val,
-                             uint64_t *vlen)
+ * its "OHDR"/"OCHK" chunks; IV.A.1), following continuation messages (at
+ * most 64 chunks). */
+es_status es__h5_raw_messages(es__h5_raw *r, uint64_t oaddr, es__h5_msg_fn fn, void *ud)
 {
     ochunk q[64];
     int nq = 0, v2 = 0, crt = 0;
     uint8_t pre[40];
     uint64_t avail = r->eof > oaddr + r->base ? r->eof - oaddr - r->base : 0;
     es_status rc;
-    *val = NULL;
     if ((rc = raw_read(r, oaddr, avail < sizeof pre ? avail : sizeof pre, pre,
                        "an object header")))
         return rc;
@@ -512,6 +515,7 @@ static es_status header_attr(es__h5_raw *r, uint64_t oaddr, const char *key, uin
         }
         for (;;) {
             uint64_t hsz = v2 ? 4u + 2u * (unsigned)crt : 8u, type, msz;
+            int k;
             if (end - p < hsz) break;
             type = v2 ? b[p] : le(b + p, 2);
             msz = le(b + p + (v2 ? 1 : 2), 2);
@@ -520,27 +524,79 @@ static es_status header_attr(es__h5_raw *r, uint64_t oaddr, const char *key, uin
             if (type == 0x10) {                  /* continuation */
                 if (msz < (uint64_t)r->sa + r->ss || nq == 64) { es__free(r->ctx, b); goto corrupt; }
                 q[nq++] = (ochunk){le(b + p, r->sa), le(b + p + r->sa, r->ss)};
-            } else if (type == 0x0C) {           /* attribute */
-                const uint8_t *d;
-                uint64_t dl;
-                int k = attr_value(b + p, msz, key, &d, &dl);
-                if (k < 0) { es__free(r->ctx, b); goto corrupt; }
-                if (k > 0) {
-                    if ((*val = es__malloc(r->ctx, (size_t)dl + 1))) memcpy(*val, d, (size_t)dl);
-                    *vlen = dl;
-                    es__free(r->ctx, b);
-                    return *val ? ES_OK : ES_ENOMEM;
-                }
+            } else if ((k = fn(ud, (unsigned)type, b + p, msz)) != 0) {
+                es__free(r->ctx, b);
+                if (k < 0) goto corrupt;
+                return ES_OK;
             }
             p += msz;
         }
         es__free(r->ctx, b);
     }
-    ES_FAIL(r->ctx, ES_ENOTFOUND, "store: '%s': attribute '%s' is not stored compactly, "
-            "which edgespace does not read", r->path, key);
+    return ES_ENOTFOUND;
 corrupt:
-    ES_FAIL(r->ctx, ES_EFORMAT, "store: '%s' is corrupt: the object header that holds "
-            "attribute '%s' is malformed", r->path, key);
+    ES_FAIL(r->ctx, ES_EFORMAT, "store: '%s' is corrupt: an object header (at %llu) is "
+            "malformed", r->path, (unsigned long long)oaddr);
+}
+
+/* The value bytes of attribute `key` in the attribute message msg[0..n). 0
+ * if the name differs, 1 with *data and *dlen if it matches, -1 if malformed. */
+static int attr_value(const uint8_t *m, uint64_t n, const char *key, const uint8_t **data,
+                      uint64_t *dlen)
+{
+    uint64_t p, nsz, tsz, ssz;
+    size_t klen = strlen(key);
+    if (n < 9 || m[0] < 1 || m[0] > 3) return -1;
+    nsz = le(m + 2, 2);
+    tsz = le(m + 4, 2);
+    ssz = le(m + 6, 2);
+    p = m[0] == 3 ? 9 : 8;
+    if (nsz == 0 || nsz > n - p) return -1;
+    if (nsz - 1 < klen || memcmp(m + p, key, klen) || m[p + klen] != '\0') return 0;
+    if (m[0] > 1 && (m[1] & 3)) return -1;   /* shared datatype or dataspace */
+    if (m[0] == 1) p += align8(nsz) + align8(tsz) + align8(ssz);
+    else p += nsz + tsz + ssz;
+    if (p > n) return -1;
+    *data = m + p;
+    *dlen = n - p;
+    return 1;
+}
+
+typedef struct attr_find {
+    es__h5_raw *r;
+    const char *key;
+    uint8_t *val;
+    uint64_t vlen;
+    int nomem;
+} attr_find;
+
+static int find_attr(void *ud, unsigned type, const uint8_t *m, uint64_t n)
+{
+    attr_find *a = ud;
+    const uint8_t *d;
+    uint64_t dl;
+    int k;
+    if (type != 0x0C) return 0;
+    if ((k = attr_value(m, n, a->key, &d, &dl)) <= 0) return k;
+    if (!(a->val = es__malloc(a->r->ctx, (size_t)dl + 1))) a->nomem = 1;
+    else memcpy(a->val, d, (size_t)dl);
+    a->vlen = dl;
+    return 1;
+}
+
+/* The raw value of attribute key of the object at oaddr into *val. */
+static es_status header_attr(es__h5_raw *r, uint64_t oaddr, const char *key, uint8_t **val,
+                             uint64_t *vlen)
+{
+    attr_find a = {r, key, NULL, 0, 0};
+    es_status rc = es__h5_raw_messages(r, oaddr, find_attr, &a);
+    *val = a.val;
+    *vlen = a.vlen;
+    if (a.nomem) return ES_ENOMEM;
+    if (rc == ES_ENOTFOUND)
+        ES_FAIL(r->ctx, ES_ENOTFOUND, "store: '%s': attribute '%s' is not stored compactly, "
+                "which edgespace does not read", r->path, key);
+    return rc;
 }
 
 es_status es__h5_read_attr_strings(es_ctx *ctx, es__h5_raw *raw, hid_t obj, const char *key,
@@ -574,14 +630,11 @@ es_status es__h5_read_attr_strings(es_ctx *ctx, es__h5_raw *raw, hid_t obj, cons
     if (!(s = es__alloc_array(ctx, np ? np : 1, sizeof *s))) { rc = ES_ENOMEM; goto done; }
     for (hssize_t i = 0; i < np; i++) s[i] = NULL;
     if (np > 0 && H5Tis_variable_str(t) > 0) {
-        H5O_info_t oi;
+        uint64_t oaddr = 0;
         budget = r->eof;
-        if (H5Oget_info2(obj, &oi, H5O_INFO_BASIC) < 0) {
-            rc = es__h5_fail(ctx, ES_EFORMAT, "store: cannot find the object of attribute '%s'",
-                             key);
+        if ((rc = es__h5_object_addr(ctx, obj, &oaddr)) ||
+            (rc = header_attr(r, oaddr, key, &val, &vlen)))
             goto done;
-        }
-        if ((rc = header_attr(r, oi.addr, key, &val, &vlen))) goto done;
         if (vlen < (uint64_t)np * (8 + r->sa)) {
             rc = es__fail(ctx, ES_EFORMAT, "store: '%s' is corrupt: attribute '%s' holds %llu "
                           "bytes for %lld strings", r->path, key, (unsigned long long)vlen,

@@ -12,8 +12,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     size_t nbase, i = 0;
     const unsigned char *base = fuzz_base_store(&nbase);
     unsigned char *b;
-    char path[64];
-    fuzz_file(0, base, nbase, path, sizeof path);
+    const char *path = fuzz_store_file(base, nbase);
     for (int m = 0; m < 4 && i + 2 <= size; m++, i += 2)
         crafted_apply(path, data[i] % crafted_nmutations, data[i + 1]);
     if (i < size) {
@@ -27,7 +26,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (n <= 0 || !(b = malloc((size_t)n)) || fread(b, 1, (size_t)n, f) != (size_t)n) abort();
         fclose(f);
         for (; i + 3 <= size; i += 3) b[((size_t)data[i] << 8 | data[i + 1]) % (size_t)n] = data[i + 2];
-        fuzz_file(0, b, (size_t)n, path, sizeof path);
+        path = fuzz_store_file(b, (size_t)n);
         free(b);
     }
     fuzz_open_and_read(path);

@@ -13,7 +13,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     size_t nbase, len;
     const unsigned char *base = fuzz_base_store(&nbase);
     unsigned char *b;
-    char path[64];
     if (size < 1 || !(b = malloc(nbase))) return 0;
     memcpy(b, base, nbase);
     len = nbase;
@@ -21,8 +20,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         b[((size_t)data[i] << 8 | data[i + 1]) % nbase] = data[i + 2];
     if ((data[0] & 1) && size >= 3)
         len = nbase * ((size_t)data[size - 2] << 8 | data[size - 1]) / 65536;
-    fuzz_file(0, b, len, path, sizeof path);
-    fuzz_open_and_read(path);
+    fuzz_open_and_read(fuzz_store_file(b, len));
     free(b);
     return 0;
 }

@@ -8,6 +8,8 @@
 #include "fuzz_util.h"
 #include "crafted.h"
 
+#include <sys/stat.h>
+
 static inline const unsigned char *fuzz_base_store(size_t *n)
 {
     static unsigned char *bytes;
@@ -28,6 +30,33 @@ static inline const unsigned char *fuzz_base_store(size_t *n)
     }
     *n = len;
     return bytes;
+}
+
+/* The input as a store file at a real path: HDF5 1.10 resolves the path it
+ * opens (realpath), so a memory file's /proc/self/fd/N name cannot be
+ * opened (every input was refused at H5Fopen before the store's code ran).
+ * In /dev/shm where there is one (memory), else in /tmp. */
+static char fuzz_store_path[96];
+
+static inline void fuzz_store_remove(void)
+{
+    remove(fuzz_store_path);
+}
+
+static inline const char *fuzz_store_file(const void *data, size_t size)
+{
+    char *path = fuzz_store_path;
+    FILE *f;
+    if (!path[0]) {
+        struct stat st;
+        snprintf(path, sizeof fuzz_store_path, "%s/edgespace-fuzz-%ld.h5",
+                 stat("/dev/shm", &st) == 0 && S_ISDIR(st.st_mode) ? "/dev/shm" : "/tmp",
+                 (long)getpid());
+        atexit(fuzz_store_remove);
+    }
+    if (!(f = fopen(path, "wb")) || (size && fwrite(data, 1, size, f) != size) || fclose(f))
+        abort();
+    return path;
 }
 
 /* Open the store at path and read all of it; refusals and failed reads

@@ -332,6 +332,10 @@ const crafted_mutation crafted_mutations[] = {
     {"heap collection size", ANY, NULL, 4},
     {"heap free space of size 0", ANY, NULL, 1},
     {"string length", ANY, NULL, 4},
+    {"group local heap free list loops", REFUSE, "local heap", 1},
+    {"group local heap free block too big", REFUSE, "local heap", 1},
+    {"group B-tree child points up", REFUSE, "B-tree", 1},
+    {"group link name outside its heap", REFUSE, "outside its local heap", 1},
 };
 const int crafted_nmutations = (int)(sizeof crafted_mutations / sizeof crafted_mutations[0]);
 
@@ -376,6 +380,55 @@ static int patch_heap(const char *path, int what, uint32_t p)
         }
         done = 1;
     }
+    rewind(fp);
+    if (fwrite(b, 1, (size_t)n, fp) != (size_t)n) done = 0;
+    free(b);
+    fclose(fp);
+    return done ? 0 : -1;
+}
+
+/* Group symbol tables (HDF5 III.A.1, III.B, III.D), patched in every group
+ * of the file: a local heap whose free list loops (libhdf5 1.10 follows it
+ * until memory runs out) or has a block past the heap, a B-tree node whose
+ * first child is itself (libhdf5 recurses without end), a symbol whose name
+ * offset is past the heap. Addresses and lengths are 8 bytes, base 0. */
+static int patch_groups(const char *path, int what)
+{
+    FILE *fp = fopen(path, "r+b");
+    unsigned char *b;
+    long n;
+    int done = 0;
+    if (!fp) return -1;
+    fseek(fp, 0, SEEK_END);
+    n = ftell(fp);
+    rewind(fp);
+    if (n <= 0 || !(b = malloc((size_t)n))) { fclose(fp); return -1; }
+    if (fread(b, 1, (size_t)n, fp) != (size_t)n) { free(b); fclose(fp); return -1; }
+#define PUT8(at, v) do { uint64_t v_ = (v); for (int q_ = 0; q_ < 8; q_++) \
+        b[(at) + q_] = (unsigned char)(v_ >> (8 * q_)); } while (0)
+#define GET8(at) (((uint64_t)b[(at)] | (uint64_t)b[(at) + 1] << 8 | (uint64_t)b[(at) + 2] << 16 | \
+        (uint64_t)b[(at) + 3] << 24 | (uint64_t)b[(at) + 4] << 32 | (uint64_t)b[(at) + 5] << 40 | \
+        (uint64_t)b[(at) + 6] << 48 | (uint64_t)b[(at) + 7] << 56))
+    for (long i = 0; i + 48 < n; i++) {
+        if (what <= 1 && !memcmp(b + i, "HEAP", 4) && b[i + 4] == 0) {
+            uint64_t dsize = GET8(i + 8), data = GET8(i + 24);
+            if (dsize < 48 || data + dsize > (uint64_t)n) continue;
+            PUT8(i + 16, 16);                          /* the free list starts at 16 */
+            PUT8(data + 16, what == 0 ? 16 : 1);       /* next: itself, or the end */
+            PUT8(data + 24, what == 0 ? 16 : dsize);   /* size: 16, or past the heap */
+            done = 1;
+        } else if (what == 2 && !memcmp(b + i, "TREE", 4) && b[i + 4] == 0) {
+            PUT8(i + 24 + 8, (uint64_t)i);             /* child 0 (after key 0) = this node */
+            b[i + 5] = 0;                              /* a leaf: its children are symbol nodes */
+            done = 1;
+        } else if (what == 3 && !memcmp(b + i, "SNOD", 4) && b[i + 4] == 1 &&
+                   (b[i + 6] | b[i + 7] << 8) > 0) {
+            PUT8(i + 8, 0xffffffull);                  /* the first symbol's name offset */
+            done = 1;
+        }
+    }
+#undef PUT8
+#undef GET8
     rewind(fp);
     if (fwrite(b, 1, (size_t)n, fp) != (size_t)n) done = 0;
     free(b);
@@ -649,6 +702,11 @@ int crafted_apply(const char *path, int k, uint32_t param)
     if (k < 0 || k >= crafted_nmutations) return -1;
     m = &crafted_mutations[k];
     param %= (uint32_t)(m->nparams > 0 ? m->nparams : 1);
+    if (!strncmp(m->name, "group ", 6)) {
+        int what = strstr(m->name, "loops") ? 0 : strstr(m->name, "too big") ? 1 :
+                   strstr(m->name, "B-tree") ? 2 : 3;
+        return patch_groups(path, what);
+    }
     if (!strncmp(m->name, "heap ", 5)) {
         int what = !strcmp(m->name, "heap object size") ? 0 :
                    !strcmp(m->name, "heap object index") ? 1 :
