@@ -310,16 +310,19 @@ static es_status check_shapes(es_store *s, es__h5_raw *raw, int64_t *n)
 }
 
 /* The groups every open looks names up in: the root, then each of the
- * store's groups, each checked before HDF5 searches it (store_groups.c). */
+ * store's groups, each checked before HDF5 searches it or decodes its
+ * attributes (store_groups.c). */
 static es_status check_groups(es_store *s, es__h5_raw *raw)
 {
     static const char *const names[] = {"/topology", "/shapes", "/labels", "/analysis"};
     es_status rc = es__h5_check_group(raw, s->file, "/");
+    if (rc == ES_OK) rc = es__h5_check_attrs(raw, s->file, "the root group");
     for (size_t i = 0; rc == ES_OK && i < sizeof names / sizeof names[0]; i++) {
         hid_t g;
         if (H5Lexists(s->file, names[i], H5P_DEFAULT) <= 0) continue;   /* said later */
         if ((g = H5Gopen2(s->file, names[i], H5P_DEFAULT)) < 0) continue;
-        rc = es__h5_check_group(raw, g, names[i]);
+        if ((rc = es__h5_check_group(raw, g, names[i])) == ES_OK)
+            rc = es__h5_check_attrs(raw, g, names[i]);
         H5Gclose(g);
     }
     return rc;

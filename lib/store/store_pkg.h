@@ -138,6 +138,11 @@ es_status es__h5_object_addr(es_ctx *ctx, hid_t obj, uint64_t *addr);
  * runs out (24 GB for three changed bytes) and B-tree children without
  * bound. A group with links in its header (new style) has nothing to check. */
 es_status es__h5_check_group(es__h5_raw *raw, hid_t group, const char *name);
+/* Check every attribute message of obj (name: for messages) before HDF5
+ * decodes them (store_groups.c): libhdf5 1.10 copies an attribute's value
+ * at the size its dataspace and datatype claim, past the message if they
+ * claim more. */
+es_status es__h5_check_attrs(es__h5_raw *raw, hid_t obj, const char *name);
 /* A string attribute, or one integer or real as text, into buf[n],
  * truncated; ES_ENOTFOUND if absent. */
 es_status es__h5_read_attr_text(es_ctx *ctx, es__h5_raw *raw, hid_t obj, const char *key,

@@ -316,7 +316,13 @@ static es_status put_attr_impl(es_ctx *ctx, es_store *s, const char *path, const
     if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
     if ((obj = H5Oopen(s->file, full, H5P_DEFAULT)) < 0)
         return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
-    rc = es__h5_write_attr_str(ctx, obj, key, value);
+    {
+        es__h5_raw *raw = NULL;
+        if ((rc = es__h5_raw_open(ctx, obj, s->path, &raw)) == ES_OK)
+            rc = es__h5_check_attrs(raw, obj, full);
+        es__h5_raw_close(raw);
+    }
+    if (rc == ES_OK) rc = es__h5_write_attr_str(ctx, obj, key, value);
     H5Oclose(obj);
     if (rc) s->broken = true;
     return rc;
@@ -455,6 +461,17 @@ static es_status get_attr_impl(es_ctx *ctx, es_store *s, const char *path, const
     if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
     if ((obj = H5Oopen(s->file, full, H5P_DEFAULT)) < 0)
         return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
+    /* HDF5 decodes every attribute of the object to find one: checked first */
+    {
+        es__h5_raw *raw = NULL;
+        if ((rc = es__h5_raw_open(ctx, obj, s->path, &raw)) == ES_OK)
+            rc = es__h5_check_attrs(raw, obj, full);
+        es__h5_raw_close(raw);
+        if (rc) {
+            H5Oclose(obj);
+            return rc;
+        }
+    }
     if (H5Aexists(obj, key) <= 0) {
         H5Oclose(obj);
         ES_FAIL(ctx, ES_ENOTFOUND, "store: %s has no attribute '%s'", full, key);

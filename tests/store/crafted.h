@@ -38,6 +38,12 @@ extern const int crafted_nmutations;
  * refused to write it (the variant cannot be made). */
 int crafted_apply(const char *path, int k, uint32_t param);
 
+/* 0 if mutation k writes through HDF5, 1 if it finds what to patch with
+ * HDF5 and patches bytes (string descriptors), 2 if it only patches bytes
+ * (heaps, symbol tables): apply them in that order, since HDF5 would walk
+ * what the patches break. */
+int crafted_patches_bytes(int k);
+
 /* 1 if a failure message is one line a user can act on: non-empty, no
  * newline, no HDF5 error-stack text or internal function names. */
 int crafted_message_ok(const char *msg);
