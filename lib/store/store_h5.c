@@ -320,6 +320,45 @@ uint64_t es__h5_covered_bytes(hid_t ds, int rank, uint64_t elem)
     return have;
 }
 
+es_status es__h5_check_chunks(es_ctx *ctx, hid_t ds, const char *path, const char *name,
+                               uint64_t elem)
+{
+    hid_t dcpl = H5Dget_create_plist(ds), sp = H5Dget_space(ds);
+    hsize_t cd[8], dims[8], maxd[8], n = 0, off[8], size = 0;
+    haddr_t addr;
+    unsigned mask;
+    uint64_t nominal = elem;
+    es_status rc = ES_OK;
+    int rank;
+    if (dcpl < 0 || sp < 0 || (rank = H5Sget_simple_extent_dims(sp, dims, maxd)) < 0 ||
+        rank > 8) {
+        rc = es__h5_fail(ctx, ES_EFORMAT, "store: '%s': cannot read the layout of %s", path, name);
+        goto done;
+    }
+    if (H5Pget_layout(dcpl) != H5D_CHUNKED) goto done;
+    /* chunks within the fixed dimensions (HDF5 makes them so; a changed byte
+     * of the layout message made a 6 KB chunk of positions claim 12 MB, and
+     * libhdf5 1.10 read it past its buffer), and a stored chunk of the size
+     * they make when nothing compresses it */
+    if (H5Pget_chunk(dcpl, rank, cd) != rank) goto bad;
+    for (int k = 0; k < rank; k++)
+        if (cd[k] < 1 || (maxd[k] != H5S_UNLIMITED && cd[k] > maxd[k]) ||
+            __builtin_mul_overflow(nominal, (uint64_t)cd[k], &nominal))
+            goto bad;
+    if (nominal > ((uint64_t)1 << 32)) goto bad;
+    if (H5Pget_nfilters(dcpl) == 0 && H5Dget_num_chunks(ds, sp, &n) >= 0 && n > 0 &&
+        (H5Dget_chunk_info(ds, sp, 0, off, &mask, &addr, &size) < 0 || size != nominal))
+        goto bad;
+    goto done;
+bad:
+    rc = es__fail(ctx, ES_EFORMAT, "store: '%s' is corrupt: the chunks of %s do not fit it", path,
+                  name);
+done:
+    es__h5_close(sp);
+    es__h5_close(dcpl);
+    return rc;
+}
+
 hid_t es__h5_file_access(void)
 {
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);

@@ -42,6 +42,7 @@ static es_status check_ds(es_store *s, es__h5_raw *raw, const char *name, H5T_cl
     }
     elem = cls == H5T_STRING && H5Tis_variable_str(t) > 0 ? es__h5_raw_vlen_size(raw)
                                                           : H5Tget_size(t);
+    if ((rc = es__h5_check_chunks(ctx, ds, s->path, name, elem))) goto done;
     for (int k = 0; k < rank; k++)
         if (__builtin_mul_overflow(need, (uint64_t)dims[k], &need)) need = UINT64_MAX;
     if (__builtin_mul_overflow(need, elem, &need)) need = UINT64_MAX;

@@ -147,6 +147,12 @@ es_status es__h5_check_attrs(es__h5_raw *raw, hid_t obj, const char *name);
  * truncated; ES_ENOTFOUND if absent. */
 es_status es__h5_read_attr_text(es_ctx *ctx, es__h5_raw *raw, hid_t obj, const char *key,
                                 char *buf, size_t n);
+/* A chunked dataset's chunks within its fixed dimensions, and its first
+ * stored chunk of the size they make when nothing compresses it (elem:
+ * bytes an element on disk); ES_OK for other layouts. Checked before HDF5
+ * reads it: libhdf5 1.10 reads a chunk at the size its layout claims. */
+es_status es__h5_check_chunks(es_ctx *ctx, hid_t ds, const char *path, const char *name,
+                               uint64_t elem);
 /* Bytes of dataset ds (rank 1..3, elem bytes an element) that the file
  * holds: its storage, or for a compressed (filtered) one the uncompressed
  * size of its allocated chunks. A count larger than this is refused before

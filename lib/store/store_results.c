@@ -380,6 +380,7 @@ static es_status get_impl(es_ctx *ctx, es_store *s, const char *path, int rank, 
         rc = es__fail(ctx, ES_EFORMAT, "store: '%s': /analysis/%s is not numbers", s->path, path);
         goto done;
     }
+    if ((rc = es__h5_check_chunks(ctx, ds, s->path, path, H5Tget_size(t)))) goto done;
     if (!es__mul_i64((int64_t)dims[0], (int64_t)dims[1], &total) || total < 0 ||
         __builtin_mul_overflow((uint64_t)total, (uint64_t)H5Tget_size(t), &need) ||
         es__h5_covered_bytes(ds, rank, H5Tget_size(t)) < need) {

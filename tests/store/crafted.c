@@ -337,6 +337,7 @@ const crafted_mutation crafted_mutations[] = {
     {"group B-tree child points up", REFUSE, "B-tree", 1},
     {"group link name outside its heap", REFUSE, "outside its local heap", 1},
     {"attribute value larger than its message", REFUSE, "an attribute of /topology", 2},
+    {"positions chunks larger than the dataset", REFUSE, "the chunks of /shapes/positions", 1},
 };
 const int crafted_nmutations = (int)(sizeof crafted_mutations / sizeof crafted_mutations[0]);
 
@@ -466,6 +467,35 @@ static int patch_attribute(const char *path, uint32_t p)
         }
         done = 1;
     }
+    rewind(fp);
+    if (fwrite(b, 1, (size_t)n, fp) != (size_t)n) done = 0;
+    free(b);
+    fclose(fp);
+    return done ? 0 : -1;
+}
+
+/* The layout message of /shapes/positions (version 3, chunked, 4 chunk
+ * dimensions after the B-tree address: 64 rows, V = 4, 3, 8 bytes) claims
+ * chunks of 6147 coordinates where the dataset has 3. */
+static int patch_layout(const char *path)
+{
+    static const unsigned char dims[16] = {64, 0, 0, 0, V, 0, 0, 0, 3, 0, 0, 0, 8, 0, 0, 0};
+    FILE *fp = fopen(path, "r+b");
+    unsigned char *b;
+    long n;
+    int done = 0;
+    if (!fp) return -1;
+    fseek(fp, 0, SEEK_END);
+    n = ftell(fp);
+    rewind(fp);
+    if (n <= 0 || !(b = malloc((size_t)n))) { fclose(fp); return -1; }
+    if (fread(b, 1, (size_t)n, fp) != (size_t)n) { free(b); fclose(fp); return -1; }
+    for (long i = 0; i + 27 < n && !done; i++)
+        if (b[i] == 3 && b[i + 1] == 2 && b[i + 2] == 4 && !memcmp(b + i + 11, dims, 16)) {
+            b[i + 11 + 8] = 0x03;
+            b[i + 11 + 9] = 0x18;
+            done = 1;
+        }
     rewind(fp);
     if (fwrite(b, 1, (size_t)n, fp) != (size_t)n) done = 0;
     free(b);
@@ -736,7 +766,7 @@ int crafted_patches_bytes(int k)
     const char *name = k >= 0 && k < crafted_nmutations ? crafted_mutations[k].name : "";
     if (!strcmp(name, "string length")) return 1;   /* finds its chunk with HDF5 */
     return !strncmp(name, "heap ", 5) || !strncmp(name, "group ", 6) ||
-           !strncmp(name, "attribute ", 10) ? 2 : 0;
+           !strncmp(name, "attribute ", 10) || !strncmp(name, "positions chunks", 16) ? 2 : 0;
 }
 
 int crafted_apply(const char *path, int k, uint32_t param)
@@ -748,6 +778,7 @@ int crafted_apply(const char *path, int k, uint32_t param)
     m = &crafted_mutations[k];
     param %= (uint32_t)(m->nparams > 0 ? m->nparams : 1);
     if (!strncmp(m->name, "attribute ", 10)) return patch_attribute(path, param);
+    if (!strcmp(m->name, "positions chunks larger than the dataset")) return patch_layout(path);
     if (!strncmp(m->name, "group ", 6)) {
         int what = strstr(m->name, "loops") ? 0 : strstr(m->name, "too big") ? 1 :
                    strstr(m->name, "B-tree") ? 2 : 3;
