@@ -212,7 +212,6 @@ static void test_kills(es_ctx *ctx, const char *base, size_t nbase)
         const char *args[10];
         int n = 0;
         for (; n < 8 && cmds[c][n]; n++) args[n] = cmds[c][n];
-        if (c == 4) args[n++] = "--name", args[n++] = "k";
         args[n] = NULL;
         snprintf(res, sizeof res, "%s/k", kinds[c]);
         /* a point needs a PCA: part of the base for this command */
