@@ -36,6 +36,11 @@ es_status es__fail(es_ctx *ctx, es_status code, const char *fmt, ...) ES__PRINTF
 void es__warn(es_ctx *ctx, const char *fmt, ...) ES__PRINTF(2, 3);
 void es__info(es_ctx *ctx, const char *fmt, ...) ES__PRINTF(2, 3);
 
+/* The context's log callback, so that a caller can put another in its place
+ * for a while (ingest collects its threads' warnings to replay them in
+ * input order) and restore it. */
+void es__ctx_get_log(const es_ctx *ctx, es_log_fn *fn, void **userdata);
+
 /* Progress callback (no-op without one). */
 void es__progress(es_ctx *ctx, const char *what, int64_t done, int64_t total);
 
@@ -52,10 +57,12 @@ void *es__alloc_array(es_ctx *ctx, int64_t n, size_t size);
  * begin opens a part file beside path (through a symlink, beside its target;
  * with the old file's mode); write to w.f; end closes it and renames it over
  * the file if rc is ES_OK and the writes succeeded, else removes it. end
- * returns rc or the write error. */
+ * returns rc or the write error. A FIFO or character device at path (a pipe,
+ * /dev/null, /dev/full) is written in place, never replaced by a file; a
+ * directory, block device or socket is refused (ES_EIO). */
 typedef struct es__file_replace {
     FILE *f;
-    char *tmp;          /* the part file */
+    char *tmp;          /* the part file (NULL when written in place) */
     char *target;       /* the symlink's resolution, or NULL */
     const char *path;   /* as given (for messages) */
 } es__file_replace;

@@ -64,6 +64,12 @@ void es_ctx_free(es_ctx *ctx) { free(ctx); }
 const char *es_ctx_errmsg(const es_ctx *ctx) { return ctx ? ctx->errmsg : ""; }
 void es_ctx_clear_error(es_ctx *ctx) { ctx->errmsg[0] = '\0'; }
 
+void es__ctx_get_log(const es_ctx *ctx, es_log_fn *fn, void **userdata)
+{
+    *fn = ctx ? ctx->log_fn : NULL;
+    *userdata = ctx ? ctx->log_ud : NULL;
+}
+
 void es_ctx_set_log(es_ctx *ctx, es_log_fn fn, void *userdata)
 {
     ctx->log_fn = fn;
@@ -89,6 +95,31 @@ void es_ctx_set_allocator(es_ctx *ctx, const es_allocator *alloc)
     }
 }
 
+/* A message is one line of text: control characters that a file or a user
+ * put into what it quotes (a column name holding a newline, a NUL-free
+ * binary field) are written as escapes (\n, \t, \x01), never raw. */
+static void one_line(char *dst, size_t n, const char *src)
+{
+    size_t at = 0;
+    for (const unsigned char *p = (const unsigned char *)src; *p && at + 1 < n; p++) {
+        char esc[5];
+        size_t k;
+        if (*p >= 0x20 && *p != 0x7f) {
+            dst[at++] = (char)*p;
+            continue;
+        }
+        if (*p == '\n') memcpy(esc, "\\n", 3);
+        else if (*p == '\r') memcpy(esc, "\\r", 3);
+        else if (*p == '\t') memcpy(esc, "\\t", 3);
+        else snprintf(esc, sizeof esc, "\\x%02x", *p);
+        k = strlen(esc);
+        if (at + k + 1 > n) break;
+        memcpy(dst + at, esc, k);
+        at += k;
+    }
+    dst[at] = '\0';
+}
+
 es_status es__fail(es_ctx *ctx, es_status code, const char *fmt, ...)
 {
     va_list ap;
@@ -99,7 +130,7 @@ es_status es__fail(es_ctx *ctx, es_status code, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(buf, sizeof buf, fmt, ap);
     va_end(ap);
-    memcpy(ctx->errmsg, buf, sizeof buf);
+    one_line(ctx->errmsg, sizeof ctx->errmsg, buf);
     return code;
 }
 
@@ -107,10 +138,11 @@ static void log_message(es_ctx *ctx, es_log_level level, const char *fmt, va_lis
     ES__PRINTF(3, 0);
 static void log_message(es_ctx *ctx, es_log_level level, const char *fmt, va_list ap)
 {
-    char buf[ES_ERRMSG_SIZE];
+    char buf[ES_ERRMSG_SIZE], line[ES_ERRMSG_SIZE];
     if (!ctx || !ctx->log_fn) return;
     vsnprintf(buf, sizeof buf, fmt, ap);
-    ctx->log_fn(ctx->log_ud, level, buf);
+    one_line(line, sizeof line, buf);
+    ctx->log_fn(ctx->log_ud, level, line);
 }
 
 void es__warn(es_ctx *ctx, const char *fmt, ...)

@@ -13,7 +13,9 @@
 
 /* The part file is made beside the file that path names (through a
  * symlink: beside its target, which is what gets replaced), with the mode
- * of a file already there. Names are tried with a counter: a part file left
+ * of a file already there. A pipe or character device is written in place
+ * (export to /dev/full as root used to replace the device node by a CSV
+ * file); a directory or block device is refused. Names are tried with a counter: a part file left
  * by a killed process of the same pid must not block every later write. */
 es_status es__replace_begin(es_ctx *ctx, const char *path, es__file_replace *w)
 {
@@ -25,6 +27,22 @@ es_status es__replace_begin(es_ctx *ctx, const char *path, es__file_replace *w)
     if (lstat(path, &st) == 0 && S_ISLNK(st.st_mode)) w->target = realpath(path, NULL);
     t = w->target ? w->target : path;
     if (stat(t, &st) == 0) have = 1;
+    if (have && (S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode))) {
+        /* a stream, not a file: renaming a part file over it would put a
+         * regular file where a device node or pipe was */
+        free(w->target);
+        w->target = NULL;
+        if (!(w->f = fopen(path, "wb")))
+            ES_FAIL(ctx, ES_EIO, "cannot write '%s': %s", path, strerror(errno));
+        return ES_OK;
+    }
+    if (have && !S_ISREG(st.st_mode)) {
+        free(w->target);
+        w->target = NULL;
+        ES_FAIL(ctx, ES_EIO, "cannot write '%s': %s", path,
+                S_ISDIR(st.st_mode) ? strerror(EISDIR) : "not a regular file, pipe or "
+                "character device");
+    }
     if (!(w->tmp = es__malloc(ctx, strlen(t) + 48))) {
         free(w->target);
         w->target = NULL;
@@ -53,9 +71,9 @@ es_status es__replace_end(es_ctx *ctx, es__file_replace *w, es_status rc)
         rc = es__fail(ctx, ES_EIO, "cannot write '%s': %s", w->path, strerror(errno));
     if (fclose(w->f) != 0 && rc == ES_OK)
         rc = es__fail(ctx, ES_EIO, "cannot write '%s': %s", w->path, strerror(errno));
-    if (rc == ES_OK && rename(w->tmp, w->target ? w->target : w->path) != 0)
+    if (rc == ES_OK && w->tmp && rename(w->tmp, w->target ? w->target : w->path) != 0)
         rc = es__fail(ctx, ES_EIO, "cannot write '%s': %s", w->path, strerror(errno));
-    if (rc != ES_OK) remove(w->tmp);
+    if (rc != ES_OK && w->tmp) remove(w->tmp);
     es__free(ctx, w->tmp);
     free(w->target);
     memset(w, 0, sizeof *w);

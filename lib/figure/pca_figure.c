@@ -20,7 +20,11 @@ static es_status draw_scores(es_ctx *ctx, es_store *store, const es_pca *p, cons
     if (a < 1 || b < 1 || a > p->ncomp || b > p->ncomp)
         ES_FAIL(ctx, ES_EINVAL, "the PCA has %lld components", (long long)p->ncomp);
     int64_t col = color ? es_store_find_column(store, color) : -1;
-    if (color && col < 0) ES_FAIL(ctx, ES_ENOTFOUND, "no label column '%s'", color);
+    if (color && col < 0) {
+        char hint[400];
+        es_store_column_hint(store, color, hint, sizeof hint);
+        ES_FAIL(ctx, ES_ENOTFOUND, "no label column '%s'%s", color, hint);
+    }
     if (col >= 0) {
         if (!(labels = es__alloc_array(ctx, nrows, sizeof *labels))) return ES_ENOMEM;
         for (int64_t i = 0; i < nrows; i++) labels[i] = es_store_label(store, rows[i], col);

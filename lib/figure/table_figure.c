@@ -8,6 +8,7 @@
 #include "figure/figure_pkg.h"
 #include "core/csv_table.h"
 #include "core/files.h"
+#include "core/suggest.h"
 #include "core/text.h"
 #include "edgespace/es_figure.h"
 
@@ -89,7 +90,12 @@ static es_status find_column(es_ctx *ctx, const table *t, const char *name, int6
         *col = k - 1;
         return ES_OK;
     }
-    ES_FAIL(ctx, ES_ENOTFOUND, "'%s' has no column '%s'", t->path, name);
+    es__suggest sg;
+    char hint[400];
+    es__suggest_init(&sg, name);
+    for (int64_t j = 0; t->header && j < t->ncols; j++) es__suggest_add(&sg, cell(t, 0, j));
+    es__suggest_format(&sg, "columns", hint, sizeof hint);
+    ES_FAIL(ctx, ES_ENOTFOUND, "'%s' has no column '%s'%s", t->path, name, hint);
 }
 
 /* The n numbers of column j into v; text is an error naming line and column. */

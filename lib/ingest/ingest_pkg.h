@@ -17,6 +17,8 @@
  * added). Start from {0} with ctx set. */
 typedef struct es__lm_builder {
     es_ctx *ctx;
+    int64_t limit;   /* most specimens the input can hold (0: no bound): room
+                      * is never made for more than the file has lines for */
     int64_t n, cap, k, kd;
     int d;
     double *xyz;
@@ -37,7 +39,8 @@ void es__lm_builder_clear(es__lm_builder *b);
 es_status es__lm_builder_finish(es__lm_builder *b, int with_tps_fields, es_landmarks **out);
 
 /* A landmark text file (TPS, index list) into *buf (es__free): a regular
- * file, its UTF-8 byte order mark dropped; messages start "landmarks: ". */
+ * file without NUL bytes, its UTF-8 byte order mark dropped; messages start
+ * "landmarks: ". */
 es_status es__lm_read_text(es_ctx *ctx, const char *path, char **buf, size_t *len);
 
 /* Free s[0..n) and s (NULL: nothing). */

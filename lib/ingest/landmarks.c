@@ -22,7 +22,10 @@ es_status es__lm_read_text(es_ctx *ctx, const char *path, char **buf, size_t *le
 {
     /* A UTF-8 byte order mark (Excel's "CSV UTF-8", Windows editors) is not
      * data: dropped, as the manifest and mesh readers do. */
-    es_status rc = es__read_file(ctx, path, ES__READ_REGULAR | ES__READ_DROP_BOM, buf, len);
+    /* A NUL byte is refused naming its line: the line-by-line readers would
+     * stop at it and silently drop the rest of the file. */
+    es_status rc = es__read_file(ctx, path, ES__READ_REGULAR | ES__READ_DROP_BOM | ES__READ_TEXT,
+                                 buf, len);
     return rc == ES_OK ? ES_OK : es__fail(ctx, rc, "landmarks: %s", es_ctx_errmsg(ctx));
 }
 
@@ -72,6 +75,7 @@ es_status es__lm_builder_add(es__lm_builder *b, int64_t k, int d, const char *fi
     }
     if (b->n == b->cap) {
         int64_t nc = b->cap ? 2 * b->cap : FIRST_CAP, bytes;
+        if (b->limit > 0 && nc > b->limit) nc = b->limit > b->n ? b->limit : b->n + 1;
         if (!es__mul_i64(nc, b->kd, &bytes) || !es__mul_i64(bytes, (int64_t)sizeof(double), &bytes))
             ES_FAIL(b->ctx, ES_ERANGE, "landmarks: %s: %lld specimens of %lld landmarks in %dD "
                     "are too many", file, (long long)nc, (long long)b->k, b->d);

@@ -161,6 +161,7 @@ es_status es_landmarks_read_csv(es_ctx *ctx, const char *path, const char *speci
                       (long long)nspec, (long long)k, (long long)(t.nrecords - 1));
         goto done;
     }
+    b.limit = nspec;
     for (int64_t j = 0; j < nspec; j++)
         if ((rc = es__lm_builder_add(&b, k, c.d, file, 0)) != ES_OK) goto done;
     /* ids in order of first appearance: the map's values */

@@ -59,6 +59,9 @@ es_status es_landmarks_read_tps(es_ctx *ctx, const char *path, int apply_scale,
     b.ctx = ctx;
     if ((rc = es__lm_read_text(ctx, path, &buf, &len)) != ES_OK) return rc;
 
+    /* a count from the file is bounded by the lines left to hold it */
+    int64_t nlines = 1;
+    for (const char *q = buf; (q = strchr(q, '\n')); q++) nlines++;
     int64_t line = 0, pending = 0;   /* coordinate lines still expected */
     int64_t skip = 0;                /* POINTS= lines of a curve still to skip */
     int d = 2, warned_curves = 0;
@@ -102,7 +105,14 @@ es_status es_landmarks_read_tps(es_ctx *ctx, const char *path, int apply_scale,
                               file, (long long)line, val);
                 goto fail;
             }
+            if (iv > nlines - line) {
+                rc = es__fail(ctx, ES_ERANGE, "landmarks: %s:%lld: %lld landmarks (LM= count) "
+                              "are too many for the %lld lines that follow", file,
+                              (long long)line, (long long)iv, (long long)(nlines - line));
+                goto fail;
+            }
             d = dim;
+            if (b.n == 0) b.limit = nlines / (iv + 1) + 1;   /* LM= line + iv lines each */
             if ((rc = es__lm_builder_add(&b, iv, d, file, line)) != ES_OK) goto fail;
             pending = iv;
         } else if ((val = tps_key(s, "ID"))) {
@@ -165,7 +175,14 @@ es_status es_landmarks_read_tps(es_ctx *ctx, const char *path, int apply_scale,
     }
     for (int64_t j = 0; j < b.n; j++) {
         if (apply_scale && isfinite(b.scale[j]))
-            for (int64_t v = 0; v < b.kd; v++) b.xyz[j * b.kd + v] *= b.scale[j];
+            for (int64_t v = 0; v < b.kd; v++)
+                if (!isfinite(b.xyz[j * b.kd + v] *= b.scale[j])) {
+                    rc = es__fail(ctx, ES_ERANGE, "landmarks: %s: specimen %lld%s%s%s: SCALE=%g "
+                                  "makes its coordinates overflow", file, (long long)j + 1,
+                                  b.ids[j] ? " ('" : "", b.ids[j] ? b.ids[j] : "",
+                                  b.ids[j] ? "')" : "", b.scale[j]);
+                    goto fail;
+                }
         if (!b.ids[j]) {
             char name[32];
             snprintf(name, sizeof name, "%lld", (long long)j + 1);

@@ -369,8 +369,10 @@ es_status es_pca_fit(es_ctx *ctx, const es_source *src, const es_pca_opts *opts,
     case ES_PCA_RANDOMIZED: {
         if (o.ncomp < 1)
             ES_FAIL(ctx, ES_EINVAL, "pca: the randomized method needs a number of components");
-        if (o.oversample < 0 || o.power_iters < 0)
-            ES_FAIL(ctx, ES_EINVAL, "pca: oversampling and power iterations must be >= 0");
+        if (o.oversample < 0 || o.power_iters < 0 || o.power_iters > 1000)
+            ES_FAIL(ctx, ES_EINVAL, "pca: oversampling must be >= 0 and power iterations "
+                    "0 to 1000 (got %lld and %lld)", (long long)o.oversample,
+                    (long long)o.power_iters);
         es_pca *p;
         if ((rc = es__pca_alloc(ctx, E, N, o.ncomp, &p)) != ES_OK) return rc;
         if ((rc = es__pca_fit_randomized(ctx, src, &o, p)) != ES_OK) {

@@ -47,7 +47,9 @@ es_status es__pca_fit_randomized(es_ctx *ctx, const es_source *src, const es_pca
                                  es_pca *p)
 {
     const int64_t E = src->nedges, N = src->nrows, B = es__source_block(src), K = opts->ncomp;
-    int64_t l = K + opts->oversample;
+    /* K <= min(N, E) (checked by es_pca_fit): clamping the oversampling
+     * first keeps K + p from overflowing for any p */
+    int64_t l = K + (opts->oversample < N ? opts->oversample : N);
     if (l > N) l = N;
     if (l > E) l = E;
     int ne, nn;

@@ -449,6 +449,18 @@ void es_point_expr_free(es_point_expr *x)
     es__free(x->ctx, x);
 }
 
+static const char *leaf_prefix(es_point_leaf k)
+{
+    switch (k) {
+    case ES_POINT_MEAN: return "mean";
+    case ES_POINT_ROW: return "row:";
+    case ES_POINT_FILE: return "file:";
+    case ES_POINT_PC: return "pc:";
+    case ES_POINT_DIFF: return "diff:";
+    }
+    return "?";
+}
+
 es_status es_point_parse(es_ctx *ctx, const char *text, es_point_expr **out)
 {
     *out = NULL;
@@ -469,6 +481,12 @@ es_status es_point_parse(es_ctx *ctx, const char *text, es_point_expr **out)
             rc = perr(&p, 0, "the expression is a number, not a point");
         }
     }
+    /* 1e300*1e300*mean: each number is finite, their product is not */
+    for (int64_t i = 0; rc == ES_OK && i < x->n; i++)
+        if (!isfinite(x->t[i].coef))
+            rc = es__fail(ctx, ES_ERANGE, "point: the coefficient of term %lld (%s%s) "
+                          "overflows", (long long)i + 1, leaf_prefix(x->t[i].kind),
+                          x->t[i].arg ? x->t[i].arg : "");
     if (rc != ES_OK) {
         es_point_expr_free(x);
         return rc;
@@ -489,17 +507,6 @@ void es_point_expr_term(const es_point_expr *x, int64_t i, double *coef, es_poin
     if (index) *index = t->index;
 }
 
-static const char *leaf_prefix(es_point_leaf k)
-{
-    switch (k) {
-    case ES_POINT_MEAN: return "mean";
-    case ES_POINT_ROW: return "row:";
-    case ES_POINT_FILE: return "file:";
-    case ES_POINT_PC: return "pc:";
-    case ES_POINT_DIFF: return "diff:";
-    }
-    return "?";
-}
 
 es_status es_point_eval(es_ctx *ctx, const es_point_expr *x, int64_t E,
                         es_point_resolve_fn resolve, void *ud, const es_mesh *mesh, double *vec,
@@ -572,6 +579,19 @@ es_status es_point_eval_rows(es_ctx *ctx, const es_point_expr *x, int64_t E, int
     es__free(ctx, leaf);
     for (int64_t e = 0; e < E; e++) in.length_sum += vec[e];
     if (in.weight != 0) in.scale = wscale / in.weight;
+    /* finite terms can still sum past the largest double: such a point is
+     * refused here, not stored for a later step to trip over */
+    for (int64_t e = 0; e < E; e++)
+        if (!isfinite(vec[e]))
+            ES_FAIL(ctx, ES_ERANGE, "point: the length of edge %lld overflows (%g): the "
+                    "coefficients are too large", (long long)e, vec[e]);
+    for (int64_t r = 0; r < nrows; r++)
+        if (!isfinite(weights[r]))
+            ES_FAIL(ctx, ES_ERANGE, "point: the weight of row %lld overflows (%g): the "
+                    "coefficients are too large", (long long)r, weights[r]);
+    if (!isfinite(in.weight) || (in.weight != 0 && !isfinite(in.scale)))
+        ES_FAIL(ctx, ES_ERANGE, "point: the shapes' weights (sum %g) or scale (%g) overflow: "
+                "the coefficients are too large", in.weight, in.scale);
     if (fabs(in.weight - 1.0) > 1e-12)
         es__warn(ctx, "point: the shapes' weights sum to %g, not 1: the lengths sum to %g",
                  in.weight, in.length_sum);

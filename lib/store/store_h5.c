@@ -11,17 +11,31 @@
  */
 #include "store/store_pkg.h"
 
+#include <pthread.h>
 #include <stdarg.h>
+#include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
 
 #define CACHE_BYTES (16u << 20)
 
+/* HDF5's description of the cause. */
 static herr_t walk_cb(unsigned n, const H5E_error2_t *err, void *data)
 {
     char *buf = data;
-    if (n == 0 && err->desc) snprintf(buf, 200, "%s", err->desc);
+    const char *en;
+    if (n != 0 || !err->desc) return 0;
+    /* the file drivers' "file write failed: time = ..., filename = ...,
+     * file descriptor = 5, errno = 28, error message = ..." says, to a
+     * user, what failed and the system's reason */
+    if ((en = strstr(err->desc, "errno = ")) && strchr(err->desc, ':')) {
+        int e = atoi(en + 8);
+        snprintf(buf, 200, "%.*s: %s", (int)(strchr(err->desc, ':') - err->desc), err->desc,
+                 strerror(e));
+    } else {
+        snprintf(buf, 200, "%s", err->desc);   /* es__fail keeps it on one line */
+    }
     return 0;
 }
 
@@ -37,6 +51,29 @@ es_status es__h5_fail(es_ctx *ctx, es_status code, const char *fmt, ...)
     H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, walk_cb, inner);
     if (*inner) return es__fail(ctx, code, "%s (HDF5: %s)", msg, inner);
     return es__fail(ctx, code, "%s", msg);
+}
+
+/* At exit HDF5 closes what is left open; after some failures inside
+ * libhdf5 1.10 (an H5Dopen of a corrupt dataset leaks its datatype) that
+ * fails, and it prints "HDF5: infinite loop closing library" and a list of
+ * its interfaces to stderr unless error printing is off. The library never
+ * prints: this runs before HDF5's own exit handler (atexit order is the
+ * reverse of registration, and H5open registered HDF5's first) and turns
+ * the printing off for that last step only. */
+static void quiet_exit(void)
+{
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+}
+
+static void init_once(void)
+{
+    if (H5open() >= 0) atexit(quiet_exit);
+}
+
+void es__h5_init(void)
+{
+    static pthread_once_t once = PTHREAD_ONCE_INIT;
+    pthread_once(&once, init_once);
 }
 
 void es__h5_close(hid_t id)
@@ -199,122 +236,127 @@ es_status es__h5_write_attr_strs(es_ctx *ctx, hid_t obj, const char *key,
 es_status es__h5_read_attr_i64(es_ctx *ctx, hid_t obj, const char *objname, const char *key,
                                int64_t *v)
 {
-    hid_t a = H5Aopen(obj, key, H5P_DEFAULT);
+    hid_t a = H5Aopen(obj, key, H5P_DEFAULT), t = -1, sp = -1;
     es_status rc = ES_OK;
     if (a < 0) return es__h5_fail(ctx, ES_EFORMAT, "store: %s has no attribute '%s'", objname, key);
-    if (H5Aread(a, H5T_NATIVE_INT64, v) < 0)
+    /* one integer: H5Aread writes every element, so a crafted array would
+     * overrun v */
+    if ((t = H5Aget_type(a)) < 0 || (sp = H5Aget_space(a)) < 0 ||
+        H5Tget_class(t) != H5T_INTEGER || H5Sget_simple_extent_type(sp) == H5S_NULL ||
+        H5Sget_simple_extent_npoints(sp) != 1)
+        rc = es__fail(ctx, ES_EFORMAT, "store: attribute '%s' of %s is not one integer", key,
+                      objname);
+    else if (H5Aread(a, H5T_NATIVE_INT64, v) < 0)
         rc = es__h5_fail(ctx, ES_EFORMAT, "store: cannot read attribute '%s' of %s", key, objname);
+    es__h5_close(sp);
+    es__h5_close(t);
     H5Aclose(a);
     return rc;
 }
 
-/* Any string attribute (variable or fixed length) into buf, truncated. */
-es_status es__h5_read_attr_text(es_ctx *ctx, hid_t obj, const char *key, char *buf, size_t n)
+/* A string attribute through the store's own decoder (store_vlen.c); one
+ * integer or real as text. */
+es_status es__h5_read_attr_text(es_ctx *ctx, es__h5_raw *raw, hid_t obj, const char *key,
+                                char *buf, size_t n)
 {
-    hid_t a = -1, t = -1, mt = -1, sp = -1;
+    hid_t a = -1, t = -1, sp = -1;
     es_status rc = ES_OK;
+    H5T_class_t cls;
     if (n) buf[0] = '\0';
     if ((a = H5Aopen(obj, key, H5P_DEFAULT)) < 0 || (t = H5Aget_type(a)) < 0 ||
         (sp = H5Aget_space(a)) < 0) {
         rc = es__h5_fail(ctx, ES_ENOTFOUND, "store: no attribute '%s'", key);
         goto done;
     }
-    if (H5Tget_class(t) == H5T_STRING && H5Tis_variable_str(t) > 0) {
-        char *s = NULL;
-        if ((mt = es__h5_str_type()) < 0 || H5Sget_simple_extent_npoints(sp) != 1 ||
-            H5Aread(a, mt, &s) < 0) {
+    cls = H5Tget_class(t);
+    if (cls == H5T_STRING) {
+        char **s = NULL;
+        int64_t ns = 0;
+        if ((rc = es__h5_read_attr_strings(ctx, raw, obj, key, &s, &ns))) goto done;
+        if (ns != 1)
+            rc = es__fail(ctx, ES_EFORMAT, "store: attribute '%s' holds %lld strings, not one",
+                          key, (long long)ns);
+        else if (n)
+            snprintf(buf, n, "%s", s[0]);
+        for (int64_t i = 0; i < ns; i++) es__free(ctx, s[i]);
+        es__free(ctx, s);
+    } else if ((cls == H5T_INTEGER || cls == H5T_FLOAT) &&
+               H5Sget_simple_extent_type(sp) != H5S_NULL &&
+               H5Sget_simple_extent_npoints(sp) == 1) {
+        long long iv;
+        double dv;
+        if (H5Aread(a, cls == H5T_INTEGER ? H5T_NATIVE_LLONG : H5T_NATIVE_DOUBLE,
+                    cls == H5T_INTEGER ? (void *)&iv : (void *)&dv) < 0) {
             rc = es__h5_fail(ctx, ES_EFORMAT, "store: cannot read attribute '%s'", key);
             goto done;
         }
-        if (n) snprintf(buf, n, "%s", s ? s : "");
-        H5free_memory(s);
-    } else if (H5Tget_class(t) == H5T_STRING) {
-        size_t len = H5Tget_size(t);
-        char *tmp = es__malloc(ctx, len + 1);
-        if (!tmp) { rc = ES_ENOMEM; goto done; }
-        if ((mt = H5Tcopy(t)) < 0 || H5Aread(a, mt, tmp) < 0) {
-            es__free(ctx, tmp);
-            rc = es__h5_fail(ctx, ES_EFORMAT, "store: cannot read attribute '%s'", key);
-            goto done;
-        }
-        tmp[len] = '\0';
-        if (n) snprintf(buf, n, "%s", tmp);
-        es__free(ctx, tmp);
-    } else if (H5Tget_class(t) == H5T_INTEGER && H5Sget_simple_extent_npoints(sp) == 1) {
-        long long v;
-        if (H5Aread(a, H5T_NATIVE_LLONG, &v) < 0) {
-            rc = es__h5_fail(ctx, ES_EFORMAT, "store: cannot read attribute '%s'", key);
-            goto done;
-        }
-        if (n) snprintf(buf, n, "%lld", v);
-    } else if (H5Tget_class(t) == H5T_FLOAT && H5Sget_simple_extent_npoints(sp) == 1) {
-        double v;
-        if (H5Aread(a, H5T_NATIVE_DOUBLE, &v) < 0) {
-            rc = es__h5_fail(ctx, ES_EFORMAT, "store: cannot read attribute '%s'", key);
-            goto done;
-        }
-        if (n) snprintf(buf, n, "%.17g", v);
+        if (n && cls == H5T_INTEGER) snprintf(buf, n, "%lld", iv);
+        else if (n) snprintf(buf, n, "%.17g", dv);
     } else {
         rc = es__fail(ctx, ES_EFORMAT, "store: attribute '%s' is not a string or scalar", key);
     }
 done:
-    es__h5_close(mt);
     es__h5_close(sp);
     es__h5_close(t);
     es__h5_close(a);
     return rc;
 }
 
-/* A whole 1-D string dataset into n freshly allocated C strings. */
-es_status es__h5_read_strings(es_ctx *ctx, hid_t loc, const char *name, int64_t n, char **out)
+uint64_t es__h5_covered_bytes(hid_t ds, int rank, uint64_t elem)
 {
-    hid_t ds = -1, sp = -1, t = -1;
-    hsize_t d = 0;
-    char **raw = NULL;
-    es_status rc = ES_OK;
-    if ((ds = es__h5_open_ds(loc, name)) < 0 || (sp = H5Dget_space(ds)) < 0 ||
-        H5Sget_simple_extent_ndims(sp) != 1) {
-        rc = es__h5_fail(ctx, ES_EFORMAT, "store: cannot open string dataset '%s'", name);
-        goto done;
+    hid_t dcpl = H5Dget_create_plist(ds), sp = H5Dget_space(ds);
+    hsize_t cd[3] = {1, 1, 1}, nchunks = 0;
+    uint64_t have = H5Dget_storage_size(ds), per = elem;
+    /* (1.10.8's H5Dget_num_chunks refuses H5S_ALL: the dataset's space) */
+    if (dcpl >= 0 && H5Pget_nfilters(dcpl) > 0 && H5Pget_layout(dcpl) == H5D_CHUNKED &&
+        rank >= 1 && rank <= 3 && H5Pget_chunk(dcpl, rank, cd) == rank && sp >= 0 &&
+        H5Dget_num_chunks(ds, sp, &nchunks) >= 0) {
+        for (int k = 0; k < rank; k++)
+            if (__builtin_mul_overflow(per, (uint64_t)cd[k], &per)) per = UINT64_MAX;
+        if (__builtin_mul_overflow(per, (uint64_t)nchunks, &have)) have = UINT64_MAX;
     }
-    H5Sget_simple_extent_dims(sp, &d, NULL);
-    if ((int64_t)d != n) {
-        rc = es__fail(ctx, ES_EFORMAT, "store: dataset '%s' has %llu rows, expected %lld",
-                      name, (unsigned long long)d, (long long)n);
-        goto done;
-    }
-    if (n == 0) goto done;
-    if (!(raw = es__alloc_array(ctx, n, sizeof *raw))) { rc = ES_ENOMEM; goto done; }
-    if ((t = es__h5_str_type()) < 0 || H5Dread(ds, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, raw) < 0) {
-        rc = es__h5_fail(ctx, ES_EFORMAT, "store: cannot read dataset '%s'", name);
-        es__free(ctx, raw);
-        raw = NULL;
-        goto done;
-    }
-    for (int64_t i = 0; i < n; i++) {
-        out[i] = es__strdup(ctx, raw[i] ? raw[i] : "");
-        if (!out[i]) { rc = ES_ENOMEM; break; }
-    }
-    H5Dvlen_reclaim(t, sp, H5P_DEFAULT, raw);
-done:
-    es__free(ctx, raw);
-    es__h5_close(t);
     es__h5_close(sp);
-    es__h5_close(ds);
-    return rc;
+    es__h5_close(dcpl);
+    return have;
 }
 
-int64_t es__h5_dataset_rows(hid_t loc, const char *name, int rank_want, hsize_t *dims)
+es_status es__h5_check_chunks(es_ctx *ctx, hid_t ds, const char *path, const char *name,
+                               uint64_t elem)
 {
-    hid_t ds = H5Dopen2(loc, name, H5P_DEFAULT), sp = -1;
-    int64_t r = -1;
-    if (ds >= 0 && (sp = H5Dget_space(ds)) >= 0 &&
-        H5Sget_simple_extent_ndims(sp) == rank_want &&
-        H5Sget_simple_extent_dims(sp, dims, NULL) >= 0)
-        r = (int64_t)dims[0];
+    hid_t dcpl = H5Dget_create_plist(ds), sp = H5Dget_space(ds);
+    hsize_t cd[8], dims[8], maxd[8], n = 0, off[8], size = 0;
+    haddr_t addr;
+    unsigned mask;
+    uint64_t nominal = elem;
+    es_status rc = ES_OK;
+    int rank;
+    if (dcpl < 0 || sp < 0 || (rank = H5Sget_simple_extent_dims(sp, dims, maxd)) < 0 ||
+        rank > 8) {
+        rc = es__h5_fail(ctx, ES_EFORMAT, "store: '%s': cannot read the layout of %s", path, name);
+        goto done;
+    }
+    if (H5Pget_layout(dcpl) != H5D_CHUNKED) goto done;
+    /* chunks within the fixed dimensions (HDF5 makes them so; a changed byte
+     * of the layout message made a 6 KB chunk of positions claim 12 MB, and
+     * libhdf5 1.10 read it past its buffer), and a stored chunk of the size
+     * they make when nothing compresses it */
+    if (H5Pget_chunk(dcpl, rank, cd) != rank) goto bad;
+    for (int k = 0; k < rank; k++)
+        if (cd[k] < 1 || (maxd[k] != H5S_UNLIMITED && cd[k] > maxd[k]) ||
+            __builtin_mul_overflow(nominal, (uint64_t)cd[k], &nominal))
+            goto bad;
+    if (nominal > ((uint64_t)1 << 32)) goto bad;
+    if (H5Pget_nfilters(dcpl) == 0 && H5Dget_num_chunks(ds, sp, &n) >= 0 && n > 0 &&
+        (H5Dget_chunk_info(ds, sp, 0, off, &mask, &addr, &size) < 0 || size != nominal))
+        goto bad;
+    goto done;
+bad:
+    rc = es__fail(ctx, ES_EFORMAT, "store: '%s' is corrupt: the chunks of %s do not fit it", path,
+                  name);
+done:
     es__h5_close(sp);
-    es__h5_close(ds);
-    return r;
+    es__h5_close(dcpl);
+    return rc;
 }
 
 hid_t es__h5_file_access(void)

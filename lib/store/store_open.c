@@ -5,157 +5,50 @@
  * One HDF5 file: a format version at the root, the topology, per-shape rows
  * (normalized lengths N x E, scales, positions N x V x 3, ids, source paths,
  * content hashes), string label columns, and analysis results with their
- * provenance. Opening reads the row metadata (ids, paths, hashes, labels)
- * into the handle once, checking the shape of every dataset against the
- * topology, so the getters never touch the file and a store that does not
- * fit its format is refused at open rather than half-way through a study.
+ * provenance. Opening (es__store_load, store_load.c) checks every dataset
+ * against the others and reads the row metadata into the handle once, so
+ * the getters never touch the file and a store that does not fit its format
+ * is refused at open rather than half-way through a study.
  * Every public entry point runs with HDF5's error printing off
  * (H5E_BEGIN_TRY/H5E_END_TRY).
  */
+#define _GNU_SOURCE   /* memfd_create */
 #include "store/store_pkg.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
-/* Version 1: meshes only. Version 2 adds the root attribute topology_kind
- * ("mesh", "truss", "none"): faces may be empty (truss: an edge list of
- * landmark pairs), and so may edges (none: landmark configurations only, no
- * /shapes/lengths or /shapes/scales). Mesh stores are still written as
- * version 1, byte-compatible with earlier releases; both versions are read. */
-#define FORMAT_VERSION 1
-#define FORMAT_VERSION_KIND 2
-
-static es_status load_columns(es_store *s)
+/* A working copy that is thrown away (an aborted or failed write) is closed
+ * into a memory file. Closing flushes HDF5's caches, and when that write
+ * fails too (the disk is full: the very failure being handled) libhdf5
+ * 1.10.8 frees the file but keeps its identifier, then crashes at exit
+ * closing it again (HDFFV-11052, fixed in 1.10.10). What the flush writes
+ * into the memory file is deleted with it. A file size limit (RLIMIT_FSIZE)
+ * applies to memory files too, so only that fault still reaches the bug. */
+static void close_discarded(hid_t file)
 {
-    es_ctx *ctx = s->ctx;
-    hid_t g = -1, a = -1, sp = -1, t = -1;
-    hssize_t n = 0;
-    char **raw = NULL;
-    es_status rc = ES_OK;
-    if ((g = H5Gopen2(s->file, "/labels", H5P_DEFAULT)) < 0 ||
-        (a = H5Aopen(g, "columns", H5P_DEFAULT)) < 0 || (sp = H5Aget_space(a)) < 0) {
-        rc = es__h5_fail(ctx, ES_EFORMAT, "store: '%s': /labels lacks its 'columns' attribute",
-                         s->path);
-        goto done;
-    }
-    n = H5Sget_simple_extent_type(sp) == H5S_NULL ? 0 : H5Sget_simple_extent_npoints(sp);
-    if (n > 0) {
-        if (!(raw = es__alloc_array(ctx, n, sizeof *raw)) ||
-            !(s->colnames = es__alloc_array(ctx, n, sizeof *s->colnames)) ||
-            !(s->labels = es__alloc_array(ctx, n, sizeof *s->labels))) {
-            rc = ES_ENOMEM;
-            goto done;
-        }
-        if ((t = es__h5_str_type()) < 0 || H5Aread(a, t, raw) < 0) {
-            rc = es__h5_fail(ctx, ES_EFORMAT, "store: cannot read /labels columns");
-            goto done;
-        }
-        s->ncols = n;
-        for (hssize_t c = 0; c < n && rc == ES_OK; c++)
-            if (!(s->colnames[c] = es__strdup(ctx, raw[c] ? raw[c] : ""))) rc = ES_ENOMEM;
-        H5Dvlen_reclaim(t, sp, H5P_DEFAULT, raw);
-        for (hssize_t c = 0; c < n && rc == ES_OK; c++) {
-            if (!(s->labels[c] = es__alloc_array(ctx, s->cap ? s->cap : 1, sizeof(char *))))
-                rc = ES_ENOMEM;
-            else
-                rc = es__h5_read_strings(ctx, g, s->colnames[c], s->nrows, s->labels[c]);
-        }
-    }
-done:
-    es__free(ctx, raw);
-    es__h5_close(t);
-    es__h5_close(sp);
-    es__h5_close(a);
-    es__h5_close(g);
-    return rc;
-}
-
-/* Check the format version and the shapes of every dataset; load ids,
- * source paths, hashes and labels. */
-static es_status load(es_store *s)
-{
-    es_ctx *ctx = s->ctx;
-    int64_t version = 0, n;
-    hsize_t dims[3];
-    es_status rc;
-    hid_t g;
-    char fp[64];
-    if ((rc = es__h5_read_attr_i64(ctx, s->file, "the root group", "format_version", &version)))
-        return es__fail(ctx, ES_EFORMAT, "store: '%s' is not an edgespace store (%s)",
-                        s->path, es_ctx_errmsg(ctx));
-    if (version != FORMAT_VERSION && version != FORMAT_VERSION_KIND)
-        ES_FAIL(ctx, ES_EFORMAT, "store: '%s' has format version %lld; this edgespace reads "
-                "versions %d and %d", s->path, (long long)version, FORMAT_VERSION,
-                FORMAT_VERSION_KIND);
-    s->kind = ES_TOPOLOGY_MESH;
-    if (version == FORMAT_VERSION_KIND) {
-        char kind[16];
-        if (es__h5_read_attr_text(ctx, s->file, "topology_kind", kind, sizeof kind))
-            ES_FAIL(ctx, ES_EFORMAT, "store: '%s' has format version 2 but no topology_kind "
-                    "attribute", s->path);
-        if (!strcmp(kind, "mesh")) s->kind = ES_TOPOLOGY_MESH;
-        else if (!strcmp(kind, "truss")) s->kind = ES_TOPOLOGY_TRUSS;
-        else if (!strcmp(kind, "none")) s->kind = ES_TOPOLOGY_NONE;
-        else
-            ES_FAIL(ctx, ES_EFORMAT, "store: '%s' has topology_kind '%s' (want mesh, truss or "
-                    "none)", s->path, kind);
-    }
-    if ((g = H5Gopen2(s->file, "/topology", H5P_DEFAULT)) < 0)
-        return es__h5_fail(ctx, ES_EFORMAT, "store: '%s' has no /topology", s->path);
-    rc = es__h5_read_attr_i64(ctx, g, "/topology", "nverts", &s->nverts);
-    if (!rc) rc = es__h5_read_attr_text(ctx, g, "fingerprint", fp, sizeof fp);
-    H5Gclose(g);
-    if (rc) return rc;
-    snprintf(s->fingerprint, sizeof s->fingerprint, "%.16s", fp);
-    if ((s->nfaces = es__h5_dataset_rows(s->file, "/topology/faces", 2, dims)) < 0 ||
-        dims[1] != 3)
-        ES_FAIL(ctx, ES_EFORMAT, "store: '%s': /topology/faces is not F x 3", s->path);
-    if ((s->nedges = es__h5_dataset_rows(s->file, "/topology/edges", 2, dims)) < 0 ||
-        dims[1] != 2)
-        ES_FAIL(ctx, ES_EFORMAT, "store: '%s': /topology/edges is not E x 2", s->path);
-    if ((s->kind == ES_TOPOLOGY_MESH) != (s->nfaces > 0) ||
-        (s->kind == ES_TOPOLOGY_NONE) != (s->nedges == 0))
-        ES_FAIL(ctx, ES_EFORMAT, "store: '%s': topology kind '%s' with %lld faces and %lld "
-                "edges", s->path, es_topology_kind_name(s->kind), (long long)s->nfaces,
-                (long long)s->nedges);
-    if (s->kind == ES_TOPOLOGY_NONE) {
-        n = es__h5_dataset_rows(s->file, "/shapes/positions", 3, dims);
-        if (n < 0 || (int64_t)dims[1] != s->nverts || dims[2] != 3)
-            ES_FAIL(ctx, ES_EFORMAT, "store: '%s': /shapes/positions is not N x %lld x 3",
-                    s->path, (long long)s->nverts);
-    } else if ((n = es__h5_dataset_rows(s->file, "/shapes/lengths", 2, dims)) < 0 ||
-               (int64_t)dims[1] != s->nedges) {
-        ES_FAIL(ctx, ES_EFORMAT, "store: '%s': /shapes/lengths is not N x %lld", s->path,
-                (long long)s->nedges);
-    }
-    if (es__h5_dataset_rows(s->file, "/shapes/positions", 3, dims) != n ||
-        (int64_t)dims[1] != s->nverts || dims[2] != 3)
-        ES_FAIL(ctx, ES_EFORMAT, "store: '%s': /shapes/positions is not %lld x %lld x 3",
-                s->path, (long long)n, (long long)s->nverts);
-    if (s->kind != ES_TOPOLOGY_NONE &&
-        es__h5_dataset_rows(s->file, "/shapes/scales", 1, dims) != n)
-        ES_FAIL(ctx, ES_EFORMAT, "store: '%s': /shapes/scales does not have %lld rows",
-                s->path, (long long)n);
-    s->nrows = 0;
-    if ((rc = es__store_reserve_rows(s, n > 0 ? n : 1))) return rc;
-    s->nrows = n;
-    if ((rc = es__h5_read_strings(ctx, s->file, "/shapes/ids", n, s->ids)) ||
-        (rc = es__h5_read_strings(ctx, s->file, "/shapes/source_paths", n, s->sources)) ||
-        (rc = es__h5_read_strings(ctx, s->file, "/shapes/content_hash", n, s->hashes)) ||
-        (rc = es__store_index_ids(s)))
-        return rc;
-    return load_columns(s);
+#if defined(__linux__) && defined(MFD_CLOEXEC)
+    void *h = NULL;
+    int sink = memfd_create("edgespace-discarded", MFD_CLOEXEC);
+    if (sink >= 0 && H5Fget_vfd_handle(file, H5P_DEFAULT, &h) >= 0 && h)
+        dup2(sink, *(int *)h);
+    if (sink >= 0) close(sink);
+#endif
+    H5Fclose(file);
 }
 
 static void release(es_store *s, bool keep_work)
 {
     if (!s) return;
     es_ctx *ctx = s->ctx;
-    if (s->file >= 0) H5Fclose(s->file);
+    if (s->file >= 0 && s->work && !keep_work) close_discarded(s->file);
+    else if (s->file >= 0) H5Fclose(s->file);
     s->file = -1;
     if (s->work && !keep_work) unlink(s->work);
     es__store_free_rows(s);
@@ -172,7 +65,7 @@ static es_status open_impl(es_ctx *ctx, const char *path, es_store_mode mode, es
     hid_t fapl;
     *out = NULL;
     if (!path || !*path) ES_FAIL(ctx, ES_EINVAL, "store: empty path");
-    if (mode != ES_STORE_READ && mode != ES_STORE_WRITE)
+    if (mode != ES_STORE_READ && mode != ES_STORE_WRITE && mode != ES_STORE_REPLACE)
         ES_FAIL(ctx, ES_EINVAL, "store: bad open mode %d", (int)mode);
     if (access(path, F_OK) != 0)
         ES_FAIL(ctx, errno == ENOENT ? ES_ENOTFOUND : ES_EIO, "store: cannot open '%s': %s",
@@ -199,7 +92,7 @@ static es_status open_impl(es_ctx *ctx, const char *path, es_store_mode mode, es
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot open '%s'", path);
         goto fail;
     }
-    if ((rc = load(s))) goto fail;
+    if ((rc = es__store_load(s))) goto fail;
     *out = s;
     return ES_OK;
 fail:
@@ -210,6 +103,7 @@ fail:
 es_status es_store_open(es_ctx *ctx, const char *path, es_store_mode mode, es_store **out)
 {
     es_status rc;
+    es__h5_init();
     H5E_BEGIN_TRY { rc = open_impl(ctx, path, mode, out); } H5E_END_TRY
     return rc;
 }
@@ -283,8 +177,8 @@ static es_status create_impl(es_ctx *ctx, const char *path, int64_t nverts, int6
     gmtime_r(&now, &tmv);
     strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", &tmv);
     if ((rc = es__h5_write_attr_i64(ctx, s->file, "format_version",
-                                    s->kind == ES_TOPOLOGY_MESH ? FORMAT_VERSION
-                                                         : FORMAT_VERSION_KIND)) ||
+                                    s->kind == ES_TOPOLOGY_MESH ? ES__FORMAT_VERSION
+                                                         : ES__FORMAT_VERSION_KIND)) ||
         (rc = es__h5_write_attr_str(ctx, s->file, "creator", "edgespace " ES_VERSION_STRING)) ||
         (rc = es__h5_write_attr_str(ctx, s->file, "created", when)) ||
         (s->kind != ES_TOPOLOGY_MESH &&
@@ -349,6 +243,7 @@ es_status es__store_create_raw(es_ctx *ctx, const char *path, int64_t nverts, in
                                const char *fingerprint, es_store **out)
 {
     es_status rc;
+    es__h5_init();
     H5E_BEGIN_TRY {
         rc = create_impl(ctx, path, nverts, nfaces, faces, nedges, edges, fingerprint, out);
     } H5E_END_TRY

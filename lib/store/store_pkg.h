@@ -21,6 +21,13 @@
 #include <stdint.h>
 #include <sys/stat.h>
 
+/* Format versions (datasets-spec/store-format.md): 1, meshes; 2 adds the
+ * root attribute topology_kind ("mesh", "truss", "none"). Mesh stores are
+ * still written as version 1, byte-compatible with earlier releases; both
+ * are read. */
+#define ES__FORMAT_VERSION 1
+#define ES__FORMAT_VERSION_KIND 2
+
 /* faces: 3 x nfaces, edges: 2 x nedges (as es_mesh_faces/es_mesh_edges),
  * fingerprint: 16 hex digits (es_mesh_fingerprint) or "". */
 es_status es__store_create_raw(es_ctx *ctx, const char *path, int64_t nverts, int64_t nfaces,
@@ -55,6 +62,9 @@ struct es_store {
 /* Record fmt plus the innermost message of HDF5's error stack and return
  * code. Call right after the failing HDF5 call, before any other. */
 es_status es__h5_fail(es_ctx *ctx, es_status code, const char *fmt, ...) ES__PRINTF(3, 4);
+/* Before the first HDF5 call of an entry point that opens or creates a
+ * file: keeps HDF5's exit handler from printing (store_h5.c). */
+void es__h5_init(void);
 /* Close any HDF5 identifier by its type; negative ids are ignored. */
 void es__h5_close(hid_t id);
 /* A variable-length UTF-8 string type (close it), or negative. */
@@ -77,18 +87,77 @@ es_status es__h5_write_attr_i64(es_ctx *ctx, hid_t obj, const char *key, int64_t
 es_status es__h5_write_attr_str(es_ctx *ctx, hid_t obj, const char *key, const char *v);
 es_status es__h5_write_attr_strs(es_ctx *ctx, hid_t obj, const char *key,
                                  const char *const *v, int64_t n);
-/* A scalar integer attribute; objname names obj in the message. */
+/* One integer attribute (a scalar or 1-element integer); objname names obj
+ * in the message. */
 es_status es__h5_read_attr_i64(es_ctx *ctx, hid_t obj, const char *objname, const char *key,
                                int64_t *v);
-/* Any string or scalar numeric attribute as text into buf[n], truncated;
- * ES_ENOTFOUND if absent. */
-es_status es__h5_read_attr_text(es_ctx *ctx, hid_t obj, const char *key, char *buf, size_t n);
-/* A whole 1-D string dataset of exactly n rows into n strings allocated
- * through ctx (out[i] owned by the caller, also on failure). */
-es_status es__h5_read_strings(es_ctx *ctx, hid_t loc, const char *name, int64_t n,
-                              char **out);
-/* Rows of a dataset of rank rank_want (its dims in dims), or -1. */
-int64_t es__h5_dataset_rows(hid_t loc, const char *name, int rank_want, hsize_t *dims);
+
+/* ---- strings read without trusting the file (store_vlen.c) ----
+ * libhdf5 1.10 trusts the global heap that holds variable-length strings
+ * (a changed byte crashed it); these decode the strings themselves and
+ * check every size against the heap and the file. A raw reader is opened on
+ * any object of the file (after a flush, so that it sees this handle's own
+ * writes) and keeps the heap collections it parsed until closed; path
+ * names the store in messages (borrowed). */
+typedef struct es__h5_raw es__h5_raw;
+es_status es__h5_raw_open(es_ctx *ctx, hid_t obj, const char *path, es__h5_raw **out);
+void es__h5_raw_close(es__h5_raw *raw);
+/* A whole 1-D string dataset (variable or fixed length) of exactly n rows
+ * into out[0..n) (allocated through ctx; the caller frees what is non-NULL,
+ * also on failure). */
+/* Bytes of one variable-length string descriptor on disk (16 with 8-byte
+ * addresses), and the file's size in bytes. */
+unsigned es__h5_raw_vlen_size(const es__h5_raw *raw);
+uint64_t es__h5_raw_file_size(const es__h5_raw *raw);
+es_status es__h5_read_strings(es_ctx *ctx, es__h5_raw *raw, hid_t loc, const char *name,
+                              int64_t n, char **out);
+/* Every string of a string attribute (a null dataspace: none). *out has *n
+ * strings, each and the array allocated through ctx. */
+es_status es__h5_read_attr_strings(es_ctx *ctx, es__h5_raw *raw, hid_t obj, const char *key,
+                                   char ***out, int64_t *n);
+/* Raw access for the structure checks (store_groups.c): n bytes at a file
+ * address, bounded by the file; little-endian numbers; the sizes of
+ * addresses and lengths. */
+es_status es__h5_raw_read(es__h5_raw *raw, uint64_t addr, uint64_t n, void *buf,
+                          const char *what);
+uint64_t es__h5_le(const uint8_t *p, unsigned n);
+unsigned es__h5_raw_addr_size(const es__h5_raw *raw);
+unsigned es__h5_raw_length_size(const es__h5_raw *raw);
+es_ctx *es__h5_raw_ctx(const es__h5_raw *raw);
+const char *es__h5_raw_path(const es__h5_raw *raw);
+/* Each message of an object header: return 0 to go on, 1 to stop (ES_OK),
+ * -1 if it is malformed (ES_EFORMAT). ES_ENOTFOUND when no call stopped. */
+typedef int (*es__h5_msg_fn)(void *ud, unsigned type, const uint8_t *msg, uint64_t n);
+es_status es__h5_raw_messages(es__h5_raw *raw, uint64_t oaddr, es__h5_msg_fn fn, void *ud);
+/* The object header address of an open object (group, dataset, file: its
+ * root group). */
+es_status es__h5_object_addr(es_ctx *ctx, hid_t obj, uint64_t *addr);
+/* Check the symbol table of an old-style group (its v1 B-tree, symbol
+ * nodes and local heap; store_groups.c) before HDF5 looks anything up in
+ * it: libhdf5 1.10 follows a local heap free list that loops until memory
+ * runs out (24 GB for three changed bytes) and B-tree children without
+ * bound. A group with links in its header (new style) has nothing to check. */
+es_status es__h5_check_group(es__h5_raw *raw, hid_t group, const char *name);
+/* Check every attribute message of obj (name: for messages) before HDF5
+ * decodes them (store_groups.c): libhdf5 1.10 copies an attribute's value
+ * at the size its dataspace and datatype claim, past the message if they
+ * claim more. */
+es_status es__h5_check_attrs(es__h5_raw *raw, hid_t obj, const char *name);
+/* A string attribute, or one integer or real as text, into buf[n],
+ * truncated; ES_ENOTFOUND if absent. */
+es_status es__h5_read_attr_text(es_ctx *ctx, es__h5_raw *raw, hid_t obj, const char *key,
+                                char *buf, size_t n);
+/* A chunked dataset's chunks within its fixed dimensions, and its first
+ * stored chunk of the size they make when nothing compresses it (elem:
+ * bytes an element on disk); ES_OK for other layouts. Checked before HDF5
+ * reads it: libhdf5 1.10 reads a chunk at the size its layout claims. */
+es_status es__h5_check_chunks(es_ctx *ctx, hid_t ds, const char *path, const char *name,
+                               uint64_t elem);
+/* Bytes of dataset ds (rank 1..3, elem bytes an element) that the file
+ * holds: its storage, or for a compressed (filtered) one the uncompressed
+ * size of its allocated chunks. A count larger than this is refused before
+ * anything of its size is allocated. */
+uint64_t es__h5_covered_bytes(hid_t ds, int rank, uint64_t elem);
 /* A name HDF5 cannot take as one link: NULL, empty, ".", ".." or with '/'. */
 bool es__h5_bad_name(const char *name);
 
@@ -110,9 +179,11 @@ es_status es__store_publish(es_ctx *ctx, es_store *s);
 
 /* Free ids, sources, hashes, labels, column names and the id map. */
 void es__store_free_rows(es_store *s);
+/* Check what the file holds and load the row metadata (store_load.c). */
+es_status es__store_load(es_store *s);
 /* Grow the per-row arrays to hold `need` rows; new slots are NULL. */
 es_status es__store_reserve_rows(es_store *s, int64_t need);
-/* Map each of the s->nrows loaded ids to its row (the first of repeats). */
+/* Map each of the s->nrows loaded ids to its row; ES_EFORMAT on a repeat. */
 es_status es__store_index_ids(es_store *s);
 
 #endif

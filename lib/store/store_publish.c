@@ -150,7 +150,7 @@ es_status es__store_begin_write(es_store *s)
     es_ctx *ctx = s->ctx;
     es_status rc;
     hid_t fapl;
-    if (s->mode != ES_STORE_WRITE)
+    if (s->mode == ES_STORE_READ)
         ES_FAIL(ctx, ES_EINVAL, "store: '%s' is open read-only", s->path);
     if (s->broken)
         ES_FAIL(ctx, ES_EIO, "store: an earlier write to '%s' failed; reopen the store",

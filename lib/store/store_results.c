@@ -38,26 +38,72 @@ static int split_path(es_ctx *ctx, const char *path, char parts[8][128], es_stat
     return n;
 }
 
-static bool link_exists(hid_t file, const char *full)
+/* Whether every component of full exists. Each group below /analysis is
+ * checked (store_groups.c) before HDF5 looks the next name up in it: a
+ * result's groups come from the file like everything else. ES_OK with
+ * *exists, or the check's refusal. */
+static es_status find_link(es_ctx *ctx, es_store *s, const char *full, bool *exists)
 {
     char buf[1200];
     size_t n = strlen(full);
-    if (n >= sizeof buf) return false;
+    int depth = 0;
+    es__h5_raw *raw = NULL;
+    es_status rc = ES_OK;
+    *exists = false;
+    if (n >= sizeof buf) return ES_OK;
     memcpy(buf, full, n + 1);
-    for (char *p = buf + 1;; p++) {
-        if (*p == '/' || *p == '\0') {
-            char save = *p;
-            *p = '\0';
-            if (H5Lexists(file, buf, H5P_DEFAULT) <= 0) return false;
-            if (!save) return true;
-            *p = save;
+    for (char *p = buf + 1; rc == ES_OK; p++) {
+        if (*p != '/' && *p != '\0') continue;
+        char save = *p;
+        *p = '\0';
+        if (H5Lexists(s->file, buf, H5P_DEFAULT) <= 0) break;
+        if (!save) {
+            *exists = true;
+            break;
         }
+        if (++depth >= 2) {   /* /analysis itself was checked at open */
+            hid_t g = H5Gopen2(s->file, buf, H5P_DEFAULT);
+            if (g >= 0) {
+                if (raw || (rc = es__h5_raw_open(ctx, g, s->path, &raw)) == ES_OK)
+                    rc = es__h5_check_group(raw, g, buf);
+                H5Gclose(g);
+            }
+        }
+        *p = save;
     }
+    es__h5_raw_close(raw);
+    return rc;
 }
 
 static void full_path(char *buf, size_t n, const char *rel)
 {
     snprintf(buf, n, "/analysis/%s", rel);
+}
+
+/* The name must be free unless the handle replaces results. */
+static es_status check_free(es_ctx *ctx, es_store *s, const char *kind, const char *name,
+                            bool *exists)
+{
+    char full[600];
+    if (es__h5_bad_name(kind) || es__h5_bad_name(name) || strlen(kind) > 120 || strlen(name) > 120)
+        ES_FAIL(ctx, ES_EINVAL, "store: bad result kind/name '%s/%s'", kind ? kind : "",
+                name ? name : "");
+    snprintf(full, sizeof full, "/analysis/%s/%s", kind, name);
+    es_status rc;
+    if ((rc = find_link(ctx, s, full, exists))) return rc;
+    if (*exists && s->mode != ES_STORE_REPLACE)
+        ES_FAIL(ctx, ES_EEXIST, "store: result %s/%s exists already in '%s' (give another name, "
+                "or --replace to replace it)", kind, name, s->path);
+    return ES_OK;
+}
+
+es_status es_store_result_check(es_ctx *ctx, es_store *s, const char *kind, const char *name)
+{
+    es_status rc;
+    bool exists;
+    if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    H5E_BEGIN_TRY { rc = check_free(ctx, s, kind, name, &exists); } H5E_END_TRY
+    return rc;
 }
 
 static es_status result_begin_impl(es_ctx *ctx, es_store *s, const char *kind, const char *name,
@@ -69,9 +115,8 @@ static es_status result_begin_impl(es_ctx *ctx, es_store *s, const char *kind, c
     time_t now = time(NULL);
     struct tm tmv;
     int64_t *all = NULL;
-    if (es__h5_bad_name(kind) || es__h5_bad_name(name) || strlen(kind) > 120 || strlen(name) > 120)
-        ES_FAIL(ctx, ES_EINVAL, "store: bad result kind/name '%s/%s'", kind ? kind : "",
-                name ? name : "");
+    bool exists;
+    if ((rc = check_free(ctx, s, kind, name, &exists))) return rc;
     if (!prov || !prov->command) ES_FAIL(ctx, ES_EINVAL, "store: a result needs provenance");
     if (prov->rows)
         for (int64_t i = 0; i < prov->nrows; i++)
@@ -80,7 +125,7 @@ static es_status result_begin_impl(es_ctx *ctx, es_store *s, const char *kind, c
                         (long long)prov->rows[i]);
     if ((rc = es__store_begin_write(s))) return rc;
     snprintf(full, sizeof full, "/analysis/%s/%s", kind, name);
-    if (link_exists(s->file, full) && H5Ldelete(s->file, full, H5P_DEFAULT) < 0) {
+    if (exists && H5Ldelete(s->file, full, H5P_DEFAULT) < 0) {
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot replace %s", full);
         goto fail;
     }
@@ -147,16 +192,19 @@ static es_status put_prepare(es_ctx *ctx, es_store *s, const char *path, char *f
 {
     char parts[8][128], group[600];
     es_status rc;
+    bool e;
     int np = split_path(ctx, path, parts, &rc);
     if (np < 0) return rc;
     if (np < 3) ES_FAIL(ctx, ES_EINVAL, "store: '%s' is not kind/name/dataset", path);
     if ((rc = es__store_begin_write(s))) return rc;
     snprintf(group, sizeof group, "/analysis/%s/%s", parts[0], parts[1]);
-    if (!link_exists(s->file, group))
+    if ((rc = find_link(ctx, s, group, &e))) return rc;
+    if (!e)
         ES_FAIL(ctx, ES_ENOTFOUND, "store: result %s/%s was not begun "
                 "(es_store_result_begin)", parts[0], parts[1]);
     full_path(full, n, path);
-    if (link_exists(s->file, full) && H5Ldelete(s->file, full, H5P_DEFAULT) < 0) {
+    if ((rc = find_link(ctx, s, full, &e))) return rc;
+    if (e && H5Ldelete(s->file, full, H5P_DEFAULT) < 0) {
         s->broken = true;
         return es__h5_fail(ctx, ES_EIO, "store: cannot replace %s", full);
     }
@@ -257,17 +305,24 @@ static es_status put_attr_impl(es_ctx *ctx, es_store *s, const char *path, const
     char parts[8][128], full[700];
     es_status rc;
     hid_t obj;
+    bool e;
     int np = split_path(ctx, path, parts, &rc);
     if (np < 0) return rc;
     if (np < 2 || !key || !*key || !value)
         ES_FAIL(ctx, ES_EINVAL, "store: bad attribute '%s' on '%s'", key ? key : "", path);
     if ((rc = es__store_begin_write(s))) return rc;
     full_path(full, sizeof full, path);
-    if (!link_exists(s->file, full))
-        ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
+    if ((rc = find_link(ctx, s, full, &e))) return rc;
+    if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
     if ((obj = H5Oopen(s->file, full, H5P_DEFAULT)) < 0)
         return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
-    rc = es__h5_write_attr_str(ctx, obj, key, value);
+    {
+        es__h5_raw *raw = NULL;
+        if ((rc = es__h5_raw_open(ctx, obj, s->path, &raw)) == ES_OK)
+            rc = es__h5_check_attrs(raw, obj, full);
+        es__h5_raw_close(raw);
+    }
+    if (rc == ES_OK) rc = es__h5_write_attr_str(ctx, obj, key, value);
     H5Oclose(obj);
     if (rc) s->broken = true;
     return rc;
@@ -289,9 +344,11 @@ static es_status get_open(es_ctx *ctx, es_store *s, const char *path, int rank, 
     char parts[8][128], full[700];
     es_status rc;
     hid_t sp;
+    bool e;
     if (split_path(ctx, path, parts, &rc) < 0) return rc;
     full_path(full, sizeof full, path);
-    if (!link_exists(s->file, full)) ES_FAIL(ctx, ES_ENOTFOUND, "store: no dataset %s", full);
+    if ((rc = find_link(ctx, s, full, &e))) return rc;
+    if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no dataset %s", full);
     if ((*ds = H5Dopen2(s->file, full, H5P_DEFAULT)) < 0)
         return es__h5_fail(ctx, ES_EFORMAT, "store: %s is not a dataset", full);
     sp = H5Dget_space(*ds);
@@ -310,27 +367,42 @@ static es_status get_impl(es_ctx *ctx, es_store *s, const char *path, int rank, 
                           size_t elem, void **data, int64_t *d0, int64_t *d1)
 {
     hsize_t dims[2] = {0, 1};
-    hid_t ds = -1;
+    hid_t ds = -1, t = -1;
     int64_t total;
+    uint64_t need;
     es_status rc = get_open(ctx, s, path, rank, dims, &ds);
     *data = NULL;
     if (rc) return rc;
-    if (!es__mul_i64((int64_t)dims[0], (int64_t)dims[1], &total)) {
-        H5Dclose(ds);
-        ES_FAIL(ctx, ES_ERANGE, "store: %s is too large", path);
+    /* a number dataset whose storage holds all of it: a crafted dataspace
+     * must not size an allocation the file cannot fill */
+    if ((t = H5Dget_type(ds)) < 0 ||
+        (H5Tget_class(t) != H5T_FLOAT && H5Tget_class(t) != H5T_INTEGER)) {
+        rc = es__fail(ctx, ES_EFORMAT, "store: '%s': /analysis/%s is not numbers", s->path, path);
+        goto done;
+    }
+    if ((rc = es__h5_check_chunks(ctx, ds, s->path, path, H5Tget_size(t)))) goto done;
+    if (!es__mul_i64((int64_t)dims[0], (int64_t)dims[1], &total) || total < 0 ||
+        __builtin_mul_overflow((uint64_t)total, (uint64_t)H5Tget_size(t), &need) ||
+        es__h5_covered_bytes(ds, rank, H5Tget_size(t)) < need) {
+        rc = es__fail(ctx, ES_EFORMAT, "store: '%s' is corrupt: /analysis/%s claims more values "
+                      "than the file holds", s->path, path);
+        goto done;
     }
     if (!(*data = es__alloc_array(ctx, total ? total : 1, elem))) {
-        H5Dclose(ds);
-        return ES_ENOMEM;
+        rc = ES_ENOMEM;
+        goto done;
     }
     if (total > 0 && H5Dread(ds, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, *data) < 0) {
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot read %s", path);
         es__free(ctx, *data);
         *data = NULL;
+        goto done;
     }
-    H5Dclose(ds);
     *d0 = (int64_t)dims[0];
     if (d1) *d1 = (int64_t)dims[1];
+done:
+    es__h5_close(t);
+    H5Dclose(ds);
     return rc;
 }
 
@@ -383,16 +455,34 @@ static es_status get_attr_impl(es_ctx *ctx, es_store *s, const char *path, const
     char parts[8][128], full[700];
     es_status rc;
     hid_t obj;
+    bool e;
     if (split_path(ctx, path, parts, &rc) < 0) return rc;
     full_path(full, sizeof full, path);
-    if (!link_exists(s->file, full)) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
+    if ((rc = find_link(ctx, s, full, &e))) return rc;
+    if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
     if ((obj = H5Oopen(s->file, full, H5P_DEFAULT)) < 0)
         return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
+    /* HDF5 decodes every attribute of the object to find one: checked first */
+    {
+        es__h5_raw *raw = NULL;
+        if ((rc = es__h5_raw_open(ctx, obj, s->path, &raw)) == ES_OK)
+            rc = es__h5_check_attrs(raw, obj, full);
+        es__h5_raw_close(raw);
+        if (rc) {
+            H5Oclose(obj);
+            return rc;
+        }
+    }
     if (H5Aexists(obj, key) <= 0) {
         H5Oclose(obj);
         ES_FAIL(ctx, ES_ENOTFOUND, "store: %s has no attribute '%s'", full, key);
     }
-    rc = es__h5_read_attr_text(ctx, obj, key, buf, n);
+    {
+        es__h5_raw *raw = NULL;
+        if ((rc = es__h5_raw_open(ctx, obj, s->path, &raw)) == ES_OK)
+            rc = es__h5_read_attr_text(ctx, raw, obj, key, buf, n);
+        es__h5_raw_close(raw);
+    }
     H5Oclose(obj);
     return rc;
 }
@@ -412,7 +502,10 @@ int es_store_has(es_store *s, const char *path)
     int r = 0;
     if (!s || !path || !*path) return 0;
     full_path(full, sizeof full, path);
-    H5E_BEGIN_TRY { r = link_exists(s->file, full) ? 1 : 0; } H5E_END_TRY
+    H5E_BEGIN_TRY {
+        bool e = false;
+        r = find_link(s->ctx, s, full, &e) == ES_OK && e;
+    } H5E_END_TRY
     return r;
 }
 
@@ -444,9 +537,23 @@ static es_status list_impl(es_ctx *ctx, es_store *s, const char *kind, char ***n
     if (kind && *kind && es__h5_bad_name(kind))
         ES_FAIL(ctx, ES_EINVAL, "store: bad result kind '%s'", kind);
     snprintf(full, sizeof full, "/analysis%s%s", kind && *kind ? "/" : "", kind ? kind : "");
-    if (!link_exists(s->file, full)) return ES_OK;
-    if ((g = H5Gopen2(s->file, full, H5P_DEFAULT)) < 0)
-        return es__h5_fail(ctx, ES_EFORMAT, "store: %s is not a group", full);
+    {
+        bool e;
+        es__h5_raw *raw = NULL;
+        es_status rc;
+        if ((rc = find_link(ctx, s, full, &e))) return rc;
+        if (!e) return ES_OK;
+        if ((g = H5Gopen2(s->file, full, H5P_DEFAULT)) < 0)
+            return es__h5_fail(ctx, ES_EFORMAT, "store: %s is not a group", full);
+        /* the group listed is searched by HDF5 too */
+        if (kind && *kind && ((rc = es__h5_raw_open(ctx, g, s->path, &raw)) ||
+                              (rc = es__h5_check_group(raw, g, full)))) {
+            es__h5_raw_close(raw);
+            H5Gclose(g);
+            return rc;
+        }
+        es__h5_raw_close(raw);
+    }
     if (H5Literate(g, H5_INDEX_NAME, H5_ITER_INC, NULL, list_cb, &l) < 0) {
         es_status rc = l.rc ? l.rc : es__h5_fail(ctx, ES_EIO, "store: cannot list %s", full);
         H5Gclose(g);

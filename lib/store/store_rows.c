@@ -10,6 +10,7 @@
  * handle broken so the half-written working copy is never published.
  */
 #include "store/store_pkg.h"
+#include "core/suggest.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -73,8 +74,13 @@ es_status es__store_index_ids(es_store *s)
     es_status rc;
     es__strmap_clear(s->ctx, &s->id_rows);
     if ((rc = es__strmap_init(s->ctx, &s->id_rows, s->nrows))) return rc;
-    for (int64_t i = 0; i < s->nrows; i++)
-        if ((rc = es__strmap_put(s->ctx, &s->id_rows, s->ids[i], i, NULL))) return rc;
+    for (int64_t i = 0; i < s->nrows; i++) {
+        int64_t prev;
+        if ((rc = es__strmap_put(s->ctx, &s->id_rows, s->ids[i], i, &prev))) return rc;
+        if (prev >= 0)
+            ES_FAIL(s->ctx, ES_EFORMAT, "store: '%s': /shapes/ids repeats '%s' (rows %lld and "
+                    "%lld)", s->path, s->ids[i], (long long)prev, (long long)i);
+    }
     return ES_OK;
 }
 
@@ -269,7 +275,8 @@ es_status es_store_read_positions(es_ctx *ctx, es_store *s, int64_t row, double 
     return rc;
 }
 
-/* Row i's values: a positive scale, finite lengths, every label given. */
+/* Row i's values: a positive scale, finite lengths and positions, every
+ * label given. */
 static es_status check_values(es_ctx *ctx, const es_store *s, const es_store_rows *r, int64_t i)
 {
     const char *id = r->ids[i];
@@ -280,6 +287,10 @@ static es_status check_values(es_ctx *ctx, const es_store *s, const es_store_row
         if (!isfinite(r->lengths[e + i * s->nedges]))
             ES_FAIL(ctx, ES_EINVAL, "store: row '%s' has a non-finite length at edge %lld", id,
                     (long long)e);
+    for (int64_t v = 0; v < 3 * s->nverts; v++)
+        if (!isfinite(r->xyz[v + i * 3 * s->nverts]))
+            ES_FAIL(ctx, ES_EINVAL, "store: row '%s' has a non-finite position at vertex %lld",
+                    id, (long long)(v / 3));
     for (int64_t c = 0; c < r->ncols; c++)
         if (!r->labels[i * r->ncols + c])
             ES_FAIL(ctx, ES_EINVAL, "store: row '%s' lacks a value for column '%s'", id,
@@ -438,6 +449,24 @@ es_status es_store_append(es_ctx *ctx, es_store *store, const es_store_rows *row
     return rc;
 }
 
+void es_store_column_hint(const es_store *s, const char *name, char *buf, size_t n)
+{
+    es__suggest sg;
+    es__suggest_init(&sg, name);
+    for (int64_t c = 0; s && c < s->ncols; c++) es__suggest_add(&sg, s->colnames[c]);
+    es__suggest_format(&sg, "columns", buf, n);
+}
+
+void es_store_value_hint(const es_store *s, int64_t col, const char *value, char *buf, size_t n)
+{
+    es__suggest sg;
+    es__suggest_init(&sg, value);
+    if (s && col < s->ncols && col >= -1)
+        for (int64_t i = 0; i < s->nrows; i++)
+            es__suggest_add(&sg, col < 0 ? s->ids[i] : s->labels[col][i]);
+    es__suggest_format(&sg, col < 0 ? "ids" : "values", buf, n);
+}
+
 es_status es_store_select(es_ctx *ctx, const es_store *s, const char *filter, int64_t **rows,
                           int64_t *nrows)
 {
@@ -468,10 +497,13 @@ es_status es_store_select(es_ctx *ctx, const es_store *s, const char *filter, in
         if (nterms == 32) ES_FAIL(ctx, ES_ERANGE, "store: more than 32 filter terms");
         snprintf(name, sizeof name, "%.*s", (int)(eq - p), p);
         if ((cols[nterms] = es_store_find_column(s, name)) < 0) {
+            char hint[400];
             if (!strcmp(name, "id")) cols[nterms] = -2;
-            else
-                ES_FAIL(ctx, ES_ENOTFOUND, "store: no label column '%s' in '%s'", name,
-                        s->path);
+            else {
+                es_store_column_hint(s, name, hint, sizeof hint);
+                ES_FAIL(ctx, ES_ENOTFOUND, "store: no label column '%s' in '%s'%s", name,
+                        s->path, hint);
+            }
         }
         vals[nterms] = eq + 1 + quoted;
         vlen[nterms] = (size_t)(end - eq - 1) - 2 * (size_t)quoted;
@@ -486,6 +518,22 @@ es_status es_store_select(es_ctx *ctx, const es_store *s, const char *filter, in
             ok = strlen(v) == vlen[k] && !memcmp(v, vals[k], vlen[k]);
         }
         if (ok) out[n++] = i;
+    }
+    /* nothing selected: a value no row has is most likely misspelt */
+    for (int64_t k = 0; n == 0 && k < nterms; k++) {
+        bool any = false;
+        for (int64_t i = 0; i < s->nrows && !any; i++) {
+            const char *v = cols[k] == -2 ? s->ids[i] : s->labels[cols[k]][i];
+            any = strlen(v) == vlen[k] && !memcmp(v, vals[k], vlen[k]);
+        }
+        if (!any && s->nrows > 0) {
+            char value[256], hint[400];
+            const int64_t col = cols[k] == -2 ? -1 : cols[k];
+            snprintf(value, sizeof value, "%.*s", (int)vlen[k], vals[k]);
+            es_store_value_hint(s, col, value, hint, sizeof hint);
+            es__warn(ctx, "store: no row has %s='%s'%s", col < 0 ? "id" : s->colnames[col],
+                     value, hint);
+        }
     }
     *rows = out;
     *nrows = n;

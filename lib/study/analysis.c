@@ -59,8 +59,14 @@ static int bad_name(const char *name)
     return 0;
 }
 
-#define CHECK_NAME(ctx, name) do { if ((name) && bad_name(name)) \
-    ES_FAIL(ctx, ES_EINVAL, "analysis: bad result name '%s' (no '/', not empty)", name); \
+/* A bad name, or one taken (not replaced without ES_STORE_REPLACE), is
+ * refused before anything is computed. */
+#define CHECK_NAME(ctx, store, kind, name) do { \
+        es_status rc_; \
+        if ((name) && bad_name(name)) \
+            ES_FAIL(ctx, ES_EINVAL, "analysis: bad result name '%s' (no '/', not empty)", name); \
+        if ((name) && (rc_ = es_store_result_check(ctx, store, kind, name)) != ES_OK) \
+            return rc_; \
     } while (0)
 
 /* Length statistics need edges: a landmarks-only store has none. */
@@ -92,10 +98,14 @@ es_status es_study_mean(es_ctx *ctx, es_store *store, const char *name, const ch
     double *scales = NULL;
     es_group_result *r = NULL;
     if (out) *out = NULL;
-    CHECK_NAME(ctx, name);
+    CHECK_NAME(ctx, store, "mean", name);
     NEED_EDGES(ctx, store);
     const int64_t E = es_store_nedges(store), col = by ? es_store_find_column(store, by) : -1;
-    if (by && col < 0) ES_FAIL(ctx, ES_ENOTFOUND, "mean: no label column '%s'", by);
+    if (by && col < 0) {
+        char hint[400];
+        es_store_column_hint(store, by, hint, sizeof hint);
+        ES_FAIL(ctx, ES_ENOTFOUND, "mean: no label column '%s'%s", by, hint);
+    }
     if ((rc = es_store_select(ctx, store, filter, &rows, &nrows)) != ES_OK) return rc;
     if (nrows == 0) {
         rc = es__fail(ctx, ES_EINVAL, "mean: no rows match '%s'", filter ? filter : "");
@@ -235,7 +245,7 @@ es_status es_study_pca(es_ctx *ctx, es_store *store, const char *name, const cha
     es_source src;
     if (out) *out = NULL;
     if (rows_out) *rows_out = NULL;
-    CHECK_NAME(ctx, name);
+    CHECK_NAME(ctx, store, "pca", name);
     NEED_EDGES(ctx, store);
     es_status rc = es_store_select(ctx, store, filter, &rows, &nrows);
     if (rc != ES_OK) return rc;
@@ -359,14 +369,17 @@ es_status es_study_diff(es_ctx *ctx, es_store *store, const char *name, const ch
                            const char *command, es_diff **out)
 {
     if (out) *out = NULL;
-    CHECK_NAME(ctx, name);
+    CHECK_NAME(ctx, store, "diff", name);
     NEED_EDGES(ctx, store);
     if (!key || !column || !from || !to)
         ES_FAIL(ctx, ES_EINVAL, "diff: a key column, a role column, 'from' and 'to' are needed");
     if (!strcmp(from, to)) ES_FAIL(ctx, ES_EINVAL, "diff: 'from' and 'to' are both '%s'", from);
     const int64_t kc = es_store_find_column(store, key), rcol = es_store_find_column(store, column);
-    if (kc < 0) ES_FAIL(ctx, ES_ENOTFOUND, "diff: no label column '%s'", key);
-    if (rcol < 0) ES_FAIL(ctx, ES_ENOTFOUND, "diff: no label column '%s'", column);
+    char hint[400];
+    if (kc < 0 || rcol < 0) {
+        es_store_column_hint(store, kc < 0 ? key : column, hint, sizeof hint);
+        ES_FAIL(ctx, ES_ENOTFOUND, "diff: no label column '%s'%s", kc < 0 ? key : column, hint);
+    }
     const int64_t N = es_store_nrows(store);
     int64_t *sel = NULL, nsel = 0;
     es_diff *d = NULL;
@@ -391,7 +404,9 @@ es_status es_study_diff(es_ctx *ctx, es_store *store, const char *name, const ch
         else if (v && !strcmp(v, to)) role[sel[j]] = ES_DIFF_TO, nto++;
     }
     if (!nfrom || !nto) {
-        rc = es__fail(ctx, ES_ENOTFOUND, "diff: no rows with %s=%s", column, !nfrom ? from : to);
+        es_store_value_hint(store, rcol, !nfrom ? from : to, hint, sizeof hint);
+        rc = es__fail(ctx, ES_ENOTFOUND, "diff: no rows with %s=%s%s", column,
+                      !nfrom ? from : to, hint);
         goto done;
     }
     es_source src;
@@ -584,7 +599,11 @@ es_status es_study_resolve(es_ctx *ctx, void *ud, es_point_leaf kind, const char
     }
     case ES_POINT_ROW: {
         int64_t row = es_store_find_row(st, arg);
-        if (row < 0) ES_FAIL(ctx, ES_ENOTFOUND, "no row with id '%s'", arg);
+        if (row < 0) {
+            char hint[400];
+            es_store_value_hint(st, -1, arg, hint, sizeof hint);
+            ES_FAIL(ctx, ES_ENOTFOUND, "no row with id '%s'%s", arg, hint);
+        }
         if ((rc = load_scales(ctx, r)) != ES_OK ||
             (rc = es_store_read_lengths(ctx, st, row, 1, (es_mat){vec, E, 1, E})) != ES_OK)
             return rc;
@@ -616,7 +635,7 @@ es_status es_study_point(es_ctx *ctx, es_store *store, const char *name, const c
     es_point_info in;
     es_study_resolver r = {store, NULL, pca_name, NULL, NULL, NULL, NULL};
     if (vec) *vec = NULL;
-    CHECK_NAME(ctx, name);
+    CHECK_NAME(ctx, store, "point", name);
     NEED_EDGES(ctx, store);
     const int64_t E = es_store_nedges(store), N = es_store_nrows(store);
     /* the row weights are stored with a named point */

@@ -20,7 +20,11 @@ static es_status groups_of(es_ctx *ctx, es_store *s, const int64_t *rows, int64_
     char **nm;
     *names = NULL;
     *ng = 0;
-    if (col < 0) ES_FAIL(ctx, ES_ENOTFOUND, "compare: no label column '%s'", by);
+    if (col < 0) {
+        char hint[400];
+        es_store_column_hint(s, by, hint, sizeof hint);
+        ES_FAIL(ctx, ES_ENOTFOUND, "compare: no label column '%s'%s", by, hint);
+    }
     if (!(nm = es__calloc(ctx, (size_t)(n > 0 ? n : 1), sizeof *nm))) return ES_ENOMEM;
     if ((rc = es__strmap_init(ctx, &map, n)) != ES_OK) {
         es__free(ctx, nm);
@@ -63,6 +67,10 @@ es_status es_study_compare(es_ctx *ctx, es_store *store, const char *gpa_name,
         ES_FAIL(ctx, ES_EINVAL, "compare: bad GPA result name '%s'", gpa_name ? gpa_name : "");
     if (e < 1) ES_FAIL(ctx, ES_EINVAL, "compare: store '%s' has no edges: it holds landmarks "
                        "only; give --edges or --triangles at ingest", es_store_path(store));
+    /* a taken result name is refused before the permutations run */
+    if (*(name ? name : gpa_name) &&
+        (rc = es_store_result_check(ctx, store, "compare", name ? name : gpa_name)) != ES_OK)
+        return rc;
     snprintf(path, sizeof path, "gpa/%s", gpa_name);
     if (!es_store_has(store, path))
         ES_FAIL(ctx, ES_ENOTFOUND, "compare: no GPA result '%s' in the store (run 'edgespace gpa "

@@ -6,8 +6,10 @@
 #include "study/study_pkg.h"
 #include "edgespace/es_io.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
+#include <unistd.h>
 
 void es_study_embed_opts_init(es_study_embed_opts *o)
 {
@@ -33,8 +35,11 @@ static es_status choose_start(es_ctx *ctx, es_store *s, const es_mesh *mesh, con
         snprintf(desc, ndesc, "nearest row %s (edge-length distance %.3g)",
                  es_store_row_id(s, *init_row), d);
     } else if (!strncmp(init, "row:", 4)) {
-        if ((*init_row = es_store_find_row(s, init + 4)) < 0)
-            ES_FAIL(ctx, ES_ENOTFOUND, "no row '%s' in the store", init + 4);
+        if ((*init_row = es_store_find_row(s, init + 4)) < 0) {
+            char hint[400];
+            es_store_value_hint(s, -1, init + 4, hint, sizeof hint);
+            ES_FAIL(ctx, ES_ENOTFOUND, "no row '%s' in the store%s", init + 4, hint);
+        }
         snprintf(desc, ndesc, "row %s", init + 4);
     } else if (!strncmp(init, "mean", 4) && (init[4] == 0 || init[4] == ':')) {
         if ((rc = es_store_select(ctx, s, init[4] ? init + 5 : NULL, sel, nsel)) != ES_OK)
@@ -126,9 +131,11 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
     double own;
     int64_t init_row = -1, *sel = NULL, nsel = 0, ne, nv, n = es_store_nrows(s);
     const int prior = !o || !o->init || !strcmp(o->init, "prior");
+    char stage_out[4200] = "", stage_res[4200] = "";
     es_status rc;
     memset(res, 0, sizeof *res);
     if (!o || !o->point) ES_FAIL(ctx, ES_EINVAL, "embed: no point given");
+    if (o->name && (rc = es_store_result_check(ctx, s, "embed", o->name)) != ES_OK) return rc;
     if ((rc = es_store_mesh(ctx, s, &mesh)) != ES_OK) return rc;
     ne = es_mesh_nedges(mesh);
     nv = es_mesh_nverts(mesh);
@@ -172,9 +179,20 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
                                     &o->embed, xyz, &res->report)) != ES_OK) {
         goto done;
     }
-    if (
-(o->output && (rc = es_mesh_write(ctx, o->output, ES_FORMAT_AUTO, mesh, xyz, NULL))) ||
-        (o->residuals && (rc = write_residuals(ctx, o->residuals, emb, nv)) != ES_OK))
+    /* with a stored result the files are staged beside their targets and
+     * renamed into place after the commit: a failed store write leaves no
+     * mesh behind, and an old file as it was */
+    if (o->name) {
+        snprintf(stage_out, sizeof stage_out, "%s.%ld.staged", o->output ? o->output : "",
+                 (long)getpid());
+        snprintf(stage_res, sizeof stage_res, "%s.%ld.staged",
+                 o->residuals ? o->residuals : "", (long)getpid());
+    }
+    if ((o->output && (rc = es_mesh_write(ctx, o->name ? stage_out : o->output,
+                                          es_mesh_format_from_path(o->output), mesh, xyz,
+                                          NULL)) != ES_OK) ||
+        (o->residuals && (rc = write_residuals(ctx, o->name ? stage_res : o->residuals, emb,
+                                               nv)) != ES_OK))
         goto done;
     if (o->name) {
         /* the rows whose positions started the embedding (none for a mesh:
@@ -188,8 +206,18 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
                                            &res->report, res->init)) != ES_OK ||
             (rc = es_store_commit(ctx, s)) != ES_OK)
             goto done;
+        if (o->output && rename(stage_out, o->output) != 0)
+            rc = es__fail(ctx, ES_EIO, "embed: stored as embed/%s, but cannot write '%s': %s",
+                          o->name, o->output, strerror(errno));
+        else if (o->residuals && rename(stage_res, o->residuals) != 0)
+            rc = es__fail(ctx, ES_EIO, "embed: stored as embed/%s, but cannot write '%s': %s",
+                          o->name, o->residuals, strerror(errno));
     }
 done:
+    if (o->name && rc != ES_OK) {
+        if (o->output) remove(stage_out);
+        if (o->residuals) remove(stage_res);
+    }
     es_embedder_free(emb);
     es_mesh_free(mesh);
     es__free(ctx, sel);

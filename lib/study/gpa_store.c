@@ -55,6 +55,7 @@ es_status es_study_gpa(es_ctx *ctx, es_store *store, const char *name, const int
     if (opts) o = *opts; else es_gpa_opts_init(&o);
     if (!name || !*name || strchr(name, '/'))
         ES_FAIL(ctx, ES_EINVAL, "gpa: result name '%s' is empty or has '/'", name ? name : "");
+    if ((rc = es_store_result_check(ctx, store, "gpa", name)) != ES_OK) return rc;
     if (n < 2) ES_FAIL(ctx, ES_EINVAL, "gpa: needs at least 2 rows, got %lld", (long long)n);
     if (k < 1) ES_FAIL(ctx, ES_EINVAL, "gpa: the store has no vertices");
 

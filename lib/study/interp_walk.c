@@ -238,6 +238,13 @@ es_status es_study_interp(es_ctx *ctx, es_store *store, const es_study_interp_op
                 "integer conversion, like 'out_%%02d.obj'");
     if (o->name) snprintf(wk.name, sizeof wk.name, "%s", o->name);
     else default_name(o->output, wk.name, sizeof wk.name);
+    /* every frame's result name is free (or replaced) before a frame is written */
+    for (int64_t i = 0; o->command && i < (o->weights ? 1 : o->steps); i++) {
+        char rn[300];
+        if (!o->weights && o->steps > 1) snprintf(rn, sizeof rn, "%s_%02lld", wk.name, (long long)i);
+        else snprintf(rn, sizeof rn, "%s", wk.name);
+        if ((rc = es_store_result_check(ctx, store, "embed", rn)) != ES_OK) return rc;
+    }
     if (o->weights) {   /* one point, one frame */
         one = *o;
         one.steps = 1;

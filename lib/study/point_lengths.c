@@ -27,7 +27,11 @@ static es_status row_point(es_ctx *ctx, es_store *store, const char *id, double 
     int64_t r = es_store_find_row(store, id), ne = es_store_nedges(store);
     double *scales;
     es_status rc;
-    if (r < 0) ES_FAIL(ctx, ES_ENOTFOUND, "no row '%s' in the store", id);
+    if (r < 0) {
+        char hint[400];
+        es_store_value_hint(store, -1, id, hint, sizeof hint);
+        ES_FAIL(ctx, ES_ENOTFOUND, "no row '%s' in the store%s", id, hint);
+    }
     if (!(scales = es__alloc_array(ctx, es_store_nrows(store), sizeof *scales)))
         return ES_ENOMEM;
     if ((rc = es_store_read_lengths(ctx, store, r, 1, (es_mat){lengths, ne, 1, ne})) == ES_OK &&

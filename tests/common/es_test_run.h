@@ -23,6 +23,15 @@ const char *es_test_edgespace(void);
 /* Start `edgespace argv...` with stdout/stderr to the given files. */
 pid_t es_test_spawn(const char *const argv[], const char *outfile,
                                   const char *errfile);
+/* The same with every write past fsize bytes of a file failing (EFBIG:
+ * RLIMIT_FSIZE, SIGXFSZ ignored so that it is an error, not a kill);
+ * fsize 0: no limit. */
+pid_t es_test_spawn_limited(const char *const argv[], const char *outfile, const char *errfile,
+                            unsigned long long fsize);
+
+/* Monotonic seconds, and a sleep of s seconds (resumed after signals). */
+double es_test_now(void);
+void es_test_sleep(double s);
 
 int es_test_wait(pid_t pid);
 

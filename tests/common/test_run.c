@@ -1,14 +1,17 @@
 /* tests/common/test_run.c — see es_test_run.h. */
 #include "es_test_run.h"
 
+#include <sys/resource.h>
+#include <time.h>
+
 const char *es_test_edgespace(void)
 {
     const char *p = getenv("EDGESPACE");
     return p && *p ? p : NULL;
 }
 
-pid_t es_test_spawn(const char *const argv[], const char *outfile,
-                                  const char *errfile)
+pid_t es_test_spawn_limited(const char *const argv[], const char *outfile, const char *errfile,
+                            unsigned long long fsize)
 {
     pid_t pid = fork();
     if (pid == 0) {
@@ -17,10 +20,34 @@ pid_t es_test_spawn(const char *const argv[], const char *outfile,
         if (o < 0 || e < 0) _exit(126);
         dup2(o, 1);
         dup2(e, 2);
+        if (fsize > 0) {
+            struct rlimit rl = {(rlim_t)fsize, (rlim_t)fsize};
+            signal(SIGXFSZ, SIG_IGN);
+            setrlimit(RLIMIT_FSIZE, &rl);
+        }
         execv(es_test_edgespace(), (char *const *)argv);
         _exit(127);
     }
     return pid;
+}
+
+pid_t es_test_spawn(const char *const argv[], const char *outfile,
+                                  const char *errfile)
+{
+    return es_test_spawn_limited(argv, outfile, errfile, 0);
+}
+
+double es_test_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void es_test_sleep(double s)
+{
+    struct timespec ts = {(time_t)s, (long)((s - (double)(time_t)s) * 1e9)};
+    while (nanosleep(&ts, &ts) != 0) {}
 }
 
 int es_test_wait(pid_t pid)

@@ -12,6 +12,19 @@ int main(void)
     ES_CHECK(strcmp(es_ctx_errmsg(ctx), "") == 0);
     ES_CHECK(es__fail(ctx, ES_EINVAL, "bad %d", 7) == ES_EINVAL);
     ES_CHECK(strcmp(es_ctx_errmsg(ctx), "bad 7") == 0);
+    /* a message is one line: control characters it quotes are escaped */
+    ES_CHECK(es__fail(ctx, ES_EFORMAT, "column '%s'", "a\nb\tc\rd\001e\x7f") == ES_EFORMAT);
+    ES_CHECK_MSG(!strcmp(es_ctx_errmsg(ctx), "column 'a\\nb\\tc\\rd\\x01e\\x7f'"), "%s",
+                 es_ctx_errmsg(ctx));
+    {
+        /* escapes never overrun the buffer: 2000 newlines make a full,
+         * terminated message */
+        char many[2001];
+        memset(many, '\n', 2000);
+        many[2000] = '\0';
+        es__fail(ctx, ES_EFORMAT, "%s", many);
+        ES_CHECK(strlen(es_ctx_errmsg(ctx)) < 1024 && !strchr(es_ctx_errmsg(ctx), '\n'));
+    }
     ES_CHECK(strcmp(es_strerror(ES_OK), "success") == 0);
     ES_CHECK(strlen(es_version()) > 0);
 

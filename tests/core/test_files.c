@@ -1,13 +1,16 @@
 /* tests/core/test_files.c — core/files.h: whole-file reads and their flags
  * (a FIFO refused at once with ES__READ_REGULAR, read to its end without;
  * the byte order mark; a NUL byte named by its line; a missing file as
- * ES_EIO or ES_ENOTFOUND), buffer reuse, mkdir -p, and the parts of a path. */
+ * ES_EIO or ES_ENOTFOUND), buffer reuse, mkdir -p, the parts of a path, and
+ * replacing a file (es__replace_begin/end) where the path is a pipe, a
+ * device or a directory. */
 #include "core/files.h"
 #include "es_test.h"
 #include "es_test_alloc.h"
 #include "es_test_files.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -216,6 +219,58 @@ static void test_paths(es_ctx *ctx)
     ES_CHECK(s0[0] == 'q');
 }
 
+/* A file is replaced whole; a pipe or character device is written in place
+ * and stays what it was (export to /dev/full used to put a CSV where the
+ * device node was); a directory is refused. */
+static void test_replace_targets(es_ctx *ctx)
+{
+    char path[4200], got[64];
+    es__file_replace w;
+    struct stat st;
+    /* a FIFO: written in place, read back by the other end */
+    in_dir("out.fifo", path, sizeof path);
+    if (mkfifo(path, 0600) == 0) {
+        int rd = open(path, O_RDONLY | O_NONBLOCK);
+        ES_CHECK(rd >= 0);
+        ES_CHECK_OK(ctx, es__replace_begin(ctx, path, &w));
+        if (w.f) fputs("through the pipe\n", w.f);
+        ES_CHECK_OK(ctx, es__replace_end(ctx, &w, ES_OK));
+        ssize_t n = rd >= 0 ? read(rd, got, sizeof got - 1) : -1;
+        ES_CHECK(n == 17 && !memcmp(got, "through the pipe\n", 17));
+        ES_CHECK(stat(path, &st) == 0 && S_ISFIFO(st.st_mode));
+        ES_CHECK(es_test_count_entries(dir, ".part") == 0);
+        if (rd >= 0) close(rd);
+        remove(path);
+    }
+    /* /dev/full: the device's error, and still a device */
+    if (stat("/dev/full", &st) == 0 && S_ISCHR(st.st_mode)) {
+        ES_CHECK_OK(ctx, es__replace_begin(ctx, "/dev/full", &w));
+        if (w.f) for (int i = 0; i < 10000; i++) fputs("0123456789", w.f);
+        ES_CHECK_FAILS(ctx, es__replace_end(ctx, &w, ES_OK), ES_EIO, "/dev/full");
+        ES_CHECK(strstr(es_ctx_errmsg(ctx), strerror(ENOSPC)) != NULL);
+        ES_CHECK(stat("/dev/full", &st) == 0 && S_ISCHR(st.st_mode));
+    }
+    /* a directory */
+    ES_CHECK_FAILS(ctx, es__replace_begin(ctx, dir, &w), ES_EIO, strerror(EISDIR));
+    ES_CHECK(w.f == NULL);
+    /* a symlink to a FIFO is written through, in place */
+    in_dir("out.fifo", path, sizeof path);
+    if (mkfifo(path, 0600) == 0) {
+        char link[4200];
+        int rd = open(path, O_RDONLY | O_NONBLOCK);
+        in_dir("to-fifo", link, sizeof link);
+        ES_CHECK(symlink(path, link) == 0);
+        ES_CHECK_OK(ctx, es__replace_begin(ctx, link, &w));
+        if (w.f) fputs("x", w.f);
+        ES_CHECK_OK(ctx, es__replace_end(ctx, &w, ES_OK));
+        ES_CHECK(rd >= 0 && read(rd, got, 1) == 1 && got[0] == 'x');
+        ES_CHECK(lstat(link, &st) == 0 && S_ISLNK(st.st_mode));
+        if (rd >= 0) close(rd);
+        remove(link);
+        remove(path);
+    }
+}
+
 int main(void)
 {
     es_ctx *ctx = NULL;
@@ -227,6 +282,7 @@ int main(void)
     test_reuse(ctx);
     test_mkdir(ctx);
     test_paths(ctx);
+    test_replace_targets(ctx);
     static const char *const left[] = {"bom.txt", "nul.txt", "small.txt", "big.txt"};
     for (size_t i = 0; i < sizeof left / sizeof *left; i++) {
         char path[4200];

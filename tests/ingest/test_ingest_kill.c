@@ -14,22 +14,8 @@
 #include "es_test_run.h"
 #include "edgespace/edgespace.h"
 
-#include <time.h>
 
 enum { NMESH = 40, NU = 100, NV = 100 };
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static void sleep_s(double s)
-{
-    struct timespec ts = {(time_t)s, (long)((s - (double)(time_t)s) * 1e9)};
-    while (nanosleep(&ts, &ts) != 0) {}
-}
 
 static int64_t store_rows(es_ctx *ctx, const char *path)
 {
@@ -86,9 +72,9 @@ int main(void)
         f = fopen(copy, "wb");
         fwrite(base, 1, nbase, f);
         fclose(f);
-        T = now();
+        T = es_test_now();
         ES_CHECK(es_test_wait(es_test_spawn(argv, o, e)) == 0);
-        T = now() - T;
+        T = es_test_now() - T;
         ES_CHECK(store_rows(ctx, copy) == NMESH);
         remove(copy);
     }
@@ -99,7 +85,7 @@ int main(void)
         pid_t pid = es_test_spawn(argv, o, e);
         int status;
         int64_t n;
-        sleep_s(at[k] * T);
+        es_test_sleep(at[k] * T);
         kill(pid, SIGKILL);
         status = es_test_wait(pid);
         {

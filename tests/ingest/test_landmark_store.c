@@ -261,7 +261,9 @@ static void attr_str(hid_t f, const char *name, char *buf, size_t n)
     char *v = NULL;
     hid_t a = -1, t = H5Tcopy(H5T_C_S1);
     buf[0] = 0;
+    /* UTF-8 as stored: HDF5 1.10 has no conversion to ASCII strings */
     H5Tset_size(t, H5T_VARIABLE);
+    H5Tset_cset(t, H5T_CSET_UTF8);
     H5E_BEGIN_TRY { a = H5Aopen(f, name, H5P_DEFAULT); } H5E_END_TRY
     if (a >= 0 && H5Aread(a, t, &v) >= 0 && v) {
         snprintf(buf, n, "%s", v);

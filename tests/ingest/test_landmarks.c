@@ -130,10 +130,17 @@ static void test_size_overflow(es_ctx *ctx)
 {
     const char *dir = es_test_tmpdir("landmarks");
     static const struct { const char *file, *text, *msg; } bad[] = {
+        /* a count is bounded by the lines left to hold it, before any
+         * allocation (LM=50000000 took 800 MB and 6 s to reach the end) */
         {"big.tps", "LM=72057594037927936\n1 2\nID=a\n",
-         "landmarks: big.tps: 72057594037927936 landmarks in 2D are too many (LM= count)"},
+         "landmarks: big.tps:1: 72057594037927936 landmarks (LM= count) are too many for the 3 "
+         "lines that follow"},
         {"big3d.tps", "LM3=4611686018427387904\n1 2 3\n",
-         "big3d.tps: 4611686018427387904 landmarks in 3D are too many"},
+         "big3d.tps:1: 4611686018427387904 landmarks (LM= count) are too many"},
+        {"lm50m.tps", "LM=50000000\n1 2\n3 4\n",
+         "lm50m.tps:1: 50000000 landmarks (LM= count) are too many for the 3 lines"},
+        {"late.tps", "LM=2\n1 2\n3 4\nLM=2\n1 2\n3 4\nLM=1000\n1 2\n",
+         "late.tps:7: 1000 landmarks (LM= count) are too many for the 2 lines"},
         {"big.csv", "specimen,landmark,x,y\na,1,0,0\na,2,1,0\na,72057594037927936,0,1\n",
          "landmarks: big.csv: 72057594037927936 landmarks in 2D are too many (largest "
          "landmark number)"},

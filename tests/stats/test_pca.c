@@ -270,6 +270,35 @@ static void test_randomized(es_ctx *ctx)
     free(X);
 }
 
+/* Options from a command line: an oversampling of 2^63 - 1 is clamped
+ * before it is added to K (it overflowed, undefined behaviour that UBSan
+ * reports), and a power iteration count that would never end is refused. */
+static void test_extreme_options(es_ctx *ctx)
+{
+    enum { E = 30, N = 12 };
+    double X[E * N];
+    es_rng g;
+    es_pca_opts o;
+    es_pca *p = NULL;
+    es_rng_init(&g, 7);
+    for (int i = 0; i < E * N; i++) X[i] = es_rng_normal(&g);
+    es_source src = es_source_matrix((es_mat){X, E, N, E}, NULL, 0);
+    es_pca_opts_init(&o);
+    o.method = ES_PCA_RANDOMIZED;
+    o.ncomp = 3;
+    o.oversample = INT64_MAX;
+    ES_CHECK_OK(ctx, es_pca_fit(ctx, &src, &o, &p));
+    ES_CHECK(p && p->ncomp == 3);
+    es_pca_free(p);
+    p = NULL;
+    o.oversample = 10;
+    o.power_iters = 1001;
+    ES_CHECK_FAILS(ctx, es_pca_fit(ctx, &src, &o, &p), ES_EINVAL, "0 to 1000");
+    ES_CHECK(p == NULL);
+    o.power_iters = INT64_MAX;
+    ES_CHECK_FAILS(ctx, es_pca_fit(ctx, &src, &o, &p), ES_EINVAL, "power iterations");
+}
+
 /* Rank-deficient data: every route, the randomized one included, returns
  * only the components above max(N, E) eps (largest), so rank-1 data asked
  * for 3 gives 1 and constant data gives none (the randomized route used to
@@ -421,6 +450,7 @@ int main(void)
     test_topk(ctx);
     test_randomized(ctx);
     test_rank(ctx);
+    test_extreme_options(ctx);
     test_face_study(ctx);
     es_ctx_free(ctx);
     ES_TEST_END();

@@ -155,6 +155,31 @@ static void test_eval(es_ctx *ctx)
 }
 
 /* Every syntax error: ES_EFORMAT and the column in the message. */
+/* Numbers that are finite alone but not together: refused, never a point
+ * of infinite lengths (1e300*1e300*mean was stored, and gpa failed later). */
+static void test_overflow(es_ctx *ctx)
+{
+    static const struct { const char *text, *msg; } cases[] = {
+        {"1e300*1e300*mean", "the coefficient of term 1 (mean) overflows"},
+        {"mean + 1e300*1e300*row:a", "the coefficient of term 2 (row:a) overflows"},
+        {"row:a/1e-320", "overflows"},
+        {"1e308*row:a + 1e308*row:a", "weights (sum inf)"},
+        {"mean + 1e308*pc:2 + 1e308*pc:2", "the length of edge 1 overflows"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        es_point_expr *x = NULL;
+        es_status rc = es_point_parse(ctx, cases[i].text, &x);
+        if (rc == ES_OK) {
+            int calls = 0;
+            double v[E];
+            rc = es_point_eval(ctx, x, E, resolve, &calls, NULL, v, NULL);
+        }
+        ES_CHECK_MSG(rc == ES_ERANGE && strstr(es_ctx_errmsg(ctx), cases[i].msg),
+                     "'%s': %d %s", cases[i].text, (int)rc, es_ctx_errmsg(ctx));
+        es_point_expr_free(x);
+    }
+}
+
 static void test_errors(es_ctx *ctx)
 {
     static const struct { const char *text, *msg; } cases[] = {
@@ -316,6 +341,7 @@ int main(void)
     if (es_ctx_new(&ctx) != ES_OK) return 1;
     test_eval(ctx);
     test_errors(ctx);
+    test_overflow(ctx);
     test_validity(ctx);
     test_row_weights(ctx);
     test_alloc_failures(ctx);

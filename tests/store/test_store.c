@@ -279,6 +279,105 @@ done:
     free(scale);
 }
 
+/* A result is never written over silently: ES_EEXIST naming it and the
+ * handle's way out, unless the handle was opened ES_STORE_REPLACE; the
+ * check before an analysis (es_store_result_check) says the same. Names a
+ * misspelt column or value: the closest ones, or those that exist; a
+ * filter value no row has is warned about. Positions must be finite. */
+static void log_to(void *ud, es_log_level level, const char *msg)
+{
+    (void)level;
+    snprintf(ud, 512, "%s", msg);
+}
+
+static void test_replace_and_hints(es_ctx *ctx, const char *dir)
+{
+    char path[4200], warned[512] = "", hint[400];
+    es_store *s = NULL;
+    es_provenance prov = {"test", NULL, -1, NULL};
+    const double v1[1] = {1}, v2[2] = {2, 3};
+    double *got = NULL;
+    int64_t n = 0;
+    batch b;
+    snprintf(path, sizeof path, "%s/replace.h5", dir);
+    ES_CHECK_OK(ctx, es__store_create_raw(ctx, path, V, F, faces, E, edges, "", &s));
+    if (!s) return;
+    const char *cols[2] = {"expression", "subject"};
+    const char *labels[6] = {"neutral", "s1", "happy", "s1", "neutral", "s2"};
+    make_batch(&b, 0, 3, "h");
+    es_store_rows r = rows_of(&b, 2, cols, labels);
+    ES_CHECK_OK(ctx, es_store_append(ctx, s, &r));
+    ES_CHECK_OK(ctx, es_store_result_begin(ctx, s, "mean", "m", &prov));
+    ES_CHECK_OK(ctx, es_store_put_vector(ctx, s, "mean/m/v", v1, 1));
+    ES_CHECK_OK(ctx, es_store_commit(ctx, s));
+    es_store_close(s);
+    s = NULL;
+
+    /* taken: refused by the check and by the write, nothing changed */
+    ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_WRITE, &s));
+    if (!s) return;
+    ES_CHECK_FAILS(ctx, es_store_result_check(ctx, s, "mean", "m"), ES_EEXIST,
+                   "result mean/m exists already");
+    ES_CHECK(strstr(es_ctx_errmsg(ctx), "--replace") != NULL);
+    ES_CHECK_FAILS(ctx, es_store_result_begin(ctx, s, "mean", "m", &prov), ES_EEXIST,
+                   "exists already");
+    ES_CHECK_OK(ctx, es_store_result_check(ctx, s, "mean", "other"));
+    ES_CHECK_OK(ctx, es_store_result_check(ctx, s, "pca", "m"));
+    ES_CHECK_FAILS(ctx, es_store_result_check(ctx, s, "mean", "a/b"), ES_EINVAL, "bad result");
+    es_store_close(s);   /* nothing was written: nothing to commit */
+    s = NULL;
+    ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_READ, &s));
+    if (s) {
+        ES_CHECK_OK(ctx, es_store_get_vector(ctx, s, "mean/m/v", &got, &n));
+        ES_CHECK(n == 1 && got && got[0] == 1);
+        es_free(ctx, got);
+        got = NULL;
+        /* read-only handles may check but never write */
+        ES_CHECK_FAILS(ctx, es_store_result_check(ctx, s, "mean", "m"), ES_EEXIST, NULL);
+        es_store_close(s);
+        s = NULL;
+    }
+    /* ES_STORE_REPLACE replaces */
+    ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_REPLACE, &s));
+    if (!s) return;
+    ES_CHECK_OK(ctx, es_store_result_check(ctx, s, "mean", "m"));
+    ES_CHECK_OK(ctx, es_store_result_begin(ctx, s, "mean", "m", &prov));
+    ES_CHECK_OK(ctx, es_store_put_vector(ctx, s, "mean/m/v", v2, 2));
+    ES_CHECK_OK(ctx, es_store_commit(ctx, s));
+    ES_CHECK_OK(ctx, es_store_get_vector(ctx, s, "mean/m/v", &got, &n));
+    ES_CHECK(n == 2 && got && got[1] == 3);
+    es_free(ctx, got);
+
+    /* misspelt names */
+    es_store_column_hint(s, "expresion", hint, sizeof hint);
+    ES_CHECK_MSG(!strcmp(hint, " (did you mean 'expression'?)"), "%s", hint);
+    es_store_column_hint(s, "zzzzzz", hint, sizeof hint);
+    ES_CHECK_MSG(!strcmp(hint, " (columns: expression, subject)"), "%s", hint);
+    es_store_value_hint(s, 0, "neutarl", hint, sizeof hint);
+    ES_CHECK_MSG(!strcmp(hint, " (did you mean 'neutral'?)"), "%s", hint);
+    es_store_value_hint(s, -1, "h1", hint, sizeof hint);
+    ES_CHECK_MSG(strstr(hint, "'h01'"), "%s", hint);
+    {
+        int64_t *sel = NULL, ns = -1;
+        ES_CHECK_FAILS(ctx, es_store_select(ctx, s, "expresion=happy", &sel, &ns), ES_ENOTFOUND,
+                       "no label column 'expresion' in");
+        ES_CHECK(strstr(es_ctx_errmsg(ctx), "did you mean 'expression'?") != NULL);
+        es_ctx_set_log(ctx, log_to, warned);
+        ES_CHECK_OK(ctx, es_store_select(ctx, s, "expression=hapy", &sel, &ns));
+        es_ctx_set_log(ctx, NULL, NULL);
+        ES_CHECK(ns == 0);
+        ES_CHECK_MSG(strstr(warned, "no row has expression='hapy' (did you mean 'happy'?)"),
+                     "%s", warned);
+        es_free(ctx, sel);
+    }
+    /* positions must be finite */
+    make_batch(&b, 10, 1, "h");
+    b.xyz[4] = NAN;
+    r = rows_of(&b, 0, NULL, NULL);
+    ES_CHECK_FAILS(ctx, es_store_append(ctx, s, &r), ES_EINVAL, "non-finite position at vertex 1");
+    es_store_close(s);
+}
+
 int main(void)
 {
     es_ctx *ctx = NULL;
@@ -558,6 +657,7 @@ int main(void)
     test_stale_writer(ctx, path);
     test_export_keeps_old_file(ctx, path, dir);
     test_many_ids(ctx, dir);
+    test_replace_and_hints(ctx, dir);
     es_ctx_free(ctx);
     ES_TEST_END();
 }

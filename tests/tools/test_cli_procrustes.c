@@ -58,7 +58,12 @@ int main(void)
                  r.err);
     ES_RUN(&r, dir, "compare", store, "--gpa", "g");
     ES_CHECK_MSG(r.status == 1 && strstr(r.err, "at least 3"), "%s", r.err);
+    /* a result is never written over silently: refused, then --replace */
     ES_RUN(&r, dir, "gpa", store, "--name", "g", "--no-scale", "--allow-reflection", "--pcs", "2");
+    ES_CHECK_MSG(r.status == 1 && strstr(r.err, "result gpa/g exists already") &&
+                 strstr(r.err, "--replace"), "%s", r.err);
+    ES_RUN(&r, dir, "gpa", store, "--name", "g", "--no-scale", "--allow-reflection", "--pcs", "2",
+           "--replace");
     ES_CHECK_MSG(r.status == 0 && strstr(r.out, "4 rows, 3D, partial GPA with reflection") &&
                  strstr(r.out, "PC variance"), "%s%s", r.out, r.err);
     ES_RUN(&r, dir, "compare", store, "--gpa", "nope");

@@ -195,7 +195,18 @@ int main(void)
         ES_CHECK_MSG(r.status == 1 && strstr(r.err, "outside edge-length space"),
                      "weights far out: %d %s", r.status, r.err);
     }
-    ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:nope", "-o", pat);
+    /* the walk's results exist: refused before a frame is written */
+    {
+        char again[4300], first[4300];
+        snprintf(again, sizeof again, "%s/again_%%02d.obj", dir);
+        snprintf(first, sizeof first, "%s/again_00.obj", dir);
+        ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-1", "-o", again,
+               "--name", "seq", "--steps", "3");
+        ES_CHECK_MSG(r.status == 1 && strstr(r.err, "result embed/seq_00 exists already") &&
+                     access(first, F_OK) != 0, "interp again: %d %s", r.status, r.err);
+    }
+    ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:nope", "-o", pat,
+           "--replace");
     ES_CHECK(r.status == 1 && strstr(r.err, "nope"));
     ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-1", "-o", out);
     ES_CHECK(r.status == 2 && strstr(r.err, "pattern"));
@@ -206,7 +217,16 @@ int main(void)
     ES_CHECK_MSG(r.status == 0 && strstr(r.out, "init: row mesh-0") &&
                  strstr(r.out, "stored: /analysis/embed/e"), "embed: %d %s %s", r.status, r.out,
                  r.err);
-    ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out, "--init", "mean");
+    /* embed/e exists: refused before solving, and no mesh is left behind */
+    {
+        char e2[4300];
+        snprintf(e2, sizeof e2, "%s/e2.obj", dir);
+        ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", e2, "--name", "e");
+        ES_CHECK_MSG(r.status == 1 && strstr(r.err, "result embed/e exists already") &&
+                     access(e2, F_OK) != 0, "embed again: %d %s", r.status, r.err);
+    }
+    ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out, "--init", "mean",
+           "--replace");
     ES_CHECK_MSG(r.status == 0 && strstr(r.out, "circular mean"), "embed mean: %s", r.err);
     /* from a given mesh: it is the alignment reference too, so a mesh moved
      * rigidly brings the output along; a mesh of another topology is refused */
@@ -239,15 +259,17 @@ int main(void)
         snprintf(other, sizeof other, "%s/tri.obj", dir);
         es_test_write_file(other, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
         snprintf(pat, sizeof pat, "mesh:%s", other);
-        ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out, "--init", pat);
+        ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out, "--init", pat,
+               "--replace");
         ES_CHECK_MSG(r.status == 1 && strstr(r.err, "do not match the store's topology"),
                      "embed from another topology: %d %s", r.status, r.err);
         snprintf(pat, sizeof pat, "%s/seq_%%02d.obj", dir);
     }
-    ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out);
+    ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out, "--replace");
     ES_CHECK_MSG(r.status == 0 && strstr(r.out, "prior of 1 row (weight 1 on mesh-2)") &&
                  strstr(r.out, "shape: bending"), "embed with the prior: %s", r.out);
-    ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out, "--init", "nearest");
+    ES_RUN(&r, dir, "embed", store, "--point", "row:mesh-2", "-o", out, "--init", "nearest",
+           "--replace");
     ES_CHECK_MSG(r.status == 0 && strstr(r.out, "nearest row mesh-2") &&
                  !strstr(r.out, "shape: bending"), "embed nearest: %s", r.out);
     /* per-vertex residuals as CSV, drawn by render --scalars */

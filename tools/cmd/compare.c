@@ -28,6 +28,7 @@ static const char usage[] =
     "      --no-figures        CSV files only\n"
     "      --seed S            seed of the permutations (default the library's)\n"
     "  -q, --quiet             print nothing on success\n"
+    "      --replace           replace a stored result of that name (else refused)\n"
     "  -h, --help              show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -41,9 +42,11 @@ int cmd_compare(int argc, char **argv)
         {"output", required_argument, NULL, 'o'},  {"name", required_argument, NULL, O_NAME},
         {"top", required_argument, NULL, O_TOP},   {"no-figures", no_argument, NULL, O_NOFIG},
         {"seed", required_argument, NULL, O_SEED}, {"quiet", no_argument, NULL, 'q'},
-        {"help", no_argument, NULL, 'h'},          {NULL, 0, NULL, 0}};
+        {"replace", no_argument, NULL, 'R'}, {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0}};
     const char *gpa = NULL, *by = NULL, *out = NULL, *name = NULL;
     es_compare_opts o;
+    es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
     int c, quiet = 0, figures = 1, have_seed = 0;
     int64_t seed = 0;
     es_compare_opts_init(&o);
@@ -68,6 +71,7 @@ int cmd_compare(int argc, char **argv)
             have_seed = 1;
             break;
         case 'q': quiet = 1; break;
+        case 'R': wmode = ES_STORE_REPLACE; break;
         case 'h': fputs(usage, stdout); return CLI_OK;
         default: return cli_usage_error("compare", "bad option");
         }
@@ -80,7 +84,7 @@ int cmd_compare(int argc, char **argv)
     es_store *s = NULL;
     es_compare_result *r = NULL;
     char *cmd = cli_command_line(argc, argv);
-    es_status rc = es_store_open(ctx, argv[optind], ES_STORE_WRITE, &s);
+    es_status rc = es_store_open(ctx, argv[optind], wmode, &s);
 #if ES_HAVE_FIGURES
     if (rc == ES_OK && figures)
         rc = es_figure_compare(ctx, s, gpa, by, &o, name, out, cmd, &r);

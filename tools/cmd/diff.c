@@ -30,6 +30,7 @@ static const char usage[] =
     "  -w, --where FILTER   only rows matching \"col=value[,...]\"\n"
     "                       (quote a value holding ',': col=\"a,b\")\n"
     "  -o, --csv PATH       write edge,v0,v1,mean,sd,se,t (- for stdout)\n"
+    "      --replace        replace a stored result of that name (else refused)\n"
     "  -h, --help           show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -47,10 +48,12 @@ int cmd_diff(int argc, char **argv)
         {"pair-by", required_argument, NULL, 'p'}, {"from", required_argument, NULL, 'f'},
         {"to", required_argument, NULL, 't'}, {"column", required_argument, NULL, 'c'},
         {"name", required_argument, NULL, 'n'}, {"where", required_argument, NULL, 'w'},
-        {"csv", required_argument, NULL, 'o'}, {"help", no_argument, NULL, 'h'},
+        {"csv", required_argument, NULL, 'o'}, {"replace", no_argument, NULL, 'R'},
+        {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
     const char *key = NULL, *from = NULL, *to = NULL, *column = NULL, *name = NULL,
                *where = NULL, *csv = NULL;
+    es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
     int c;
     optind = 1;
     while ((c = getopt_long(argc, argv, "p:f:t:c:n:w:o:h", lo, NULL)) != -1) {
@@ -62,6 +65,7 @@ int cmd_diff(int argc, char **argv)
         case 'n': name = optarg; break;
         case 'w': where = optarg; break;
         case 'o': csv = optarg; break;
+        case 'R': wmode = ES_STORE_REPLACE; break;
         case 'h': fputs(usage, stdout); return CLI_OK;
         default: return cli_usage_error("diff", "bad option");
         }
@@ -78,7 +82,7 @@ int cmd_diff(int argc, char **argv)
         snprintf(defname, sizeof defname, "%s-minus-%s", to, from);
         name = defname;
     }
-    es_status rc = es_store_open(ctx, argv[optind], ES_STORE_WRITE, &st);
+    es_status rc = es_store_open(ctx, argv[optind], wmode, &st);
     if (rc != ES_OK) {
         cli_fail("diff", ctx, rc);
         goto done;
@@ -118,14 +122,14 @@ int cmd_diff(int argc, char **argv)
     else   /* one pair: no spread, so no t */
         printf("|mean difference| = %.6g; no t statistics (%lld pair)\n", sqrt(norm),
                (long long)d->npairs);
-    if ((rc = es_store_commit(ctx, st)) != ES_OK) {
+    /* the table first: a failure leaves the store as it was */
+    if ((csv && (rc = es_study_write_diff_table(ctx, st, d, csv)) != ES_OK) ||
+        (rc = es_store_commit(ctx, st)) != ES_OK) {
         cli_fail("diff", ctx, rc);
         goto done;
     }
     printf("stored as /analysis/diff/%s\n", name);
     ret = CLI_OK;
-    if (csv && (rc = es_study_write_diff_table(ctx, st, d, csv)) != ES_OK)
-        ret = cli_fail("diff", ctx, rc);
 done:
     es_diff_free(d);
     if (ret == CLI_OK) es_store_close(st);

@@ -38,7 +38,7 @@ static const char usage[] =
     "  -n, --name NAME      result name in the store (default: the output's base name)\n"
     "      --no-store       do not write the report into the store\n"
     "      --bending W      weight of the prior's bending term against the lengths\n"
-    "                       (default 0.002; 0: the prior only starts and frames it)\n"
+    "                       (default 0.0025; 0: the prior only starts and frames it)\n"
     "      --refine-iters N refinement iterations (default 12; more for accuracy,\n"
     "                       0 for the linear stages only)\n"
     "      --residuals CSV  per vertex of the output: closure energy, mean relative\n"
@@ -47,6 +47,7 @@ static const char usage[] =
     "                       [,deviation]; render MESH --scalars CSV draws the first)\n"
     "      --paper          the published method's stages only (stage 1 always, no\n"
     "                       refinement), for comparison\n"
+    "      --replace        replace a stored result of that name (else refused)\n"
     "  -h, --help           show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -57,11 +58,13 @@ int cmd_embed(int argc, char **argv)
         {"point", required_argument, NULL, 'p'}, {"output", required_argument, NULL, 'o'},
         {"init", required_argument, NULL, 'i'},  {"scale", required_argument, NULL, 's'},
         {"name", required_argument, NULL, 'n'},  {"no-store", no_argument, NULL, 'N'},
-        {"paper", no_argument, NULL, 'P'},       {"help", no_argument, NULL, 'h'},
-        {"refine-iters", required_argument, NULL, 'R'}, {"bending", required_argument, NULL, 'B'},
+        {"paper", no_argument, NULL, 'P'},       {"replace", no_argument, NULL, 'X'},
+        {"help", no_argument, NULL, 'h'},        {"bending", required_argument, NULL, 'B'},
+        {"refine-iters", required_argument, NULL, 'R'},
         {"residuals", required_argument, NULL, 'r'}, {"pca", required_argument, NULL, 'c'},
         {NULL, 0, NULL, 0}};
     char namebuf[256], text[1024], *cmd = NULL;
+    es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
     int c, store_it = 1;
     int64_t iters;
     es_ctx *ctx;
@@ -100,6 +103,7 @@ int cmd_embed(int argc, char **argv)
                 return cli_usage_error("embed", "--refine-iters wants a count >= 0");
             o.embed.refine_max_iter = (int)iters;
             break;
+        case 'X': wmode = ES_STORE_REPLACE; break;
         case 'h': fputs(usage, stdout); return CLI_OK;
         default: return cli_usage_error("embed", "bad option");
         }
@@ -119,7 +123,7 @@ int cmd_embed(int argc, char **argv)
     if (store_it) o.command = cmd = cli_command_line(argc, argv);
     const char *name = o.name;
     if (!store_it) o.name = NULL;
-    if (!(rc = es_store_open(ctx, argv[optind], store_it ? ES_STORE_WRITE : ES_STORE_READ, &s)))
+    if (!(rc = es_store_open(ctx, argv[optind], store_it ? wmode : ES_STORE_READ, &s)))
         rc = es_study_embed(ctx, s, &o, NULL, &res);
     if (rc) {
         cli_fail("embed", ctx, rc);

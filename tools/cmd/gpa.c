@@ -26,6 +26,7 @@ static const char usage[] =
     "      --max-iter N        iteration limit (default 1000)\n"
     "      --pcs N             principal components stored (default min(10, n-1))\n"
     "  -q, --quiet             print nothing on success\n"
+    "      --replace           replace a stored result of that name (else refused)\n"
     "  -h, --help              show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -39,10 +40,12 @@ int cmd_gpa(int argc, char **argv)
         {"where", required_argument, NULL, 'w'},  {"tol", required_argument, NULL, O_TOL},
         {"max-iter", required_argument, NULL, O_MAXIT},
         {"pcs", required_argument, NULL, O_PCS},  {"quiet", no_argument, NULL, 'q'},
-        {"help", no_argument, NULL, 'h'},         {NULL, 0, NULL, 0}};
+        {"replace", no_argument, NULL, 'R'}, {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0}};
     const char *name = NULL, *where = NULL;
     es_gpa_opts o;
     int64_t npc = 0;
+    es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
     int c, quiet = 0;
     es_gpa_opts_init(&o);
     optind = 1;
@@ -65,6 +68,7 @@ int cmd_gpa(int argc, char **argv)
                 return cli_usage_error("gpa", "bad --pcs '%s'", optarg);
             break;
         case 'q': quiet = 1; break;
+        case 'R': wmode = ES_STORE_REPLACE; break;
         case 'h': fputs(usage, stdout); return CLI_OK;
         default: return cli_usage_error("gpa", "bad option");
         }
@@ -77,7 +81,7 @@ int cmd_gpa(int argc, char **argv)
     int64_t *rows = NULL, nrows = -1;
     es_gpa_report rep;
     char *cmd = cli_command_line(argc, argv);
-    es_status rc = es_store_open(ctx, argv[optind], ES_STORE_WRITE, &s);
+    es_status rc = es_store_open(ctx, argv[optind], wmode, &s);
     if (rc == ES_OK && where && *where) rc = es_store_select(ctx, s, where, &rows, &nrows);
     if (rc == ES_OK) rc = es_study_gpa(ctx, s, name, rows, nrows, &o, npc, cmd, &rep);
     if (rc == ES_OK) rc = es_store_commit(ctx, s);

@@ -38,8 +38,9 @@ static const char usage[] =
     "  -n, --name NAME       result name in the store (default: output base name)\n"
     "      --no-store        do not write reports into the store\n"
     "      --bending W      weight of the prior's bending term against the lengths\n"
-    "                       (default 0.002; 0: the prior only starts and frames it)\n"
+    "                       (default 0.0025; 0: the prior only starts and frames it)\n"
     "      --refine-iters N  refinement iterations per frame (default 12)\n"
+    "      --replace         replace a stored result of that name (else refused)\n"
     "  -h, --help            show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -79,10 +80,12 @@ int cmd_interp(int argc, char **argv)
         {"steps", required_argument, NULL, 'k'}, {"t0", required_argument, NULL, '0'},
         {"t1", required_argument, NULL, '1'},   {"weights", required_argument, NULL, 'w'},
         {"output", required_argument, NULL, 'o'}, {"name", required_argument, NULL, 'n'},
-        {"no-store", no_argument, NULL, 'N'},   {"help", no_argument, NULL, 'h'},
-        {"refine-iters", required_argument, NULL, 'R'}, {"bending", required_argument, NULL, 'B'}, {"pca", required_argument, NULL, 'c'},
+        {"no-store", no_argument, NULL, 'N'},   {"replace", no_argument, NULL, 'X'},
+        {"help", no_argument, NULL, 'h'},       {"bending", required_argument, NULL, 'B'},
+        {"refine-iters", required_argument, NULL, 'R'}, {"pca", required_argument, NULL, 'c'},
         {NULL, 0, NULL, 0}};
     es_study_interp_opts o;
+    es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
     int c, store_it = 1;
     int64_t iters;
     es_ctx *ctx;
@@ -122,6 +125,7 @@ int cmd_interp(int argc, char **argv)
                 return cli_usage_error("interp", "--refine-iters wants a count >= 0");
             o.embed.refine_max_iter = (int)iters;
             break;
+        case 'X': wmode = ES_STORE_REPLACE; break;
         case 'h': fputs(usage, stdout); return CLI_OK;
         default: return cli_usage_error("interp", "bad option");
         }
@@ -149,7 +153,7 @@ int cmd_interp(int argc, char **argv)
         return CLI_FAIL;
     }
     o.command = cmd;
-    if ((rc = es_store_open(ctx, argv[optind], store_it ? ES_STORE_WRITE : ES_STORE_READ, &s)) ||
+    if ((rc = es_store_open(ctx, argv[optind], store_it ? wmode : ES_STORE_READ, &s)) ||
         (rc = es_study_interp(ctx, s, &o)))
         cli_fail("interp", ctx, rc);
     else if (store_it)

@@ -25,6 +25,7 @@ static const char usage[] =
     "  -n, --name NAME    result name in the store\n"
     "      --no-store     compute and export only; leave the store unchanged\n"
     "  -o, --csv PATH     write edge,v0,v1,<group>... (one column per group; - for stdout)\n"
+    "      --replace      replace a stored result of that name (else refused)\n"
     "  -h, --help         show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -34,9 +35,11 @@ int cmd_mean(int argc, char **argv)
     static const struct option lo[] = {
         {"by", required_argument, NULL, 'b'}, {"where", required_argument, NULL, 'w'},
         {"name", required_argument, NULL, 'n'}, {"csv", required_argument, NULL, 'o'},
-        {"no-store", no_argument, NULL, 'N'}, {"help", no_argument, NULL, 'h'},
+        {"no-store", no_argument, NULL, 'N'}, {"replace", no_argument, NULL, 'R'},
+        {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
     const char *by = NULL, *where = NULL, *name = NULL, *csv = NULL;
+    es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
     int c, nostore = 0;
     optind = 1;
     while ((c = getopt_long(argc, argv, "b:w:n:o:h", lo, NULL)) != -1) {
@@ -46,6 +49,7 @@ int cmd_mean(int argc, char **argv)
         case 'n': name = optarg; break;
         case 'o': csv = optarg; break;
         case 'N': nostore = 1; break;
+        case 'R': wmode = ES_STORE_REPLACE; break;
         case 'h': fputs(usage, stdout); return CLI_OK;
         default: return cli_usage_error("mean", "bad option");
         }
@@ -65,7 +69,7 @@ int cmd_mean(int argc, char **argv)
     es_store *st = NULL;
     es_group_result *r = NULL;
     int ret = CLI_FAIL;
-    es_status rc = es_store_open(ctx, argv[optind], name ? ES_STORE_WRITE : ES_STORE_READ, &st);
+    es_status rc = es_store_open(ctx, argv[optind], name ? wmode : ES_STORE_READ, &st);
     if (rc == ES_OK) rc = es_study_mean(ctx, st, name, where, by, cmdline, &r);
     if (rc != ES_OK) {
         cli_fail("mean", ctx, rc);
@@ -74,14 +78,14 @@ int cmd_mean(int argc, char **argv)
     printf("%-20s %8s %14s\n", by ? by : "group", "rows", "mean scale");
     for (int64_t g = 0; g < r->ngroups; g++)
         printf("%-20s %8lld %14.6g\n", r->names[g], (long long)r->counts[g], r->scales[g]);
-    if ((rc = es_store_commit(ctx, st)) != ES_OK) {
+    /* the table first: a failure leaves the store as it was */
+    if ((csv && (rc = es_study_write_mean_table(ctx, st, r, csv)) != ES_OK) ||
+        (rc = es_store_commit(ctx, st)) != ES_OK) {
         cli_fail("mean", ctx, rc);
         goto done;
     }
     if (name) printf("stored as /analysis/mean/%s\n", name);
     ret = CLI_OK;
-    if (csv && (rc = es_study_write_mean_table(ctx, st, r, csv)) != ES_OK)
-        ret = cli_fail("mean", ctx, rc);
 done:
     es_group_result_free(r);
     if (ret == CLI_OK) es_store_close(st);

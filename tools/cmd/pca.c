@@ -31,6 +31,7 @@ static const char usage[] =
     "      --seed S           seed of the randomized method\n"
     "  -o, --csv PREFIX       write PREFIX_scores.csv (id, every label, PC1..PCK),\n"
     "                         PREFIX_eigenvalues.csv and PREFIX_components.csv\n"
+    "      --replace          replace a stored result of that name (else refused)\n"
     "  -h, --help             show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -42,11 +43,12 @@ int cmd_pca(int argc, char **argv)
         {"components", required_argument, NULL, 'k'}, {"method", required_argument, NULL, 'm'},
         {"oversample", required_argument, NULL, 'p'}, {"power-iters", required_argument, NULL, 'q'},
         {"seed", required_argument, NULL, 's'}, {"csv", required_argument, NULL, 'o'},
-        {"help", no_argument, NULL, 'h'}, {NULL, 0, NULL, 0}};
+        {"replace", no_argument, NULL, 'R'}, {"help", no_argument, NULL, 'h'}, {NULL, 0, NULL, 0}};
     const char *name = "default", *where = NULL, *csv = NULL;
     es_pca_opts o;
     es_pca_opts_init(&o);
     int64_t seed = -1;
+    es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
     int c;
     optind = 1;
     while ((c = getopt_long(argc, argv, "n:w:k:m:o:h", lo, NULL)) != -1) {
@@ -77,6 +79,7 @@ int cmd_pca(int argc, char **argv)
             else if (!strcmp(optarg, "randomized")) o.method = ES_PCA_RANDOMIZED;
             else return cli_usage_error("pca", "unknown method '%s'", optarg);
             break;
+        case 'R': wmode = ES_STORE_REPLACE; break;
         case 'h': fputs(usage, stdout); return CLI_OK;
         default: return cli_usage_error("pca", "bad option");
         }
@@ -92,7 +95,7 @@ int cmd_pca(int argc, char **argv)
     es_pca *p = NULL;
     int64_t *rows = NULL, nrows = 0;
     int ret = CLI_FAIL;
-    es_status rc = es_store_open(ctx, argv[optind], ES_STORE_WRITE, &st);
+    es_status rc = es_store_open(ctx, argv[optind], wmode, &st);
     if (rc == ES_OK) rc = es_study_pca(ctx, st, name, where, &o, cmdline, &p, &rows, &nrows);
     if (rc != ES_OK) {
         cli_fail("pca", ctx, rc);
@@ -109,14 +112,14 @@ int cmd_pca(int argc, char **argv)
                (long long)(k + 1), p->eigenvalues[k], 100 * p->explained[k], 100 * cum);
     }
     if (p->ncomp > 10) printf("  ... (%lld more)\n", (long long)(p->ncomp - 10));
-    if ((rc = es_store_commit(ctx, st)) != ES_OK) {
+    /* the tables first: a failure leaves the store as it was */
+    if ((csv && (rc = es_study_write_pca_tables(ctx, st, p, rows, csv)) != ES_OK) ||
+        (rc = es_store_commit(ctx, st)) != ES_OK) {
         cli_fail("pca", ctx, rc);
         goto done;
     }
     printf("stored as /analysis/pca/%s\n", name);
     ret = CLI_OK;
-    if (csv && (rc = es_study_write_pca_tables(ctx, st, p, rows, csv)) != ES_OK)
-        ret = cli_fail("pca", ctx, rc);
 done:
     es_pca_free(p);
     es_free(ctx, rows);

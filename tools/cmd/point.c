@@ -26,6 +26,7 @@ static const char usage[] =
     "  -p, --pca NAME    the PCA of pc:K (default: the only one, or \"default\")\n"
     "  -s, --scale S     embed at scale S instead of the rule\n"
     "  -o, --csv PATH    write edge,v0,v1,length (normalized) as CSV (- for stdout)\n"
+    "      --replace     replace a stored result of that name (else refused)\n"
     "  -h, --help        show this help\n"
     "\n"
     "Exit status: 0 ok (also for an invalid point), 1 failure, 2 usage error.\n";
@@ -35,9 +36,10 @@ int cmd_point(int argc, char **argv)
     static const struct option lo[] = {
         {"name", required_argument, NULL, 'n'}, {"pca", required_argument, NULL, 'p'},
         {"scale", required_argument, NULL, 's'}, {"csv", required_argument, NULL, 'o'},
-        {"help", no_argument, NULL, 'h'}, {NULL, 0, NULL, 0}};
+        {"replace", no_argument, NULL, 'R'}, {"help", no_argument, NULL, 'h'}, {NULL, 0, NULL, 0}};
     const char *name = NULL, *pca = NULL, *csv = NULL;
     double scale = 0;
+    es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
     int c;
     optind = 1;
     while ((c = getopt_long(argc, argv, "n:p:s:o:h", lo, NULL)) != -1) {
@@ -49,6 +51,7 @@ int cmd_point(int argc, char **argv)
             if (cli_parse_double(optarg, &scale) || !(scale > 0))
                 return cli_usage_error("point", "--scale wants a positive number");
             break;
+        case 'R': wmode = ES_STORE_REPLACE; break;
         case 'h': fputs(usage, stdout); return CLI_OK;
         default: return cli_usage_error("point", "bad option");
         }
@@ -61,7 +64,7 @@ int cmd_point(int argc, char **argv)
     double *vec = NULL;
     es_point_info info;
     int ret = CLI_FAIL;
-    es_status rc = es_store_open(ctx, argv[optind], name ? ES_STORE_WRITE : ES_STORE_READ, &st);
+    es_status rc = es_store_open(ctx, argv[optind], name ? wmode : ES_STORE_READ, &st);
     if (rc == ES_OK)
         rc = es_study_point(ctx, st, name, argv[optind + 1], pca, scale, cmdline, &vec, NULL,
                             &info);
@@ -89,17 +92,15 @@ int cmd_point(int argc, char **argv)
                    v->worst_violation);
         printf("\n");
     }
-    if ((rc = es_store_commit(ctx, st)) != ES_OK) {
+    /* the table first: a failure leaves the store as it was */
+    static const char *const names[1] = {"length"};
+    if ((csv && (rc = es_study_write_edge_table(ctx, st, csv, 1, names, vec)) != ES_OK) ||
+        (rc = es_store_commit(ctx, st)) != ES_OK) {
         cli_fail("point", ctx, rc);
         goto done;
     }
     if (name) printf("stored as /analysis/point/%s\n", name);
     ret = CLI_OK;
-    if (csv) {
-        static const char *const names[1] = {"length"};
-        if ((rc = es_study_write_edge_table(ctx, st, csv, 1, names, vec)) != ES_OK)
-            ret = cli_fail("point", ctx, rc);
-    }
 done:
     es_free(ctx, vec);
     if (ret == CLI_OK) es_store_close(st);

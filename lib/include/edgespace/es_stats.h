@@ -85,7 +85,7 @@ typedef struct es_pca_opts {
                              ES_PCA_RANDOMIZED needs K > 0. */
     es_pca_method method;
     int64_t oversample;   /* randomized: extra sample vectors p (default 10) */
-    int64_t power_iters;  /* randomized: subspace iterations q (default 4) */
+    int64_t power_iters;  /* randomized: subspace iterations q (default 4, at most 1000) */
 } es_pca_opts;
 
 /* Defaults: ncomp 0, AUTO, oversample 10, power_iters 4. */

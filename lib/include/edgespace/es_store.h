@@ -52,12 +52,22 @@ ES_API const char *es_topology_kind_name(es_topology_kind kind);
 
 typedef enum es_store_mode {
     ES_STORE_READ = 0,
-    ES_STORE_WRITE = 1   /* read and write an existing store */
+    ES_STORE_WRITE = 1,  /* read and write an existing store; a result is never
+                            written over one of the same name (ES_EEXIST) */
+    ES_STORE_REPLACE = 2 /* ES_STORE_WRITE, and results written through this
+                            handle replace those of the same name (--replace) */
 } es_store_mode;
 
-/* Open an existing store; checks the format version. Fails with
- * ES_ENOTFOUND if the file does not exist, ES_EFORMAT if it is not a store
- * (or of another format version). */
+/* Open an existing store. Everything the file says is checked once, here,
+ * before any of it is used: the format version, every dataset's type,
+ * shape and row count against the others and against the bytes the file
+ * holds, the topology's indices (faces within the vertices, edges sorted,
+ * unique and those of the faces), the scales, unique non-empty ids, the
+ * label columns, and every string against HDF5's heap (strings are decoded
+ * by the store itself, not by libhdf5, whose heap reader crashes on a
+ * corrupt file). Fails with ES_ENOTFOUND if the file does not exist,
+ * ES_EFORMAT naming the dataset and what disagrees if it is not a store (or
+ * of another format version, or corrupt). */
 ES_API es_status es_store_open(es_ctx *ctx, const char *path, es_store_mode mode,
                                es_store **out);
 /* Create a new, empty store (N = 0) for `mesh`'s topology, open for
@@ -158,19 +168,31 @@ ES_API const char *es_store_column_name(const es_store *store, int64_t col);
 ES_API int64_t es_store_find_column(const es_store *store, const char *name);
 ES_API const char *es_store_label(const es_store *store, int64_t row, int64_t col);
 
+/* For the message about a name the store does not have: the label columns
+ * closest to `name` by edit distance, as " (did you mean 'group'?)", or the
+ * first few columns when none is close (" (columns: file, id, ...)"); for
+ * es_store_value_hint, the values of column col (col -1: the row ids). ""
+ * when there is nothing to offer. Writes at most n bytes to buf. */
+ES_API void es_store_column_hint(const es_store *store, const char *name, char *buf, size_t n);
+ES_API void es_store_value_hint(const es_store *store, int64_t col, const char *value, char *buf,
+                                size_t n);
+
 /* Rows matching a filter "col=value[,col=value...]" (all must hold; NULL or
  * "" selects every row; the column "id" means the row id unless a label
  * column has that name), in row order. A value that holds ',' is written
  * quoted, col="a,b" (any characters but '"'); ES_EFORMAT on a quote that
  * is not closed or not followed by ',' or the end. *rows is allocated with the ctx
- * allocator (es_free). Unknown columns fail with ES_ENOTFOUND. */
+ * allocator (es_free). Unknown columns fail with ES_ENOTFOUND naming the
+ * closest ones; a value that no row has selects nothing, with a warning
+ * (log callback) that names the closest values. */
 ES_API es_status es_store_select(es_ctx *ctx, const es_store *store, const char *filter,
                                  int64_t **rows, int64_t *nrows);
 
 /* ---- analysis results -------------------------------------------------
  * Results live under /analysis/<kind>/<name>/ (kind: pca, mean, diff,
- * point, gpa, compare, embed, ...). Writing a result that exists replaces
- * it. Each result group carries provenance attributes (command, tool
+ * point, gpa, compare, embed, ...). Writing a result that exists is refused
+ * (ES_EEXIST naming it) unless the handle was opened with ES_STORE_REPLACE,
+ * which replaces it: never silently. Each result group carries provenance attributes (command, tool
  * version, UTC time, rows used) set by es_store_result_begin: attributes
  * command, tool_version, time, params, store_nrows, and the dataset
  * input_rows (int64 row indices). Writes go to the working copy and become
@@ -182,7 +204,14 @@ typedef struct es_provenance {
     const char *params;      /* free-form "key=value; ..." parameters, or NULL */
 } es_provenance;
 
-/* Create (or replace) /analysis/<kind>/<name> with its provenance. */
+/* ES_OK if /analysis/<kind>/<name> may be written through this handle (the
+ * name is free, or the handle replaces results), else ES_EEXIST naming it;
+ * ES_EINVAL for a bad kind or name. The analyses of es_study.h call it
+ * before they compute, so that a long one is not run only to be refused. */
+ES_API es_status es_store_result_check(es_ctx *ctx, es_store *store, const char *kind,
+                                       const char *name);
+/* Create /analysis/<kind>/<name> with its provenance (replacing one of that
+ * name only with ES_STORE_REPLACE; es_store_result_check's rule). */
 ES_API es_status es_store_result_begin(es_ctx *ctx, es_store *store, const char *kind,
                                        const char *name, const es_provenance *prov);
 /* Datasets inside a result group: `path` is "<kind>/<name>/<dataset>". */

@@ -15,7 +15,9 @@
  *   point/<name>: lengths (E), scale (1); attrs expression, weight, valid,
  *                 n_bad_faces, n_nonpositive, worst_violation, worst_face
  * Every result carries the provenance of es_store_result_begin (command,
- * tool version, time, rows used) and is replaced when written again.
+ * tool version, time, rows used). A name that is taken is refused with
+ * ES_EEXIST before anything is computed, unless the store was opened with
+ * ES_STORE_REPLACE, which replaces it (es_store_result_check).
  */
 #ifndef EDGESPACE_ES_STUDY_H
 #define EDGESPACE_ES_STUDY_H
@@ -182,7 +184,7 @@ ES_API es_status es_study_write_projection_table(es_ctx *ctx, const es_study_pro
 
 /* GPA of the positions of `rows` (nrows of them; rows NULL with nrows = -1:
  * every row) of an open store, with the PCA of the residual tangent
- * coordinates, written to /analysis/gpa/<name> (replaced if present) with
+ * coordinates, written to /analysis/gpa/<name> (a taken name: as above) with
  * provenance (command; params: scale, allow_reflection, tol, max_iter):
  *   aligned   n x k*d   row j: configuration of input row j (x-, y-, z-block)
  *   mean      k*d       Procrustes mean;  size, rho, scale: n each

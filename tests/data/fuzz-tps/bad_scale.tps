@@ -1,0 +1,3 @@
+1LM=1
+1 2
+SCALE=zero

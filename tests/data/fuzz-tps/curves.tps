@@ -1,0 +1,9 @@
+1LM=2
+0 0
+1 1
+CURVES=1
+POINTS=2
+0 0
+1 1
+ID=c
+SCALE=2
