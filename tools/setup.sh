@@ -22,6 +22,7 @@ packages=(
   build-essential meson ninja-build pkg-config python3
   libopenblas-dev liblapacke-dev libsuitesparse-dev libhdf5-dev hdf5-tools libcsv-dev
   libcairo2-dev libcjson-dev
+  r-base-core r-cran-shapes   # R oracles: the shapes package's landmark data sets
   clang libclang-rt-14-dev   # libFuzzer targets for the parsers
 )
 
