@@ -65,8 +65,9 @@ def _is_one_mesh(m):
     """An Embedding, a Mesh, or a (V, F) pair of arrays (not a list of meshes)."""
     if hasattr(m, "V") or hasattr(m, "vertices"):
         return True
-    if isinstance(m, (list, tuple)) and len(m) == 2:
-        V, F = (np.asarray(x) for x in m)
+    if isinstance(m, (list, tuple)) and len(m) == 2 and \
+            all(isinstance(x, np.ndarray) for x in m):
+        V, F = m
         return V.ndim == 2 and V.shape[-1] == 3 and F.ndim == 2 and \
             np.issubdtype(F.dtype, np.integer)
     return False

@@ -188,8 +188,8 @@ class Store:
     def abort(self):
         """Close, discarding uncommitted writes."""
         if self._ptr is not None:
-            ptr = ffi.gc(self._ptr, None)
-            lib.es_store_abort(ptr)
+            ffi.gc(self._ptr, None)   # no es_store_close at collection
+            lib.es_store_abort(self._ptr)
             self._ptr = None
 
     def __enter__(self):
