@@ -8,11 +8,12 @@ keep their context alive.
 
 Progress (es_ctx_set_progress) reaches `progress`: a callable
 progress(what, done, total), True or "auto" (a tqdm bar per stage when tqdm
-is installed, else nothing), or None/False (silent). Warnings the library
-logs become EdgespaceWarning (warnings.warn); notes go to the logging
-logger "edgespace" at INFO.
+is installed, else nothing), or None/False (silent); the default context's
+is "auto". Warnings the library logs become EdgespaceWarning
+(warnings.warn); notes go to the logging logger "edgespace" at INFO.
 """
 import logging
+import sys
 import threading
 import warnings
 
@@ -27,8 +28,16 @@ class EdgespaceWarning(UserWarning):
 
 
 def _tqdm():
+    """tqdm's bar class for where we run: widgets in a Jupyter kernel that has
+    ipywidgets, text on a terminal; None where neither would read well (a
+    kernel without widgets, where text bars leave blank lines) or without
+    tqdm."""
     try:
-        from tqdm.auto import tqdm
+        if "ipykernel" in sys.modules:
+            import ipywidgets  # noqa: F401
+            from tqdm.notebook import tqdm
+        else:
+            from tqdm.std import tqdm
     except ImportError:
         return None
     return tqdm
@@ -68,8 +77,9 @@ class Context:
     seed      everything random the library does (randomized PCA, permutation
               tests, synthetic data) starts from it; default 0x5eed, the
               library's and the notebooks'.
-    progress  callable(what, done, total), True/"auto" (tqdm when installed)
-              or None/False.
+    progress  callable(what, done, total), True/"auto" (a tqdm bar per stage
+              that lasts over a second, when tqdm is installed: text on a
+              terminal, a widget in Jupyter with ipywidgets) or None/False.
     """
 
     def __init__(self, seed=None, progress="auto"):
