@@ -3,7 +3,8 @@
 what its C twin notebooks-c/01_faces.c finds on the same data with the same
 seed: the same PCA (eigenvalues, explained variance, scores), the same
 embedded points (scale, RMS and largest edge errors, bending and distance
-from the prior), to the digits the C notebook prints. Both run small
+from the prior), to the digits the C notebook prints, and the same figures
+byte for byte. Both run small
 (EDGESPACE_NOTEBOOK_SMALL=1, --small: the test suite's sizes) into a
 temporary folder."""
 import csv
@@ -64,6 +65,14 @@ def test_the_notebook_ran_and_its_checks_passed(runs):
     assert images >= 4                                    # scree, scatter, faces, heat map
     for f in ("expressions.png", "happy_t_heatmap.png", "pc1_pc2.png", "mean_neutral.obj"):
         assert (py / f).stat().st_size > 1000
+
+
+def test_same_figures_as_the_c_notebook(runs):
+    """The pictures are drawn by the same library calls from the same numbers:
+    byte for byte the C notebook's PNGs."""
+    c, py, _, _ = runs
+    for f in ("pc1_pc2.png", "pc1_pc3.png", "expressions.png", "happy_t_heatmap.png"):
+        assert (py / f).read_bytes() == (c / f).read_bytes(), f
 
 
 def test_same_pca_as_the_c_notebook(runs):

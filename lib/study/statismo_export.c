@@ -18,6 +18,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <sys/stat.h>
 
 void es_study_statismo_opts_init(es_study_statismo_opts *o)
 {
@@ -304,6 +305,15 @@ es_status es_study_export_statismo(es_ctx *ctx, es_store *s, const es_study_stat
     if (es_store_topology_kind(s) != ES_TOPOLOGY_MESH || es_store_nfaces(s) < 1)
         ES_FAIL(ctx, ES_EINVAL, "statismo: store '%s' has no triangles; a statismo mesh model "
                 "needs them", es_store_path(s));
+    {
+        /* the store itself as the output: refused before the embeddings
+         * (es_statismo_write refuses any HDF5 file that is not a model) */
+        struct stat a, b;
+        if (path && stat(path, &a) == 0 && stat(es_store_path(s), &b) == 0 &&
+            a.st_dev == b.st_dev && a.st_ino == b.st_ino)
+            ES_FAIL(ctx, ES_EEXIST, "statismo: refusing to overwrite the store '%s' with a "
+                    "model", path);
+    }
     if (o->gpa_name ? 0 : !(o->sd > 0 && isfinite(o->sd)))
         ES_FAIL(ctx, ES_EINVAL, "statismo: the step along each PC must be > 0 sd (got %g)",
                 o->sd);

@@ -127,6 +127,8 @@ def test_export_errors(store_path, tmp_path, cli, ctx):
         shutil.copyfile(store_path, other)
         with pytest.raises(es.ExistsError, match="not a statismo model"):
             st.export_statismo(other, pca="faces", ncomp=1)
+        with pytest.raises(es.ExistsError, match="refusing to overwrite the store"):
+            st.export_statismo(store_path, pca="faces", ncomp=1)
         st.export_statismo(tmp_path / "m.h5", pca="faces", ncomp=1)
         st.export_statismo(tmp_path / "m.h5", pca="faces", ncomp=2)
     with h5py.File(tmp_path / "m.h5", "r") as f:

@@ -207,8 +207,20 @@ int main(void)
                        "> 0 sd");
         o.sd = 1;
         ES_CHECK_FAILS(ctx, es_study_export_statismo(ctx, s, &o, path, NULL), ES_EEXIST,
-                       "not a statismo model");
+                       "refusing to overwrite the store");
         ES_CHECK(es_test_same_bytes(path, store_before, n1));
+        {   /* any other HDF5 file that is not a model: refused at the write */
+            char copy[4400];
+            FILE *c;
+            snprintf(copy, sizeof copy, "%s/other.h5", dir);
+            if ((c = fopen(copy, "wb"))) {
+                fwrite(store_before, 1, n1, c);
+                fclose(c);
+            }
+            ES_CHECK_FAILS(ctx, es_study_export_statismo(ctx, s, &o, copy, NULL), ES_EEXIST,
+                           "not a statismo model");
+            ES_CHECK(es_test_same_bytes(copy, store_before, n1));
+        }
         /* invalid models: nothing written, the earlier file intact */
         double mean[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0}, basis[9] = {1}, var1[1] = {1};
         int64_t tri[3] = {0, 1, 3};
