@@ -28,9 +28,12 @@ packages=(
   libopenblas-dev liblapacke-dev libsuitesparse-dev libhdf5-dev hdf5-tools libcsv-dev
   libcairo2-dev libcjson-dev
   clang libclang-rt-14-dev   # libFuzzer targets for the parsers
-  # the Python package, its tests and notebooks (Debian's /usr/bin/python3)
-  python3-cffi python3-numpy python3-pytest python3-h5py python3-tqdm
+  # the Python package, its tests and notebooks (Debian's /usr/bin/python3;
+  # python/tests/run.py --check verifies them below)
+  python3-cffi python3-numpy python3-pytest python3-h5py python3-tqdm python3-pandas
   jupyter-nbconvert python3-ipykernel
+  # R, for the tests that run datasets-spec/store-format.md's R snippets
+  r-base-core r-cran-hdf5r r-bioc-rhdf5
 )
 
 install_missing() {
@@ -70,6 +73,8 @@ install_python() {
     echo "$here/python" | $sudo tee "$pth" >/dev/null
     echo "setup: $pth -> $here/python" >&2
   fi
+  # every module the Python tests need, or fail: CI runs them, never skips them
+  "$py" "$here/python/tests/run.py" --check
   if [ -f "$here/build/lib/libedgespace.so" ]; then
     (cd / && "$py" -c "import edgespace") || { echo "setup: import edgespace failed" >&2; return 1; }
   fi
