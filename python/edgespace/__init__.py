@@ -62,7 +62,7 @@ def pca(X, ncomp=0, method="auto", oversample=10, power_iters=4, ctx=None):
     """PCA of the rows of an (N, E) array of length vectors (es_pca_fit on
     es_source_matrix: the array is the library's E x N matrix, not copied)."""
     from ._context import ctx_of
-    from .store import _PCA_METHODS
+    from .store import _pca_method
     ctx = ctx_of(ctx)
     X = _A.f64(X, (None, None), "X")
     m, keep = _A.mat(X)
@@ -70,7 +70,7 @@ def pca(X, ncomp=0, method="auto", oversample=10, power_iters=4, ctx=None):
     srcp = ffi.new("es_source *", src)
     o = ffi.new("es_pca_opts *")
     lib.es_pca_opts_init(o)
-    o.ncomp, o.method = int(ncomp), getattr(lib, _PCA_METHODS[method])
+    o.ncomp, o.method = int(ncomp), _pca_method(method)
     o.oversample, o.power_iters = int(oversample), int(power_iters)
     out = ffi.new("es_pca **")
     ctx.call(lib.es_pca_fit, srcp, o, out)

@@ -25,6 +25,13 @@ _PCA_METHODS = {"auto": "ES_PCA_AUTO", "gram": "ES_PCA_GRAM",
                 "covariance": "ES_PCA_COVARIANCE", "randomized": "ES_PCA_RANDOMIZED"}
 
 
+def _pca_method(method):
+    """es_pca_method of a name; a ValueError naming the choices otherwise."""
+    if method not in _PCA_METHODS:
+        raise ValueError(f"PCA method {method!r}: one of {', '.join(_PCA_METHODS)}")
+    return getattr(lib, _PCA_METHODS[method])
+
+
 def _s(x):
     return None if x is None else str(x).encode("utf-8")
 
@@ -450,7 +457,7 @@ class Store:
         pca/<name> when name is given. Returns a PCA with .rows."""
         o = ffi.new("es_pca_opts *")
         lib.es_pca_opts_init(o)
-        o.ncomp, o.method = int(ncomp), getattr(lib, _PCA_METHODS[method])
+        o.ncomp, o.method = int(ncomp), _pca_method(method)
         o.oversample, o.power_iters = int(oversample), int(power_iters)
         out, rows, n = ffi.new("es_pca **"), ffi.new("int64_t **"), ffi.new("int64_t *")
         self.ctx.call(lib.es_study_pca, self.ptr, _s(name) or ffi.NULL, _s(filter) or ffi.NULL,
