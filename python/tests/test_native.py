@@ -7,12 +7,13 @@ command's."""
 import os
 import shutil
 import subprocess
+import sys
 
 import pytest
 
 import edgespace as es
 from edgespace import _native
-from conftest import BUILD_ROOT
+from conftest import BUILD_ROOT, SOURCE_ROOT
 
 
 def _structs():
@@ -77,3 +78,38 @@ def test_declarations_are_the_headers():
     assert "#" not in decl and "ES_API" not in decl and "/*" not in decl
     assert "es_status es_study_embed(" in " ".join(decl.split())
     assert es.has_figures() == _native.has("es_render")
+
+
+def _import_in_a_fresh_interpreter(tmp_path, code, **env_extra):
+    """Run code in Debian's python3 from /, the package found the way
+    tools/setup.sh makes it found (a .pth file naming python/ in a site
+    directory), with no EDGESPACE_* variables."""
+    site = tmp_path / "site"
+    site.mkdir(exist_ok=True)
+    (site / "edgespace.pth").write_text(os.path.dirname(os.path.dirname(es.__file__)) + "\n")
+    env = {k: v for k, v in os.environ.items()
+           if not k.startswith("EDGESPACE") and k != "PYTHONPATH"}
+    env.update(env_extra)
+    boot = f"import site; site.addsitedir({str(site)!r}); " + code
+    return subprocess.run([sys.executable, "-c", boot], cwd="/", env=env,
+                          capture_output=True, text=True)
+
+
+def test_set_up_makes_import_edgespace_work(tmp_path):
+    built = os.path.join(SOURCE_ROOT, "build", "lib", "libedgespace.so")
+    if not os.path.isfile(built):
+        pytest.skip(f"no build/ in this checkout ({built}): the library is found elsewhere")
+    r = _import_in_a_fresh_interpreter(
+        tmp_path, "import edgespace as es; print(es.LIBRARY_PATH); print(es.INCLUDE_DIR); "
+                  "print(es.version())")
+    assert r.returncode == 0, r.stderr
+    lib_path, inc, version = r.stdout.split()
+    assert os.path.samefile(lib_path, built) and version == es.version()
+    assert os.path.samefile(inc, os.path.join(SOURCE_ROOT, "lib", "include", "edgespace"))
+
+
+def test_a_wrong_library_path_is_a_load_error(tmp_path):
+    r = _import_in_a_fresh_interpreter(
+        tmp_path, "import edgespace", EDGESPACE_LIBRARY=str(tmp_path / "nope.so"))
+    assert r.returncode == 1
+    assert f"LoadError: EDGESPACE_LIBRARY='{tmp_path / 'nope.so'}' is not a file" in r.stderr
