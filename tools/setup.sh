@@ -6,6 +6,11 @@
 #   bash tools/setup.sh test    # install, build, run every test  (README step 2)
 #   bash tools/setup.sh build   # install and build only
 #
+# Every mode also makes the Python package (python/edgespace) importable by
+# Debian's interpreter: a path file edgespace.pth in its site-packages names
+# python/ of this checkout, and the package loads build/lib/libedgespace.so
+# (python/README.md); `/usr/bin/python3 -c "import edgespace"` then works.
+#
 # Installs exactly the missing Debian packages (apt-get, non-interactive,
 # idempotent: a second run installs nothing). Environment:
 #   BUILD_DIR   build directory (default: build)
@@ -24,6 +29,12 @@ packages=(
   libcairo2-dev libcjson-dev
   r-base-core r-cran-shapes   # R oracles: the shapes package's landmark data sets
   clang libclang-rt-14-dev   # libFuzzer targets for the parsers
+  # the Python package, its tests and notebooks (Debian's /usr/bin/python3;
+  # python/tests/run.py --check verifies them below)
+  python3-cffi python3-numpy python3-pytest python3-h5py python3-tqdm python3-pandas
+  jupyter-nbconvert python3-ipykernel
+  # R, for the tests that run datasets-spec/store-format.md's R snippets
+  r-cran-hdf5r r-bioc-rhdf5
 )
 
 install_missing() {
@@ -50,11 +61,32 @@ configure_and_build() {
   ninja -C "$build_dir" >&2
 }
 
+# python/ on Debian's interpreter's path (idempotent; rewritten when the
+# checkout moves). The package finds the library that `build` holds.
+install_python() {
+  local py=/usr/bin/python3 site pth sudo=""
+  [ -x "$py" ] || return 0
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  site=$("$py" -c 'import site; print(site.getsitepackages()[0])')
+  pth="$site/edgespace.pth"
+  if [ "$(cat "$pth" 2>/dev/null)" != "$here/python" ]; then
+    $sudo mkdir -p "$site"
+    echo "$here/python" | $sudo tee "$pth" >/dev/null
+    echo "setup: $pth -> $here/python" >&2
+  fi
+  # every module the Python tests need, or fail: CI runs them, never skips them
+  "$py" "$here/python/tests/run.py" --check
+  if [ -f "$here/build/lib/libedgespace.so" ]; then
+    (cd / && "$py" -c "import edgespace") || { echo "setup: import edgespace failed" >&2; return 1; }
+  fi
+}
+
 install_missing
 case "$mode" in
-  build) configure_and_build ;;
-  demo)  configure_and_build; bash tools/main-job.sh "$build_dir" ;;
+  build) configure_and_build; install_python ;;
+  demo)  configure_and_build; install_python; bash tools/main-job.sh "$build_dir" ;;
   # shellcheck disable=SC2086
-  test)  configure_and_build; meson test -C "$build_dir" --print-errorlogs --num-processes 2 ${TEST_ARGS:-} ;;
+  test)  configure_and_build; install_python
+         meson test -C "$build_dir" --print-errorlogs --num-processes 2 ${TEST_ARGS:-} ;;
   *) echo "usage: $0 [build|demo|test]" >&2; exit 2 ;;
 esac

@@ -1,14 +1,18 @@
 /* tools/cmd/export.c — edgespace export: a store's rows as a CSV of edge
- * lengths or as mesh files (es_export_lengths_csv, es_export_meshes). */
+ * lengths or as mesh files (es_export_lengths_csv, es_export_meshes), or a
+ * stored PCA as a statismo shape model (es_study_export_statismo). */
 #include "cli.h"
 #include "commands.h"
 
 #include <getopt.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static const char usage[] =
     "usage: edgespace export STORE (--lengths CSV | --meshes DIR) [options]\n"
+    "       edgespace export STORE --statismo MODEL.h5 [--pca NAME | --gpa NAME]\n"
+    "                        [--components K] [--sd C] [--noise-variance V]\n"
     "\n"
     "Write rows of a store: their edge lengths as CSV (id, scale, then one column\n"
     "per edge named by its 0-based vertex pair 'a-b'), or their positions as they\n"
@@ -20,9 +24,52 @@ static const char usage[] =
     "  -f, --format FMT      mesh format: obj (default), ply, ply-ascii, off\n"
     "  -s, --select FILTER   only rows matching col=value[,col=value...]\n"
     "                        (quote a value holding ',': col=\"a,b\")\n"
+    "      --statismo FILE   write a statismo shape model (datasets-spec/statismo.md)\n"
+    "                        that statismo and scalismo load: of an edge-length PCA\n"
+    "      --pca NAME        (default: the only one, else 'default'), linearized by\n"
+    "                        embedding its mean -/+ C sd along each PC; or of the\n"
+    "      --gpa NAME        Procrustes PCA of a GPA result (its tangent modes)\n"
+    "      --components K    modes to export (default: 10 of a PCA, all of a GPA)\n"
+    "      --sd C            the step along each PC, in sd (default 1)\n"
+    "      --noise-variance V  the model's noise variance (default: 0 for a PCA,\n"
+    "                        the PPCA estimate for a GPA)\n"
     "  -h, --help            show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
+
+/* --statismo: one library call; the report on standard output. */
+static int export_statismo(const char *store, const char *path, es_study_statismo_opts *so,
+                           int other, int argc, char **argv)
+{
+    es_study_statismo_report r;
+    es_store *s = NULL;
+    es_ctx *ctx;
+    es_status rc;
+    char *cmd;
+    if (other) return cli_usage_error("export", "--statismo goes alone (no --lengths, "
+                                      "--meshes or --select)");
+    if (so->pca_name && so->gpa_name) return cli_usage_error("export", "give --pca or --gpa");
+    if (!(ctx = cli_ctx_new("export"))) return CLI_FAIL;
+    so->command = cmd = cli_command_line(argc, argv);
+    if ((rc = es_store_open(ctx, store, ES_STORE_READ, &s)) == ES_OK)
+        rc = es_study_export_statismo(ctx, s, so, path, &r);
+    es_store_close(s);
+    free(cmd);
+    if (rc != ES_OK) {
+        cli_fail("export", ctx, rc);
+        es_ctx_free(ctx);
+        return CLI_FAIL;
+    }
+    printf("%s: %lld modes of %s, %lld vertices, %lld triangles, noise variance %.6g\n", path,
+           (long long)r.ncomp, r.source, (long long)r.nverts, (long long)r.nfaces,
+           r.noise_variance);
+    if (!so->gpa_name)
+        printf("embeddings: worst RMS ratio %.3g, worst bending %.3f x the prior's; "
+               "nonlinearity over -/+%g sd %.3g\n", r.worst_rms_ratio, r.worst_bend_ratio,
+               so->sd, r.nonlinearity);
+    es_ctx_free(ctx);
+    return CLI_OK;
+}
 
 int cmd_export(int argc, char **argv)
 {
@@ -30,14 +77,19 @@ int cmd_export(int argc, char **argv)
         {"lengths", required_argument, NULL, 'l'}, {"raw", no_argument, NULL, 'R'},
         {"meshes", required_argument, NULL, 'M'},  {"format", required_argument, NULL, 'f'},
         {"select", required_argument, NULL, 's'},  {"help", no_argument, NULL, 'h'},
+        {"statismo", required_argument, NULL, 'S'}, {"pca", required_argument, NULL, 'P'},
+        {"gpa", required_argument, NULL, 'G'},      {"components", required_argument, NULL, 'k'},
+        {"sd", required_argument, NULL, 'c'}, {"noise-variance", required_argument, NULL, 'n'},
         {NULL, 0, NULL, 0}};
-    const char *lengths = NULL, *meshes = NULL, *filter = NULL;
+    const char *lengths = NULL, *meshes = NULL, *filter = NULL, *statismo = NULL;
+    es_study_statismo_opts so;
     es_mesh_format fmt = ES_FORMAT_OBJ;
     es_store *s = NULL;
     es_ctx *ctx;
     es_status rc;
     int64_t *rows = NULL, nrows = 0;
     int c, raw = 0;
+    es_study_statismo_opts_init(&so);
     optind = 1;
     while ((c = getopt_long(argc, argv, "l:M:f:s:h", longopts, NULL)) != -1) {
         switch (c) {
@@ -52,11 +104,30 @@ int cmd_export(int argc, char **argv)
             else if (!strcmp(optarg, "off")) fmt = ES_FORMAT_OFF;
             else return cli_usage_error("export", "unknown format '%s'", optarg);
             break;
+        case 'S': statismo = optarg; break;
+        case 'P': so.pca_name = optarg; break;
+        case 'G': so.gpa_name = optarg; break;
+        case 'k':
+            if (cli_parse_i64(optarg, &so.ncomp) || so.ncomp < 1)
+                return cli_usage_error("export", "--components wants a count >= 1");
+            break;
+        case 'c':
+            if (cli_parse_double(optarg, &so.sd) || so.sd <= 0)
+                return cli_usage_error("export", "--sd wants a number > 0");
+            break;
+        case 'n':
+            if (cli_parse_double(optarg, &so.noise_variance) || so.noise_variance < 0)
+                return cli_usage_error("export", "--noise-variance wants a number >= 0");
+            break;
         case 'h': fputs(usage, stdout); return CLI_OK;
         default: return cli_usage_error("export", "bad option");
         }
     }
     if (optind != argc - 1) return cli_usage_error("export", "give exactly one STORE");
+    if (statismo) return export_statismo(argv[optind], statismo, &so, filter || lengths || meshes,
+                                         argc, argv);
+    if (so.pca_name || so.gpa_name)
+        return cli_usage_error("export", "--pca and --gpa go with --statismo");
     if (!lengths == !meshes)
         return cli_usage_error("export", "give one of --lengths CSV or --meshes DIR");
     if (raw && !lengths) return cli_usage_error("export", "--raw goes with --lengths");

@@ -243,6 +243,39 @@ ES_API int es_store_has(es_store *store, const char *path);
 ES_API es_status es_store_list_results(es_ctx *ctx, es_store *store, const char *kind,
                                        char ***names, int64_t *n);
 
+/* ---- statismo shape models --------------------------------------------
+ * A linear shape model mean + sum_k b_k sqrt(variance_k) basis_k (b ~
+ * N(0, I)) over one triangle mesh, written in the statismo 0.9 HDF5 layout
+ * that statismo (StatisticalModel IO) and scalismo (StatismoIO) load:
+ * datasets-spec/statismo.md is the exact layout. Coordinates are
+ * vertex-interleaved (x0 y0 z0 x1 ...), as statismo's sample vectors are;
+ * they are stored in single precision, as statismo keeps them.
+ * es_study_export_statismo builds one from a stored PCA or GPA. */
+typedef struct es_statismo_model {
+    int64_t nverts, nfaces;
+    const int64_t *faces;      /* 3 x F, 0-based (the representer's cells) */
+    const double *mean;        /* 3 x V: the mean shape, also the representer's
+                                  reference mesh */
+    int64_t ncomp;             /* K >= 1 modes */
+    const double *basis;       /* 3V x K, column k = mode k (orthonormal columns) */
+    const double *variance;    /* K: variance along each mode */
+    double noise_variance;     /* the PPCA noise variance (>= 0) */
+    int64_t nscores;           /* samples with coefficients (0: none) */
+    const double *scores;      /* K x nscores: sample j's coefficients, in units of
+                                  each mode's standard deviation */
+    const char *builder;       /* modelinfo builder name (NULL: "edgespace") */
+    int64_t ndata, nparams;    /* key/value strings of the builder's dataInfo
+                                  and parameters groups */
+    const char *const *data_keys, *const *data_values;
+    const char *const *param_keys, *const *param_values;
+} es_statismo_model;
+
+/* Write m to path (replaced only once complete). ES_EINVAL on a model
+ * without vertices, faces or modes, a face index out of range, non-finite
+ * values or negative variances; ES_ERANGE beyond 2^31 vertices; ES_EEXIST
+ * if path is an HDF5 file that is not a statismo model (a store, say). */
+ES_API es_status es_statismo_write(es_ctx *ctx, const char *path, const es_statismo_model *m);
+
 #ifdef __cplusplus
 }
 #endif

@@ -348,6 +348,54 @@ ES_API int es_study_frame_path(const char *pattern, int64_t i, char *out, size_t
  * "NAME_NN" for a sequence. Returns buf. */
 ES_API const char *es_study_interp_name(const es_study_interp_opts *opts, char *buf, size_t n);
 
+/* ---- shape models for other tools ---------------------------------------- */
+
+/* What es_study_export_statismo exports: a stored edge-length PCA
+ * (pca_name; NULL and gpa_name NULL: the PCA es_study_pca_load picks) or
+ * the Procrustes PCA of a stored GPA result (gpa_name). */
+typedef struct es_study_statismo_opts {
+    const char *pca_name, *gpa_name;   /* at most one */
+    int64_t ncomp;          /* modes (0: every mode of a GPA; min(10, K) of a PCA,
+                               each of which costs two embeddings) */
+    double sd;              /* edge-length PCA: embed mean -/+ sd standard deviations
+                               along each PC (default 1) */
+    double noise_variance;  /* < 0 (default): 0 for an edge-length PCA, the PPCA
+                               estimate of a GPA's (the variance the kept modes leave,
+                               per remaining coordinate) */
+    const char *command;    /* recorded in the model's builder parameters */
+    es_embed_opts embed;    /* the embeddings' solver options */
+} es_study_statismo_opts;
+ES_API void es_study_statismo_opts_init(es_study_statismo_opts *opts);
+
+typedef struct es_study_statismo_report {
+    char source[256];       /* "pca/<name>" or "gpa/<name>" */
+    int64_t ncomp, nverts, nfaces;
+    double noise_variance;
+    /* edge-length PCA only (0 otherwise): the worst embedding of the 2K + 1
+     * points (RMS ratio, bending against the prior) and the largest
+     * |X(+c) + X(-c) - 2 X(0)| / |X(+c) - X(-c)| over the PCs: how far the
+     * meshes are from linear in the PC coefficient over -/+ c sd */
+    double worst_rms_ratio, worst_bend_ratio, nonlinearity;
+} es_study_statismo_report;
+
+/* Write a statismo shape model (es_statismo_write) to path.
+ * Edge-length PCA: the mean X(0) is the embedding of the PCA's mean (the
+ * point mean[FILTER] of its rows) and X(+-c) of mean -/+ c sd along each PC
+ * (mean[FILTER] + c*pc:K), each embedded near the prior of its row weights
+ * in the store's frame as es_study_embed does; the linearization
+ * d_k = (X(+c) - X(-c)) / 2c (mesh change per sd of PC k) gives the model
+ * X(0) + D a, a ~ N(0, I), written with orthonormal modes: the principal
+ * axes U of D with variances s^2 (D = U S W^T), sample coefficients
+ * W^T (z_k / sd_k). GPA: the Procrustes mean, the tangent PCA's loadings
+ * as modes and sdev^2 as variances (dim 3 only). Progress: "statismo:
+ * embedding". ES_EINVAL for a store without triangles, both results given,
+ * sd <= 0 or more modes than the result has; ES_ENOTFOUND for a missing
+ * result; the embedding's errors (a point that leaves edge-length space
+ * names its edge: give a smaller sd). report may be NULL. */
+ES_API es_status es_study_export_statismo(es_ctx *ctx, es_store *store,
+                                          const es_study_statismo_opts *opts, const char *path,
+                                          es_study_statismo_report *report);
+
 #ifdef __cplusplus
 }
 #endif

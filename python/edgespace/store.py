@@ -1,0 +1,716 @@
+"""python/edgespace/store.py — a shape store (es_store.h) and the analyses on
+it (es_study.h): the same calls the `edgespace` command makes, so a result
+made here is the result the command would make, stored with its provenance.
+
+Lengths come back as (N, E) float64 arrays written by the library straight
+into numpy memory (the E x N column-major matrix of es_store_read_lengths is
+that array), positions as (V, 3), labels as arrays of str. Results the
+library allocates (a PCA, a comparison) are read-only views that keep their
+owner alive.
+
+Models (issue 15, linear models on the store) are not bound yet: they will
+be Store methods beside mean/pca/diff calling their es_study_* functions.
+"""
+import os
+import tempfile
+
+import numpy as np
+
+from . import _arrays as A
+from ._context import ctx_of
+from ._native import ffi, lib
+from .mesh import Embedding, Mesh, report_dict, set_embed_opts
+
+_PCA_METHODS = {"auto": "ES_PCA_AUTO", "gram": "ES_PCA_GRAM",
+                "covariance": "ES_PCA_COVARIANCE", "randomized": "ES_PCA_RANDOMIZED"}
+
+
+def _pca_method(method):
+    """es_pca_method of a name; a ValueError naming the choices otherwise."""
+    if method not in _PCA_METHODS:
+        raise ValueError(f"PCA method {method!r}: one of {', '.join(_PCA_METHODS)}")
+    return getattr(lib, _PCA_METHODS[method])
+
+
+def _s(x):
+    return None if x is None else str(x).encode("utf-8")
+
+
+def _c(x):
+    """str -> char[] kept by the caller; None -> NULL."""
+    return A.cstr(x)
+
+
+class PCA:
+    """A fitted PCA (es_pca): mean (E,), components (K, E) (row k = unit
+    component k), eigenvalues (K,), explained (K,), total_variance, scores
+    (N, K) of the fitted rows, rows (store rows of the scores, or None)."""
+
+    def __init__(self, ctx, ptr, rows=None):
+        self.ctx = ctx
+        self._ptr = A.owned(ctx, ptr, lib.es_pca_free)
+        p = self._ptr
+        E, K, N = int(p.nedges), int(p.ncomp), int(p.nrows)
+        self.nedges, self.ncomp, self.nrows = E, K, N
+        self.method = ffi.string(ffi.cast("es_pca_method", p.method)).replace("ES_PCA_", "").lower()
+        self.total_variance = float(p.total_variance)
+        self.mean = A.view(p.mean, (E,), self)
+        self.components = A.view(p.components, (K, E), self)
+        self.eigenvalues = A.view(p.eigenvalues, (K,), self)
+        self.explained = A.view(p.explained, (K,), self)
+        # scores are N x K column-major (ld N): the (K, N) C-order array, transposed
+        self.scores = A.view(p.scores, (K, N), self).T if N else np.zeros((0, K))
+        self.rows = rows
+
+    @property
+    def ptr(self):
+        return self._ptr
+
+    def project(self, X):
+        """Scores (n, K) and residual norms (n,) of length vectors X (n, E)."""
+        X = A.f64(np.atleast_2d(X), (None, self.nedges), "X")
+        m, keep = A.mat(X)
+        scores = np.empty((X.shape[0], self.ncomp))   # K x n column-major
+        res = np.empty(X.shape[0])
+        self.ctx.call(lib.es_pca_project, self._ptr, m[0], A.dptr(scores), A.dptr(res))
+        return scores, res
+
+    def row_weights(self, x=None, ridge_rel=1e-3):
+        """Weights (N,) on the fitted rows that reproduce x (es_pca_row_weights)."""
+        w = np.empty(self.nrows)
+        xp = None if x is None else A.f64(x, (self.nedges,), "x")
+        self.ctx.call(lib.es_pca_row_weights, self._ptr, A.dptr(xp), float(ridge_rel),
+                      A.dptr(w))
+        return w
+
+    def __repr__(self):
+        return f"<edgespace.PCA {self.method} E={self.nedges} K={self.ncomp} N={self.nrows}>"
+
+
+class Result:
+    """Plain result holder: attributes named as in es_study.h."""
+
+    def __init__(self, **kw):
+        self.__dict__.update(kw)
+
+    def __repr__(self):
+        keys = ", ".join(k for k in self.__dict__ if not k.startswith("_"))
+        return f"<edgespace.{type(self).__name__} {keys}>"
+
+
+class MeanResult(Result):
+    """groups (list of str), means (G, E), counts (G,), scales (G,)."""
+
+
+class Diff(Result):
+    """mean, sd, se, t (E,), pair_from, pair_to (P,) store rows, unpaired."""
+
+
+class Point(Result):
+    """lengths (E,), scale, weights (N,) row weights, info (dict)."""
+
+
+class GPAResult(Result):
+    """aligned (n, k, d), mean (k, d), size/rho/scale (n,), rotation (n, d, d),
+    centroid (n, d), pc_sdev, pc_percent (npc,), pc_scores (n, npc),
+    pc_loadings (npc, k, d), report (dict)."""
+
+
+class CompareResult(Result):
+    """Distances in the two spaces and their agreement (es_compare_result)."""
+
+
+def ingest(store_path, manifest=None, files=None, create=True, threads=0, ctx=None):
+    """Ingest meshes into a store (es_ingest_manifest / es_ingest_files):
+    all-or-nothing; returns the report as a dict."""
+    ctx = ctx_of(ctx)
+    if (manifest is None) == (files is None):
+        raise ValueError("ingest: give manifest= or files=")
+    o = ffi.new("es_ingest_opts *")
+    lib.es_ingest_opts_init(o)
+    o.create, o.threads = int(create), int(threads)
+    rep = ffi.new("es_ingest_report *")
+    if manifest is not None:
+        ctx.call(lib.es_ingest_manifest, _s(store_path), _s(manifest), o, rep)
+    else:
+        fs = A.CStrings([str(f) for f in files])
+        ctx.call(lib.es_ingest_files, _s(store_path), len(fs), fs.ptr, o, rep)
+    return A.struct_dict(rep, "es_ingest_report")
+
+
+class Store:
+    """An open shape store. Store(path) or Store.open(path, write=False);
+    Store.create(path, faces, ...) for a new one. Use as a context manager or
+    close(); a write handle publishes its writes at commit() and close()
+    (es_store.h: all-or-nothing)."""
+
+    def __init__(self, path, write=False, ctx=None, _ptr=None):
+        self.ctx = ctx_of(ctx)
+        if _ptr is None:
+            p = ffi.new("es_store **")
+            mode = lib.ES_STORE_WRITE if write else lib.ES_STORE_READ
+            self.ctx.call(lib.es_store_open, _s(path), mode, p)
+            _ptr = p[0]
+        self._ptr = A.owned(self.ctx, _ptr, lib.es_store_close)
+        self.writable = bool(write)
+        self._mesh = None
+
+    open = classmethod(lambda cls, path, write=False, ctx=None: cls(path, write, ctx))
+
+    @classmethod
+    def create(cls, path, faces=None, nverts=None, vertices=None, edges=None, ctx=None):
+        """A new, empty store: for a mesh topology (faces (F, 3) and nverts or
+        reference vertices (V, 3)), or without faces (edges (E, 2) pairs: a
+        truss; neither: landmarks only, nverts required). Open for writing;
+        appears at path on commit()/close()."""
+        ctx = ctx_of(ctx)
+        p = ffi.new("es_store **")
+        if faces is not None:
+            m = Mesh(faces, vertices, nverts, ctx=ctx)
+            ctx.call(lib.es_store_create, _s(path), m.ptr, p)
+        else:
+            if nverts is None:
+                raise ValueError("Store.create: nverts is needed without faces")
+            ed = A.i64(edges if edges is not None else np.zeros((0, 2)), (None, 2), "edges")
+            ctx.call(lib.es_store_create_edges, _s(path), int(nverts), ed.shape[0],
+                     A.iptr(ed), p)
+        return cls(path, True, ctx, _ptr=p[0])
+
+    # -- handle -----------------------------------------------------------
+    def commit(self):
+        """Publish what was written so far (es_store_commit)."""
+        self.ctx.call(lib.es_store_commit, self._ptr)
+
+    def close(self):
+        """Commit (raising its error) and close. Idempotent."""
+        if self._ptr is None:
+            return
+        try:
+            if self.writable:
+                self.commit()
+        finally:
+            ffi.release(self._ptr)
+            self._ptr = None
+
+    def abort(self):
+        """Close, discarding uncommitted writes."""
+        if self._ptr is not None:
+            ffi.gc(self._ptr, None)   # no es_store_close at collection
+            lib.es_store_abort(self._ptr)
+            self._ptr = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, et, ev, tb):
+        if et is None:
+            self.close()
+        else:
+            self.abort()
+
+    @property
+    def ptr(self):
+        if self._ptr is None:
+            raise ValueError("the store is closed")
+        return self._ptr
+
+    # -- shape of the data ------------------------------------------------
+    nrows = property(lambda self: int(lib.es_store_nrows(self.ptr)))
+    nedges = property(lambda self: int(lib.es_store_nedges(self.ptr)))
+    nverts = property(lambda self: int(lib.es_store_nverts(self.ptr)))
+    nfaces = property(lambda self: int(lib.es_store_nfaces(self.ptr)))
+    path = property(lambda self: A.string(lib.es_store_path(self.ptr)))
+    fingerprint = property(lambda self: A.string(lib.es_store_fingerprint(self.ptr)))
+
+    @property
+    def topology_kind(self):
+        return A.string(lib.es_topology_kind_name(lib.es_store_topology_kind(self.ptr)))
+
+    @property
+    def faces(self):
+        """(F, 3) int64 face list."""
+        out = np.empty((self.nfaces, 3), dtype=np.int64)
+        self.ctx.call(lib.es_store_read_faces, self.ptr, A.iptr(out))
+        return out
+
+    @property
+    def edges(self):
+        """(E, 2) int64 edge list (min, max), sorted: column e of the lengths."""
+        out = np.empty((self.nedges, 2), dtype=np.int64)
+        self.ctx.call(lib.es_store_read_edges, self.ptr, A.iptr(out))
+        return out
+
+    @property
+    def mesh(self):
+        """The topology with row 0's positions (a Mesh; cached)."""
+        if self._mesh is None:
+            p = ffi.new("es_mesh **")
+            self.ctx.call(lib.es_store_mesh, self.ptr, p)
+            self._mesh = Mesh._adopt(self.ctx, p[0])
+        return self._mesh
+
+    # -- rows and labels --------------------------------------------------
+    @property
+    def ids(self):
+        """Row ids, an array of str (N,)."""
+        return np.array([A.string(lib.es_store_row_id(self.ptr, i)) for i in range(self.nrows)],
+                        dtype=object)
+
+    @property
+    def columns(self):
+        """Label column names."""
+        return [A.string(lib.es_store_column_name(self.ptr, c))
+                for c in range(lib.es_store_ncolumns(self.ptr))]
+
+    def label(self, column):
+        """The labels of one column, an array of str (N,)."""
+        c = lib.es_store_find_column(self.ptr, _s(column))
+        if c < 0:
+            from ._errors import NotFoundError
+            raise NotFoundError(f"no label column '{column}' in '{self.path}'",
+                                lib.ES_ENOTFOUND)
+        return np.array([A.string(lib.es_store_label(self.ptr, i, c)) for i in range(self.nrows)],
+                        dtype=object)
+
+    def labels(self):
+        """The label table as a dict of arrays: "id", then every column."""
+        out = {"id": self.ids}
+        for c in self.columns:
+            out[c] = self.label(c)
+        return out
+
+    def table(self):
+        """The label table as a pandas DataFrame (pandas installed) or a dict."""
+        t = self.labels()
+        try:
+            import pandas as pd
+        except ImportError:
+            return t
+        return pd.DataFrame(t)
+
+    def find_row(self, id):
+        """Row of an id, or -1."""
+        return int(lib.es_store_find_row(self.ptr, _s(id)))
+
+    def select(self, filter=None):
+        """Rows matching "col=value[,col=value...]" (None: all), int64 array."""
+        rows, n = ffi.new("int64_t **"), ffi.new("int64_t *")
+        self.ctx.call(lib.es_store_select, self.ptr, _s(filter) or ffi.NULL, rows, n)
+        return np.array(A.view(rows[0], (n[0],), A.Freed(self.ctx, rows[0]), "i8"))
+
+    def source_path(self, row):
+        return A.string(lib.es_store_source_path(self.ptr, int(row)))
+
+    def content_hash(self, row):
+        return A.string(lib.es_store_content_hash(self.ptr, int(row)))
+
+    # -- data -------------------------------------------------------------
+    def _rows(self, rows):
+        """rows as (row0, n) for a contiguous range, else an int64 array."""
+        N = self.nrows
+        if rows is None:
+            return (0, N)
+        if isinstance(rows, slice):
+            start, stop, step = rows.indices(N)
+            if step == 1:
+                return (start, max(stop - start, 0))
+            rows = np.arange(start, stop, step)
+        if isinstance(rows, (int, np.integer)):
+            return (int(rows), 1)
+        return A.i64(rows, (None,), "rows")
+
+    def lengths(self, rows=None, out=None):
+        """Normalized lengths (n, E) of rows (None: all; a slice, a list of
+        rows or one row). out: an (n, E) float64 C-order array to fill."""
+        r = self._rows(rows)
+        n = r[1] if isinstance(r, tuple) else len(r)
+        if out is None:
+            out = np.empty((n, self.nedges))
+        elif out.shape != (n, self.nedges) or out.dtype != np.float64 or \
+                not out.flags.c_contiguous:
+            raise ValueError(f"out must be a C-contiguous float64 array of shape "
+                             f"{(n, self.nedges)}")
+        m, keep = A.mat(out)
+        if isinstance(r, tuple):
+            self.ctx.call(lib.es_store_read_lengths, self.ptr, r[0], r[1], m[0])
+        else:
+            self.ctx.call(lib.es_store_read_lengths_rows, self.ptr, A.iptr(r), len(r), m[0])
+        return out
+
+    def scales(self):
+        """(N,) scales (sum of raw edge lengths) of all rows."""
+        out = np.empty(self.nrows)
+        self.ctx.call(lib.es_store_read_scales, self.ptr, A.dptr(out))
+        return out
+
+    def positions(self, rows=None):
+        """Vertex positions as ingested: (V, 3) for one row, (n, V, 3) for
+        several (None: all)."""
+        if isinstance(rows, (int, np.integer)):
+            out = np.empty((self.nverts, 3))
+            self.ctx.call(lib.es_store_read_positions, self.ptr, int(rows), A.dptr(out))
+            return out
+        r = self._rows(rows)
+        rows = np.arange(r[0], r[0] + r[1]) if isinstance(r, tuple) else r
+        out = np.empty((len(rows), self.nverts, 3))
+        for j, i in enumerate(rows):
+            self.ctx.call(lib.es_store_read_positions, self.ptr, int(i), A.dptr(out[j]))
+        return out
+
+    def append(self, ids, vertices, labels=None, source_paths=None):
+        """Append shapes given as arrays: ids (n str), vertices (n, V, 3) in
+        the store's topology, labels {column: n values}. Lengths and scales
+        are computed by the library (es_edge_lengths, es_lengths_normalize);
+        nothing is written if any row fails (es_store_append). Commit (or
+        close) publishes them."""
+        X = A.f64(vertices, (None, self.nverts, 3), "vertices")
+        n, E = X.shape[0], self.nedges
+        if len(ids) != n:
+            raise ValueError(f"append: {len(ids)} ids for {n} shapes")
+        L, sc = np.empty((n, E)), np.empty(n)
+        if E:
+            if self.topology_kind == "mesh":
+                mesh = self.mesh
+                for j in range(n):
+                    self.ctx.call(lib.es_edge_lengths, mesh.ptr, A.dptr(X[j]), A.dptr(L[j]))
+            else:   # a truss: the stored edge list
+                ed = self.edges
+                L[:] = np.linalg.norm(X[:, ed[:, 0]] - X[:, ed[:, 1]], axis=2)
+            for j in range(n):
+                s = ffi.new("double *")
+                self.ctx.call(lib.es_lengths_normalize, E, A.dptr(L[j]), A.dptr(L[j]), s)
+                sc[j] = s[0]
+        cols = list(labels) if labels else []
+        cells = [str(labels[c][i]) for i in range(n) for c in cols]
+        rows = ffi.new("es_store_rows *")
+        cid, ccol, ccell = A.CStrings([str(i) for i in ids]), A.CStrings(cols), \
+            A.CStrings(cells)
+        csrc = A.CStrings([str(p) for p in source_paths]) if source_paths else None
+        pl, ps, px = A.dptr(L), A.dptr(sc), A.dptr(X)
+        rows.n, rows.ids, rows.lengths, rows.scales, rows.xyz = n, cid.ptr, pl, ps, px
+        rows.ncols, rows.colnames, rows.labels = len(cols), ccol.ptr, ccell.ptr
+        if csrc is not None:
+            rows.source_paths = csrc.ptr
+        self.ctx.call(lib.es_store_append, self.ptr, rows)
+        self._mesh = None
+
+    # -- stored results ---------------------------------------------------
+    def results(self, kind=None):
+        """Names of stored results of a kind (None: the kinds present)."""
+        names, n = ffi.new("char ***"), ffi.new("int64_t *")
+        self.ctx.call(lib.es_store_list_results, self.ptr, _s(kind) or ffi.NULL, names, n)
+        out = []
+        for i in range(n[0]):
+            out.append(A.string(names[0][i]))
+            lib.es_free(self.ctx.ptr, names[0][i])
+        lib.es_free(self.ctx.ptr, names[0])
+        return out
+
+    def has(self, path):
+        """True if /analysis/<path> exists (a result or one of its datasets)."""
+        return bool(lib.es_store_has(self.ptr, _s(path)))
+
+    def get_matrix(self, path):
+        """A stored matrix "<kind>/<name>/<dataset>" as an array of the
+        dataset's shape (read-only view of the library's buffer)."""
+        m = ffi.new("es_mat *")
+        self.ctx.call(lib.es_store_get_matrix, self.ptr, _s(path), m)
+        return A.view(m.data, (m.cols, m.rows), A.Freed(self.ctx, m.data))
+
+    def get_vector(self, path):
+        v, n = ffi.new("double **"), ffi.new("int64_t *")
+        self.ctx.call(lib.es_store_get_vector, self.ptr, _s(path), v, n)
+        return A.view(v[0], (n[0],), A.Freed(self.ctx, v[0]))
+
+    def get_ints(self, path):
+        v, n = ffi.new("int64_t **"), ffi.new("int64_t *")
+        self.ctx.call(lib.es_store_get_ints, self.ptr, _s(path), v, n)
+        return A.view(v[0], (n[0],), A.Freed(self.ctx, v[0]), "i8")
+
+    def get_attr(self, path, key):
+        buf = ffi.new("char[]", 4096)
+        self.ctx.call(lib.es_store_get_attr, self.ptr, _s(path), _s(key), buf, 4096)
+        return ffi.string(buf).decode("utf-8", "replace")
+
+    # -- analyses (es_study.h) ---------------------------------------------
+    def _command(self, what):
+        return _c(f"python: edgespace.Store.{what}")
+
+    def mean(self, by=None, filter=None, name=None):
+        """Means of the rows matching filter, one per value of label column
+        `by` (es_study_mean); stored as mean/<name> when name is given."""
+        out = ffi.new("es_group_result **")
+        self.ctx.call(lib.es_study_mean, self.ptr, _s(name) or ffi.NULL,
+                      _s(filter) or ffi.NULL, _s(by) or ffi.NULL, self._command("mean"), out)
+        r = A.owned(self.ctx, out[0], lib.es_group_result_free)
+        G, E = int(r.ngroups), int(r.nedges)
+        res = MeanResult(groups=[A.string(r.names[g]) for g in range(G)],
+                         means=A.view(r.means, (G, E), r),
+                         counts=A.view(r.counts, (G,), r, "i8"),
+                         scales=A.view(r.scales, (G,), r))
+        self._committed(name)
+        return res
+
+    def pca(self, name=None, filter=None, ncomp=0, method="auto", oversample=10,
+            power_iters=4):
+        """Fit a PCA of the rows matching filter (es_study_pca); stored as
+        pca/<name> when name is given. Returns a PCA with .rows."""
+        o = ffi.new("es_pca_opts *")
+        lib.es_pca_opts_init(o)
+        o.ncomp, o.method = int(ncomp), _pca_method(method)
+        o.oversample, o.power_iters = int(oversample), int(power_iters)
+        out, rows, n = ffi.new("es_pca **"), ffi.new("int64_t **"), ffi.new("int64_t *")
+        self.ctx.call(lib.es_study_pca, self.ptr, _s(name) or ffi.NULL, _s(filter) or ffi.NULL,
+                      o, self._command("pca"), out, rows, n)
+        r = np.array(A.view(rows[0], (n[0],), A.Freed(self.ctx, rows[0]), "i8"))
+        self._committed(name)
+        return PCA(self.ctx, out[0], r)
+
+    def load_pca(self, name=None):
+        """A stored PCA (es_study_pca_load; None: the only one, else 'default')."""
+        out, rows, n = ffi.new("es_pca **"), ffi.new("int64_t **"), ffi.new("int64_t *")
+        self.ctx.call(lib.es_study_pca_load, self.ptr, _s(name) or ffi.NULL, out, rows, n)
+        r = np.array(A.view(rows[0], (n[0],), A.Freed(self.ctx, rows[0]), "i8"))
+        return PCA(self.ctx, out[0], r)
+
+    def diff(self, name, key, column, from_, to, filter=None):
+        """Paired difference to - from, rows paired by label `key`
+        (es_study_diff); stored as diff/<name> when name is given."""
+        out = ffi.new("es_diff **")
+        self.ctx.call(lib.es_study_diff, self.ptr, _s(name) or ffi.NULL, _s(filter) or ffi.NULL,
+                      _s(key), _s(column), _s(from_), _s(to), self._command("diff"), out)
+        d = A.owned(self.ctx, out[0], lib.es_diff_free)
+        E, P, U = int(d.nedges), int(d.npairs), int(d.nunpaired)
+        res = Diff(mean=A.view(d.mean, (E,), d), sd=A.view(d.sd, (E,), d),
+                   se=A.view(d.se, (E,), d), t=A.view(d.t, (E,), d),
+                   pair_from=A.view(d.pair_from, (P,), d, "i8"),
+                   pair_to=A.view(d.pair_to, (P,), d, "i8"),
+                   unpaired=A.view(d.unpaired, (U,), d, "i8"), npairs=P)
+        self._committed(name)
+        return res
+
+    def point(self, expr, name=None, pca=None, scale=0.0):
+        """Evaluate a point expression (datasets-spec/point-syntax.md) with its
+        row weights (es_study_point); stored as point/<name> when name is given.
+        Returns a Point: lengths (E,), weights (N,), scale, info (validity)."""
+        vec = ffi.new("double **")
+        w = np.empty(self.nrows)
+        info = ffi.new("es_point_info *")
+        self.ctx.call(lib.es_study_point, self.ptr, _s(name) or ffi.NULL, _s(expr),
+                      _s(pca) or ffi.NULL, float(scale), self._command("point"), vec, A.dptr(w),
+                      info)
+        lengths = np.array(A.view(vec[0], (self.nedges,), A.Freed(self.ctx, vec[0])))
+        inf = A.struct_dict(info, "es_point_info")
+        inf["validity"] = A.struct_dict(info.validity, "es_validity")
+        self._committed(name)
+        return Point(lengths=lengths, weights=w, scale=inf["scale"], info=inf, expr=expr)
+
+    def point_weights(self, spec, pca=None):
+        """A point as a command names it ("row:ID", a stored point's name, or
+        an expression): lengths, scale and row weights (es_study_point_weights)."""
+        L, w, sc = np.empty(self.nedges), np.empty(self.nrows), ffi.new("double *")
+        self.ctx.call(lib.es_study_point_weights, self.ptr, _s(spec), _s(pca) or ffi.NULL,
+                      A.dptr(L), sc, A.dptr(w))
+        return Point(lengths=L, weights=w, scale=sc[0], info=None, expr=spec)
+
+    def prior(self, weights):
+        """The prior of row weights (N,): dict xyz (V, 3) in the store's frame,
+        alpha and sd (E,) (es_study_rows_load + es_study_prior), as
+        Embedder.solve(prior=...) takes it."""
+        w = A.f64(weights, (self.nrows,), "weights")
+        rows = ffi.new("es_study_rows **")
+        self.ctx.call(lib.es_study_rows_load, self.ptr, self.mesh.ptr, rows)
+        r = A.owned(self.ctx, rows[0], lib.es_study_rows_free)
+        xyz, alpha, sd = np.empty((self.nverts, 3)), np.empty(self.nedges), np.empty(self.nedges)
+        self.ctx.call(lib.es_study_prior, r, A.dptr(w), A.dptr(xyz), A.dptr(alpha), A.dptr(sd))
+        return {"xyz": xyz, "alpha": alpha, "sd": sd}
+
+    def nearest_row(self, lengths, rows=None):
+        """(row, distance) of the stored row nearest in edge-length distance."""
+        L = A.f64(lengths, (self.nedges,), "lengths")
+        r = None if rows is None else A.i64(rows, (None,), "rows")
+        row, dist = ffi.new("int64_t *"), ffi.new("double *")
+        self.ctx.call(lib.es_study_nearest_row, self.ptr, A.dptr(L), A.iptr(r),
+                      0 if r is None else len(r), row, dist)
+        return int(row[0]), float(dist[0])
+
+    def embed(self, point, pca=None, init=None, scale=0.0, name=None, output=None,
+              residuals=None, **opts):
+        """Embed a point of the store's space (es_study_embed: near the prior
+        of its row weights, in the store's frame, unless init names an explicit
+        start). Returns Embedding(V, F, report) with report["scale"] and
+        report["init"]. name stores /analysis/embed/<name> (write handle);
+        output/residuals write the mesh and per-vertex CSV. opts: es_embed_opts."""
+        o = ffi.new("es_study_embed_opts *")
+        lib.es_study_embed_opts_init(o)
+        keep = [_c(point), _c(pca), _c(init), _c(name), _c(output), _c(residuals),
+                self._command("embed")]
+        o.point, o.pca_name = keep[0], keep[1]
+        if init is not None:
+            o.init = keep[2]
+        o.name, o.output, o.residuals, o.command = keep[3], keep[4], keep[5], keep[6]
+        o.scale = float(scale)
+        set_embed_opts(o.embed, opts)
+        xyz = np.empty((self.nverts, 3))
+        res = ffi.new("es_study_embed_result *")
+        self.ctx.call(lib.es_study_embed, self.ptr, o, A.dptr(xyz), res)
+        rep = report_dict(res.report)
+        rep["scale"] = float(res.scale)
+        rep["init"] = ffi.string(res.init).decode("utf-8", "replace")
+        return Embedding(xyz, self.mesh.faces, rep)
+
+    def interp(self, from_=None, to=None, steps=9, t0=0.0, t1=1.0, weights=None, pca=None,
+               name=None, output=None, **opts):
+        """A walk from `from_` (t = t0) to `to` (t = t1) in `steps` frames, or one
+        weighted combination of rows (weights="0.3*row:a + 0.7*row:b"), each
+        frame embedded as es_study_interp embeds it. Returns a list of
+        Embedding (report["t_heading"] says which t). output: a mesh file
+        pattern ("walk_%02d.obj") to keep the frames; name stores them."""
+        o = ffi.new("es_study_interp_opts *")
+        lib.es_study_interp_opts_init(o)
+        frames = []
+
+        def on_frame(ud, i, n, path, heading, report):
+            frames.append((int(i), A.string(path), A.string(heading), report_dict(report[0])))
+
+        cb = ffi.callback("es_study_frame_fn", on_frame)
+        with tempfile.TemporaryDirectory(prefix="edgespace-interp-") as d:
+            pattern = output if output is not None else os.path.join(d, "frame_%04d.ply")
+            keep = [_c(from_), _c(to), _c(weights), _c(pca), _c(pattern), _c(name),
+                    self._command("interp") if name else ffi.NULL]
+            setattr(o, "from", keep[0])   # a Python keyword
+            o.to, o.weights, o.pca_name, o.output, o.name, o.command = keep[1:]
+            o.t0, o.t1, o.steps = float(t0), float(t1), int(steps)
+            o.frame = cb
+            set_embed_opts(o.embed, opts)
+            self.ctx.call(lib.es_study_interp, self.ptr, o)
+            out = []
+            F = self.mesh.faces
+            for i, path, heading, rep in sorted(frames):
+                rep["heading"] = heading
+                out.append(Embedding(self.mesh.read_positions(path), F, rep))
+        return out
+
+    def project(self, inputs=(), where=None, pca=None):
+        """Scores of row ids / mesh files (and rows matching `where`) on a
+        stored PCA (es_study_project): dict names, scores (n, K), residuals."""
+        ins = A.CStrings([str(x) for x in inputs])
+        out = ffi.new("es_study_projection **")
+        self.ctx.call(lib.es_study_project, self.ptr, _s(pca) or ffi.NULL, len(ins), ins.ptr,
+                      _s(where) or ffi.NULL, out)
+        p = A.owned(self.ctx, out[0], lib.es_study_projection_free)
+        n, K = int(p.n), int(p.ncomp)
+        return {"names": [A.string(p.names[i]) for i in range(n)],
+                "scores": np.array(A.view(p.scores, (K, n), p).T),
+                "residuals": np.array(A.view(p.residuals, (n,), p))}
+
+    def gpa(self, name, rows=None, scale=True, allow_reflection=False, tol=1e-10,
+            max_iter=1000, npc=0):
+        """GPA of the rows' positions with the PCA of the tangent coordinates
+        (es_study_gpa), stored as gpa/<name> and committed; the stored arrays
+        come back in (specimen, landmark, dimension) order."""
+        o = ffi.new("es_gpa_opts *")
+        lib.es_gpa_opts_init(o)
+        o.scale, o.allow_reflection, o.tol, o.max_iter = int(scale), int(allow_reflection), \
+            float(tol), int(max_iter)
+        r = None if rows is None else A.i64(rows, (None,), "rows")
+        rep = ffi.new("es_gpa_report *")
+        self.ctx.call(lib.es_study_gpa, self.ptr, _s(name), A.iptr(r),
+                      -1 if r is None else len(r), o, int(npc), self._command("gpa"), rep)
+        self.commit()
+        return self.load_gpa(name, A.struct_dict(rep, "es_gpa_report"))
+
+    def load_gpa(self, name, report=None):
+        """A stored GPA result (see gpa)."""
+        g = f"gpa/{name}"
+        d, k = int(self.get_attr(g, "dim")), int(self.get_attr(g, "k"))
+        n = self.get_matrix(g + "/aligned").shape[0]
+
+        def blocks(a):   # rows of x-block, y-block[, z-block] -> (rows, k, d)
+            return np.ascontiguousarray(np.asarray(a).reshape(-1, d, k).transpose(0, 2, 1))
+        res = GPAResult(dim=d, k=k, n=n, report=report)
+        res.aligned = blocks(self.get_matrix(g + "/aligned"))
+        res.mean = blocks(self.get_vector(g + "/mean"))[0]
+        for v in ("size", "rho", "scale", "pc_sdev", "pc_percent"):
+            setattr(res, v, np.array(self.get_vector(f"{g}/{v}")))
+        res.rotation = np.array(self.get_matrix(g + "/rotation")).reshape(n, d, d).transpose(0, 2, 1)
+        res.centroid = np.array(self.get_matrix(g + "/centroid"))
+        res.pc_scores = np.array(self.get_matrix(g + "/pc_scores"))
+        res.pc_loadings = blocks(self.get_matrix(g + "/pc_loadings"))
+        return res
+
+    def compare(self, gpa, by=None, permutations=999, top_pairs=20, normalize_lengths=True,
+                name=None, out_dir=None):
+        """Edge-length space against Procrustes space on a stored GPA's rows
+        (es_study_compare); stored as compare/<name> (None: not stored) and
+        committed; out_dir gets the CSV tables."""
+        o = ffi.new("es_compare_opts *")
+        lib.es_compare_opts_init(o)
+        o.permutations, o.top_pairs = int(permutations), int(top_pairs)
+        o.normalize_lengths = int(normalize_lengths)
+        out = ffi.new("es_compare_result **")
+        self.ctx.call(lib.es_study_compare, self.ptr, _s(gpa), _s(by) or ffi.NULL, o,
+                      _s(name) if name else b"", _s(out_dir) or ffi.NULL,
+                      self._command("compare"), out)
+        r = A.owned(self.ctx, out[0], lib.es_compare_result_free)
+        if name:
+            self.commit()
+        n, T, G = int(r.n), int(r.ntop), int(r.ngroups)
+        res = CompareResult(
+            n=n, d_len=A.view(r.d_len, (n, n), r).T, d_proc=A.view(r.d_proc, (n, n), r).T,
+            mantel_rho=r.mantel_rho, mantel_p=r.mantel_p, nn_agreement=r.nn_agreement,
+            nn_len=A.view(r.nn_len, (n,), r, "i8"), nn_proc=A.view(r.nn_proc, (n,), r, "i8"),
+            top_pairs=A.view(r.top_pairs, (T, 2), r, "i8"), top_diff=A.view(r.top_diff, (T,), r),
+            ids=[A.string(r.ids[i]) for i in range(n)] if r.ids != ffi.NULL else None,
+            group=A.view(r.group, (n,), r, "i8") if r.group != ffi.NULL else None,
+            group_names=[A.string(r.group_names[g]) for g in range(G)]
+            if r.group_names != ffi.NULL else [],
+            groups_len=A.struct_dict(r.groups_len, "es_group_stats"),
+            groups_proc=A.struct_dict(r.groups_proc, "es_group_stats"))
+        if G:
+            res.mean_len = A.view(r.mean_len, (G, G), r).T
+            res.mean_proc = A.view(r.mean_proc, (G, G), r).T
+            res.p_len = A.view(r.p_len, (G, G), r).T
+            res.p_proc = A.view(r.p_proc, (G, G), r).T
+        return res
+
+    # -- files --------------------------------------------------------------
+    def export_lengths_csv(self, path, rows=None, raw=False):
+        """Rows' lengths as CSV (es_export_lengths_csv; %.17g)."""
+        r = None if rows is None else A.i64(rows, (None,), "rows")
+        self.ctx.call(lib.es_export_lengths_csv, self.ptr, A.iptr(r), -1 if r is None else len(r),
+                      int(raw), _s(path))
+
+    def export_meshes(self, directory, rows=None, fmt="obj"):
+        """Rows' positions as mesh files DIR/<id>.<ext> (es_export_meshes)."""
+        r = None if rows is None else A.i64(rows, (None,), "rows")
+        f = getattr(lib, "ES_FORMAT_" + fmt.upper().replace("-", "_"))
+        self.ctx.call(lib.es_export_meshes, self.ptr, A.iptr(r), -1 if r is None else len(r),
+                      _s(directory), f)
+
+    def export_statismo(self, path, pca=None, gpa=None, ncomp=0, sd=1.0, noise_variance=None,
+                        **opts):
+        """A statismo shape model of a stored PCA or GPA
+        (es_study_export_statismo; datasets-spec/statismo.md). Returns the
+        report as a dict."""
+        o = ffi.new("es_study_statismo_opts *")
+        lib.es_study_statismo_opts_init(o)
+        keep = [_c(pca), _c(gpa), self._command("export_statismo")]
+        o.pca_name, o.gpa_name, o.command = keep
+        o.ncomp, o.sd = int(ncomp), float(sd)
+        if noise_variance is not None:
+            o.noise_variance = float(noise_variance)
+        set_embed_opts(o.embed, opts)
+        rep = ffi.new("es_study_statismo_report *")
+        self.ctx.call(lib.es_study_export_statismo, self.ptr, o, _s(path), rep)
+        return A.struct_dict(rep, "es_study_statismo_report")
+
+    def _committed(self, name):
+        if name:
+            self.commit()
+
+    def __repr__(self):
+        if self._ptr is None:
+            return "<edgespace.Store (closed)>"
+        return (f"<edgespace.Store {self.path!r} {self.topology_kind} N={self.nrows} "
+                f"V={self.nverts} E={self.nedges}>")

@@ -1,0 +1,67 @@
+"""Pictures from Python: PNG bytes from es_render and the plots, the same
+bytes the command draws for the same mesh and options, and Jupyter's inline
+display (_repr_png_)."""
+import struct
+
+import numpy as np
+import pytest
+
+import edgespace as es
+
+pytestmark = pytest.mark.skipif(not es.has_figures(), reason="library built without figures")
+
+
+def png_size(data):
+    assert data[:8] == b"\x89PNG\r\n\x1a\n" and data[12:16] == b"IHDR"
+    return struct.unpack(">II", data[16:24])
+
+
+def test_render_is_the_commands_picture(tmp_path, cli, ctx):
+    syn = es.synth("face", n=1, ctx=ctx)
+    m = es.Mesh(syn["faces"], syn["vertices"][0], ctx=ctx)
+    m.write(tmp_path / "f.ply")
+    cli("render", tmp_path / "f.ply", "-o", tmp_path / "cli.png")
+    img = es.render((syn["vertices"][0], syn["faces"]), ctx=ctx)
+    assert isinstance(img, bytes) and img == (tmp_path / "cli.png").read_bytes()
+    assert png_size(img) == (480, 480)
+    assert img._repr_png_() == bytes(img)
+    # with scalars, a title and a colour map: the command's options
+    t = np.linspace(-1, 1, m.nedges)
+    np.savetxt(tmp_path / "t.csv", t, fmt="%.17g")
+    cli("render", tmp_path / "f.ply", "-o", tmp_path / "cli2.png", "--scalars", tmp_path / "t.csv",
+        "--cmap", "rdbu", "--title", "t", "--width", "300", "--height", "200")
+    img2 = es.render(m, scalars=t, scalar_kind="edge", cmap="rdbu", title="t", width=300,
+                     height=200, ctx=ctx)
+    assert img2 == (tmp_path / "cli2.png").read_bytes()
+
+
+def test_several_panels_and_the_auto_view(ctx):
+    syn = es.synth("face", n=2, ctx=ctx)
+    V, F = syn["vertices"], syn["faces"]
+    img = es.render([(V[0], F), (V[3], F)], labels=["a", "b"], width=200, height=150, ctx=ctx)
+    w, h = png_size(img)
+    assert w >= 400 and h >= 150
+    view, up = es.auto_view(V[0], F, ctx=ctx)
+    assert np.isclose(np.linalg.norm(view), 1) and abs(view @ up) < 1e-12
+    same = es.render([(V[0], F), (V[3], F)], labels=["a", "b"], width=200, height=150,
+                     view=view, up=up, ctx=ctx)
+    assert png_size(same) == (w, h)
+
+
+def test_embedding_displays_inline(store_path, ctx):
+    with es.Store(store_path, ctx=ctx) as s:
+        e = s.embed("row:face_s01_neutral")
+    png = e._repr_png_()
+    assert png_size(png) == (360, 360)
+
+
+def test_plots(ctx):
+    rng = np.random.default_rng(0)
+    x, y = rng.normal(size=20), rng.normal(size=20)
+    img = es.plot_scatter(x, y, labels=["a", "b"] * 10, title="s", xlabel="x", ylabel="y",
+                          legend_title="g", ctx=ctx)
+    assert png_size(img)[0] > 100
+    img = es.plot_scree([3.0, 2.0, 1.0], total=7.0, title="scree", ctx=ctx)
+    assert png_size(img)[0] > 100
+    with pytest.raises(ValueError):
+        es.plot_scatter(x, y[:5], ctx=ctx)
