@@ -11,7 +11,8 @@
  *
  *   bench_walk [levels [frames [rows]]]   (defaults 0, 20, 30; data from
  *                                          ../shared/data/face-study)
- *   EDGESPACE_VERBOSE=1 prints the refinement's iterations.
+ *   EDGESPACE_VERBOSE=1 prints the refinement's iterations;
+ *   EDGESPACE_BENCH_TOL=RMS,MAX (fractions) sets the accuracy stop.
  */
 #include <edgespace/edgespace.h>
 
@@ -111,6 +112,11 @@ int main(int argc, char **argv)
     es_embed_opts eo;
     es_embed_opts_init(&eo);
     eo.verbose = getenv("EDGESPACE_VERBOSE") != NULL;
+    if (getenv("EDGESPACE_BENCH_TOL") &&   /* the accuracy stop, as fractions */
+        sscanf(getenv("EDGESPACE_BENCH_TOL"), "%lf,%lf", &eo.refine_rms_tol,
+               &eo.refine_max_tol) == 2)
+        printf("# refinement stops at rms <= %.3g %%, max <= %.3g %%\n", 100 * eo.refine_rms_tol,
+               100 * eo.refine_max_tol);
     printf("# face-study x %lld rows, %d subdivisions: %lld vertices, %lld edges\n",
            (long long)n, levels, (long long)nv, (long long)ne);
     double w0 = bench_wall_s(), c0 = bench_process_cpu_s();
