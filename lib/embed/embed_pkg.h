@@ -46,13 +46,8 @@ struct es_embedder {
     int64_t *eslot;         /* 3E: slot of (row block 0, column c) of edge e's block */
     uint8_t *eswap;         /* E: 1 if edge e's first vertex is its block's row vertex */
     int64_t *vslot;         /* 3V: slot of the diagonal entry of column c of v's block */
-    /* measured costs of the position system (stage_refine.c): a numeric
-     * factorization and one preconditioned CG step, in seconds (0: not yet
-     * measured), and the CG steps the lagged factor needed when it last
-     * succeeded */
-    double cost_factor, cost_cg_step, cg_steps_ok;
-    int cg_lag_ok;          /* CG is tried on a factor at most this many iterations old */
-    int64_t factors_made;   /* H3 factorizations over the embedder's life */
+    int cg_lag_ok;          /* stage 4 tries CG on a factor at most this many iterations
+                               old (stage_refine.c) */
     /* closure variables */
     int64_t nvar, *var, *amap_off, *amap, *adiag;
     cholmod_common cm;

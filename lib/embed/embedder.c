@@ -338,7 +338,6 @@ es_status es_embedder_new(es_ctx *ctx, const es_mesh *mesh, es_embedder **out)
     if (!emb) return ES_ENOMEM;
     emb->ctx = ctx;
     emb->mesh = mesh;
-    emb->cg_lag_ok = 1;
     emb->nv = es_mesh_nverts(mesh);
     emb->ne = es_mesh_nedges(mesh);
     emb->nf = es_mesh_nfaces(mesh);

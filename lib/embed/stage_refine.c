@@ -8,7 +8,7 @@
  * stage closes both. Its matrix is the Gauss-Newton matrix plus the
  * curvature of the stretched edges' residuals, in H3's pattern, solved by
  * a numeric factorization, or by CG on the factor of an earlier matrix
- * where the measured costs say that is cheaper. Rigid motions (and, on
+ * at the lags where that has converged. Rigid motions (and, on
  * open meshes, flexes) are held by the damping, so the result stays near
  * the stage-3 mesh; with a prior, the bending term (bending.c) holds the
  * flexes near the data's dihedrals. It stops as soon as the lengths meet
@@ -18,14 +18,6 @@
 
 #include <math.h>
 #include <string.h>
-#include <time.h>
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 es__refine_opts es__refine_opts_from(const es_embed_opts *o)
 {
@@ -104,39 +96,23 @@ static void assemble(es_embedder *emb, const double *L, const double *xyz,
 }
 
 /* How many CG steps on the factor of a matrix `lag` iterations old may
- * take, 0 for none. A CG step costs two triangular solves and a
- * multiplication by H3, a factorization about k of them (k = 8-10 at 9K
- * and 54K vertices on this project's machines), and near the solution the
- * lagged factor needed 6-11 steps where it converged at all: CG is tried
- * only where its expected cost stays below a factorization's, both
- * measured on this embedder, and at lags where it has converged before
- * (on the faces it converged one iteration after a factorization and
- * failed after two, so trying every iteration wasted a CG run on every
- * other one). */
+ * take, 0 for none. Near the solution the lagged factor needed 6-11 steps
+ * where it converged at all, and on the faces it converged one iteration
+ * after a factorization and failed after two, so trying every iteration
+ * wasted a CG run on every other one: CG is tried only at lags where it
+ * has converged before in this refinement. The rule sees only the
+ * iterates, never the clock, so a solve gives the same mesh on every run
+ * and whatever the embedder solved before. */
 static int cg_budget(const es_embedder *emb, int lag)
 {
-    int budget;
-    if (lag > emb->cg_lag_ok) return 0;
-    if (!(emb->cost_factor > 0 && emb->cost_cg_step > 0)) return 12;   /* first trial */
-    budget = (int)(0.9 * emb->cost_factor / emb->cost_cg_step);
-    if (budget > 30) budget = 30;
-    return budget >= 2 && (double)budget >= (emb->cg_steps_ok > 0 ? emb->cg_steps_ok : 6) + 1
-               ? budget
-               : 0;
+    return lag <= emb->cg_lag_ok ? 12 : 0;
 }
 
-/* Record what a CG run on a factor `lag` iterations old cost and whether it
- * converged: the lags allowed next grow by one on success, shrink below a
- * failure. */
-static void cg_measured(es_embedder *emb, int lag, int steps, int max_it, double t)
+/* Whether a CG run on a factor `lag` iterations old converged: the lags
+ * allowed next grow by one on success, shrink below a failure. */
+static void cg_outcome(es_embedder *emb, int lag, int steps)
 {
-    int used = steps < 0 ? max_it : steps;
-    if (used > 0) {
-        double c = t / used;
-        emb->cost_cg_step = emb->cost_cg_step > 0 ? 0.5 * (emb->cost_cg_step + c) : c;
-    }
     if (steps >= 0) {
-        emb->cg_steps_ok = steps;
         if (lag >= emb->cg_lag_ok) emb->cg_lag_ok = lag + 1;
     } else {
         emb->cg_lag_ok = lag - 1 > 0 ? lag - 1 : 0;
@@ -149,17 +125,11 @@ static void cg_measured(es_embedder *emb, int lag, int steps, int max_it, double
 static int factor_step(es_embedder *emb, const double *bp, double *stepp)
 {
     int64_t n3 = 3 * emb->nv;
-    double t0 = now_s(), t;
     int st;
     memcpy(emb->B3->x, bp, (size_t)n3 * sizeof(double));
     emb->B3->ncol = 1;
     st = es__factor_solve(emb, emb->H3, emb->L3, emb->B3);
     emb->B3->ncol = 3;
-    t = now_s() - t0;
-    /* the embedder's first factorization also first touches the factor's
-     * memory, which says nothing of the next ones */
-    if (emb->factors_made++ > 0)
-        emb->cost_factor = emb->cost_factor > 0 ? 0.5 * (emb->cost_factor + t) : t;
     emb->nfactor++;
     if (st == 0) memcpy(stepp, emb->X->x, (size_t)n3 * sizeof(double));
     return st;
@@ -193,6 +163,7 @@ es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz, es__b
      * evaluated afresh and the relative stopping rule waits */
     int annealing = bp && bp->decay > 0 && bp->decay < 1 && bp->mu > bp->mu_min;
     if (bp && !(bp->mu > 0)) bp = NULL;
+    emb->cg_lag_ok = 1;   /* learnt afresh in every refinement */
     cur = evaluate(emb, xyz, L, bp);
     for (int it = 0; it < ro->max_iter && cur.cost > ctol; it++) {
         double mean = 0, pred, rho = 0;
@@ -223,9 +194,8 @@ es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz, es__b
                 for (int r = 0; r < 3; r++) hp[3 * emb->pinv[v] + r] = -g[3 * v + r];
             used = -1;
             if (budget > 0) {
-                double t0 = now_s();
                 used = es__lagged_pcg(emb, emb->H3, emb->L3, emb->B3, hp, stepp, eta, budget);
-                cg_measured(emb, lag, used, budget, now_s() - t0);
+                cg_outcome(emb, lag, used);
             }
             if (used < 0) {
                 st = factor_step(emb, hp, stepp);
