@@ -265,6 +265,9 @@ typedef struct es_embed_prior {
                                the output array */
     const double *alpha;    /* E: prior dihedrals (NULL: those of xyz) */
     const double *sd;       /* E: the rows' spread per edge (NULL: none) */
+    const double *start;    /* 3 x V: on open meshes, refine from these positions instead
+                               of xyz, e.g. a walk's previous frame (NULL: xyz); must
+                               not be the output array */
 } es_embed_prior;
 
 /* Embed target lengths (E; scale as es_embed_solve) near a prior. The
