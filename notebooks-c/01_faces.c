@@ -550,7 +550,7 @@ static int embed(notebook *nb, study *s)
         /* the prior of the point's row weights starts the solve, holds the
          * free directions of the open face near the data's bending, and puts
          * the output in the store's frame: every face stands alike */
-        es_embed_prior pr = {prior, prior + V3, prior + V3 + s->E};
+        es_embed_prior pr = {prior, prior + V3, prior + V3 + s->E, NULL};
         if ((rc = es_study_prior(nb->ctx, rows, s->w + p * s->N, prior, prior + V3,
                                  prior + V3 + s->E)) != ES_OK ||
             (rc = es_embed_prior_solve(nb->ctx, emb, s->pts + p * s->E, s->pt_scale[p], &pr,

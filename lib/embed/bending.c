@@ -129,7 +129,7 @@ void es__bend_assemble(es_embedder *emb, const double *xyz, const es__bend_prior
             double fac = p >= 2 ? 2.0 : 1.0;   /* the doubled (c, c) and (d, d) blocks */
             for (int i = 0; i < 3; i++)
                 for (int j = i; j < 3; j++)
-                    x[es__pos_diag(emb->H3, 3, emb->nlow, q[p], i, j)] +=
+                    x[es__h3_diag(emb, q[p], i, j)] +=
                         fac * w * gq[3 * p + i] * gq[3 * p + j];
             for (int s = p + 1; s < 4; s++) {
                 if (p == 2 && s == 3) continue;
@@ -137,8 +137,7 @@ void es__bend_assemble(es_embedder *emb, const double *xyz, const es__bend_prior
                 if (ee < 0) continue;
                 for (int i = 0; i < 3; i++)
                     for (int j = 0; j < 3; j++)
-                        x[es__pos_off(emb->H3, 3, emb->rank, ee, q[hi], i, j)] +=
-                            w * gq[3 * lo + i] * gq[3 * hi + j];
+                        x[es__h3_off(emb, ee, i, j)] += w * gq[3 * lo + i] * gq[3 * hi + j];
             }
         }
     }

@@ -36,7 +36,18 @@ struct es_embedder {
     int64_t *edge_slot;     /* 2E: slot of e in the star of edges[2e], of edges[2e+1] */
     uint8_t *pinned;        /* V: lowest vertex of its component */
     double *vweight;        /* V: 1 for vertices in a face, else 0 */
-    int64_t *rank, *nlow;   /* block-pattern bookkeeping (see es__pos_off) */
+    int64_t *rank, *nlow;   /* H1's pattern bookkeeping (see es__pos_off) */
+    /* H3 is stored lower-triangular in the fill-reducing vertex order, so
+     * that CHOLMOD factorizes it as it is (no permuted transpose per
+     * factorization, which cost ~7 % of each and a fresh allocation):
+     * perm[j] is the vertex in block position j, pinv its inverse; the
+     * slots of H3's entries are es__h3_off / es__h3_diag (embedder.c). */
+    int64_t *perm, *pinv;   /* V each */
+    int64_t *eslot;         /* 3E: slot of (row block 0, column c) of edge e's block */
+    uint8_t *eswap;         /* E: 1 if edge e's first vertex is its block's row vertex */
+    int64_t *vslot;         /* 3V: slot of the diagonal entry of column c of v's block */
+    int cg_lag_ok;          /* stage 4 tries CG on a factor at most this many iterations
+                               old (stage_refine.c) */
     /* closure variables */
     int64_t nvar, *var, *amap_off, *amap, *adiag;
     cholmod_common cm;
@@ -57,8 +68,25 @@ struct es_embedder {
     int64_t nfactor;        /* numeric factorizations in the last solve */
 };
 
-/* Value slots of the upper-triangular block pattern (bs x bs blocks) of a
- * V x V vertex adjacency that embedder.c builds: entry (r, c) of the block
+/* Slot in H3->x of H[3a + p, 3b + q], (a, b) = edge e's vertices (a < b),
+ * and of H[3v + r, 3v + c] (either triangle). */
+static inline int64_t es__h3_off(const es_embedder *emb, int64_t e, int p, int q)
+{
+    return emb->eswap[e] ? emb->eslot[3 * e + q] + p : emb->eslot[3 * e + p] + q;
+}
+
+static inline int64_t es__h3_diag(const es_embedder *emb, int64_t v, int r, int c)
+{
+    return r < c ? emb->vslot[3 * v + r] + (c - r) : emb->vslot[3 * v + c] + (r - c);
+}
+
+/* x (3V, vertex order) to xp (H3's order) and back; ncol columns of
+ * leading dimension 3V. */
+void es__h3_permute(const es_embedder *emb, const double *x, double *xp, int ncol);
+void es__h3_unpermute(const es_embedder *emb, const double *xp, double *x, int ncol);
+
+/* Value slots of the upper-triangular pattern of the V x V vertex
+ * adjacency H1 (bs = 1) that embedder.c builds: entry (r, c) of the block
  * of edge e = (a, b), a < b, in column block b, and entry (r, c) of the
  * diagonal block of v. Edges are sorted by (min, max), so rank[e] is the
  * position of a among b's lower neighbours and nlow[v] their count. */
@@ -159,12 +187,25 @@ es_status es__bend_flaps(es_embedder *emb);
 void es__bend_weights(const es_embedder *emb, const double *L, const double *sd,
                       double sd_floor, double *omega);
 
+/* When stage 4 stops (es_embed_opts): after max_iter iterations; when the
+ * cost fell by less than rtol per iteration over 3 (once the bending
+ * weight holds); when the RMS relative edge error is below tol; and when
+ * the edge lengths meet the accuracy asked for, RMS ratio <= rms_tol and
+ * max relative error <= max_tol (both > 0; 0 turns that rule off). */
+typedef struct es__refine_opts {
+    int max_iter;
+    double rtol, tol, rms_tol, max_tol;
+    int verbose;
+} es__refine_opts;
+
+/* The refinement's rules from the embedding options. */
+es__refine_opts es__refine_opts_from(const es_embed_opts *o);
+
 /* Stage 4: Levenberg-Marquardt on the relative edge-length residuals
  * against L (plus the bending prior's term when bp is given), xyz in place;
  * *iters grows by the iterations run. */
-es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz,
-                           es__bend_prior *bp, int max_iter, double rtol, double tol,
-                           int verbose, int64_t *iters);
+es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz, es__bend_prior *bp,
+                           const es__refine_opts *ro, int64_t *iters);
 
 /* What a prior solve asks of the driver (solve.c) beyond es_embed_solve. */
 typedef struct es__solve_ext {

@@ -48,6 +48,89 @@ static cholmod_sparse *block_pattern(es_embedder *emb, int bs)
     return A;
 }
 
+/* H3's pattern: lower-triangular (CHOLMOD stype -1) in the vertex order
+ * emb->perm, which is already fill-reducing and postordered, so CHOLMOD
+ * factorizes it in place. Column 3j + c (j = pinv[v]) holds rows 3j + c ..
+ * 3j + 2 of v's diagonal block, then the three rows of each neighbour u
+ * with pinv[u] > j in increasing pinv[u]. Fills emb->eslot, eswap, vslot.
+ * (A vertex block's three columns stay together in every postorder of the
+ * block-expanded elimination tree, so the vertex order loses nothing.) */
+static cholmod_sparse *perm_block_pattern(es_embedder *emb)
+{
+    int64_t nv = emb->nv, nz = 0, *cp, *ri, *hi = NULL, *he = NULL;
+    const int64_t *pinv = emb->pinv;
+    cholmod_sparse *A;
+    for (int64_t v = 0; v < nv; v++) {
+        int64_t nhi = 0;
+        for (int64_t i = emb->off[v]; i < emb->off[v + 1]; i++) nhi += pinv[emb->sv[i]] > pinv[v];
+        nz += 6 + 9 * nhi;
+    }
+    A = cholmod_l_allocate_sparse((size_t)(3 * nv), (size_t)(3 * nv), (size_t)nz, 1, 1, -1,
+                                  CHOLMOD_REAL, &emb->cm);
+    hi = es__alloc_array(emb->ctx, emb->maxk + 1, sizeof *hi);
+    he = es__alloc_array(emb->ctx, emb->maxk + 1, sizeof *he);
+    if (!A || !hi || !he) {
+        cholmod_l_free_sparse(&A, &emb->cm);
+        es__free(emb->ctx, hi);
+        es__free(emb->ctx, he);
+        return NULL;
+    }
+    es__advise_huge(A->x, (size_t)nz * sizeof(double));
+    cp = A->p;
+    ri = A->i;
+    cp[0] = 0;
+    for (int64_t j = 0; j < nv; j++) {
+        int64_t v = emb->perm[j], n = 0;
+        /* v's later neighbours in the order, sorted (stars are short) */
+        for (int64_t i = emb->off[v]; i < emb->off[v + 1]; i++) {
+            int64_t u = emb->sv[i], k = n++;
+            if (pinv[u] <= j) {
+                n--;
+                continue;
+            }
+            while (k > 0 && pinv[hi[k - 1]] > pinv[u]) {
+                hi[k] = hi[k - 1];
+                he[k] = he[k - 1];
+                k--;
+            }
+            hi[k] = u;
+            he[k] = emb->se[i];
+        }
+        for (int c = 0; c < 3; c++) {
+            int64_t p = cp[3 * j + c];
+            emb->vslot[3 * v + c] = p;
+            for (int r = c; r < 3; r++) ri[p++] = 3 * j + r;
+            for (int64_t k = 0; k < n; k++) {
+                int64_t e = he[k];
+                if (c == 0) emb->eswap[e] = emb->edges[2 * e] != v;
+                emb->eslot[3 * e + c] = p;
+                for (int r = 0; r < 3; r++) ri[p++] = 3 * pinv[hi[k]] + r;
+            }
+            cp[3 * j + c + 1] = p;
+        }
+    }
+    es__free(emb->ctx, hi);
+    es__free(emb->ctx, he);
+    memset(A->x, 0, (size_t)nz * sizeof(double));
+    return A;
+}
+
+void es__h3_permute(const es_embedder *emb, const double *x, double *xp, int ncol)
+{
+    int64_t n3 = 3 * emb->nv;
+    for (int c = 0; c < ncol; c++)
+        for (int64_t v = 0; v < emb->nv; v++)
+            for (int r = 0; r < 3; r++) xp[c * n3 + 3 * emb->pinv[v] + r] = x[c * n3 + 3 * v + r];
+}
+
+void es__h3_unpermute(const es_embedder *emb, const double *xp, double *x, int ncol)
+{
+    int64_t n3 = 3 * emb->nv;
+    for (int c = 0; c < ncol; c++)
+        for (int64_t v = 0; v < emb->nv; v++)
+            for (int r = 0; r < 3; r++) x[c * n3 + 3 * v + r] = xp[c * n3 + 3 * emb->pinv[v] + r];
+}
+
 static int cmp_i64(const void *a, const void *b)
 {
     int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
@@ -130,6 +213,70 @@ static es_status closure_pattern(es_embedder *emb)
     return ES_OK;
 }
 
+/* ---- symbolic analyses -------------------------------------------------- */
+
+/* CHOLMOD's analysis with one ordering method (< 0: its default choice);
+ * the settings are restored. */
+static cholmod_factor *analyze_with(es_embedder *emb, cholmod_sparse *A, int ordering,
+                                    int postorder)
+{
+    cholmod_common *cm = &emb->cm;
+    int nmethods = cm->nmethods, ord = cm->method[0].ordering, post = cm->postorder;
+    cholmod_factor *L;
+    if (ordering >= 0) {
+        cm->nmethods = 1;
+        cm->method[0].ordering = ordering;
+    }
+    cm->postorder = postorder;
+    L = cholmod_l_analyze(A, cm);
+    cm->nmethods = nmethods;
+    cm->method[0].ordering = ord;
+    cm->postorder = post;
+    return L;
+}
+
+/* The fill-reducing order of the vertices is computed on the V x V vertex
+ * graph (H1's pattern), not on the 3V x 3V position matrix: the same
+ * factor (equal nnz(L) with AMD, 2.55e9 against 2.55e9 flops with nested
+ * dissection at 54K vertices) for a third to a half of the analysis time.
+ * From 10K vertices METIS orders it (on the face meshes 5-15 % fewer
+ * flops per factorization than AMD, which orders smaller meshes in less
+ * time than they would gain). The order includes CHOLMOD's postorder of
+ * the vertex elimination tree; H3 is then built in that order and analysed
+ * as it is (perm_block_pattern). */
+static es_status analyze(es_embedder *emb)
+{
+    int64_t nv = emb->nv;
+    emb->L1 = analyze_with(emb, emb->H1, nv >= 10000 ? CHOLMOD_METIS : CHOLMOD_AMD, 1);
+    if (!emb->L1) goto cm_fail;
+    memcpy(emb->perm, emb->L1->Perm, (size_t)nv * sizeof *emb->perm);
+    for (int64_t j = 0; j < nv; j++) emb->pinv[emb->perm[j]] = j;
+    if (!(emb->H3 = perm_block_pattern(emb))) goto cm_fail;
+    emb->L3 = analyze_with(emb, emb->H3, CHOLMOD_NATURAL, 0);
+    if (!emb->L3) goto cm_fail;
+    /* a supernodal factor's values, allocated now with huge pages (their
+     * first touch was ~3x the cost of a later factorization). Only a
+     * supernodal symbolic factor may be converted here: asking for
+     * to_super on a simplicial one (small meshes) gave a factor whose
+     * solves were wrong (residual 3 on the oracle's hemi2 frames). */
+    if (emb->L3->is_super) {
+        if (!cholmod_l_change_factor(CHOLMOD_REAL, 1, 1, 1, 1, emb->L3, &emb->cm)) goto cm_fail;
+        es__advise_huge(emb->L3->x, emb->L3->xsize * sizeof(double));
+    }
+    if (emb->nvar > 0) {
+        es_status rc = closure_pattern(emb);
+        if (rc != ES_OK) return rc;
+        emb->LA = analyze_with(emb, emb->HA, -1, 1);
+        if (!emb->LA) goto cm_fail;
+    }
+    return ES_OK;
+cm_fail: {
+        es_status rc = es__cm_check(emb, "analyze");
+        return rc != ES_OK ? rc : es__fail(emb->ctx, ES_ENOMEM, "embed: CHOLMOD out of memory "
+                                                                "in analyze");
+    }
+}
+
 /* ---- construction ----------------------------------------------------- */
 
 static es_status alloc_work(es_embedder *emb)
@@ -161,7 +308,12 @@ static es_status alloc_work(es_embedder *emb)
     ALLOC(emb->res, 9 * nv + ne);
     ALLOC(emb->grad, 3 * nv + ne);
     ALLOC(emb->diag, 3 * (3 * nv + ne));
-    ALLOC(emb->pcg, 18 * nv + 4 * ne);
+    ALLOC(emb->pcg, 21 * nv + 4 * ne);
+    ALLOC(emb->perm, nv);
+    ALLOC(emb->pinv, nv);
+    ALLOC(emb->eslot, 3 * ne);
+    ALLOC(emb->eswap, ne);
+    ALLOC(emb->vslot, 3 * nv);
     ALLOC(emb->jw, 9 * ns);
     ALLOC(emb->fanwork, 18 * (2 * emb->maxk + 2));
     ALLOC(emb->fanr, 9);
@@ -263,46 +415,16 @@ es_status es_embedder_new(es_ctx *ctx, const es_mesh *mesh, es_embedder **out)
     }
 
     /* patterns and symbolic analyses: once per topology */
-    emb->H3 = block_pattern(emb, 3);
     emb->H1 = block_pattern(emb, 1);
-    if (!emb->H3 || !emb->H1) {
+    if (!emb->H1) {
         rc = es__cm_check(emb, "pattern");
         if (rc == ES_OK) rc = ES_ENOMEM;
         goto fail;
     }
-    /* The position matrix H3 is factorized once per refinement iteration.
-     * On larger meshes, with the supernodes above, CHOLMOD's nested
-     * dissection (NESDIS) orders it better than AMD: 11-22 % faster
-     * embeddings at 14K-54K vertices, for 0.1-0.35 s more analysis (once
-     * per topology); below 10K vertices the analysis costs more than a
-     * single embedding gains. H1 and HA keep the default ordering. */
-    {
-        int nmethods = emb->cm.nmethods, ordering = emb->cm.method[0].ordering;
-        if (emb->nv >= 10000) {
-            emb->cm.nmethods = 1;
-            emb->cm.method[0].ordering = CHOLMOD_NESDIS;
-        }
-        emb->L3 = cholmod_l_analyze(emb->H3, &emb->cm);
-        emb->cm.nmethods = nmethods;
-        emb->cm.method[0].ordering = ordering;
-    }
-    emb->L1 = cholmod_l_analyze(emb->H1, &emb->cm);
-    if (!emb->L3 || !emb->L1) {
-        rc = es__cm_check(emb, "analyze");
-        if (rc == ES_OK) rc = ES_ENUMERIC;
-        goto fail;
-    }
-    if (emb->nvar > 0) {
-        if ((rc = closure_pattern(emb)) != ES_OK) goto fail;
-        emb->LA = cholmod_l_analyze(emb->HA, &emb->cm);
-        if (!emb->LA) {
-            rc = es__cm_check(emb, "analyze");
-            if (rc == ES_OK) rc = ES_ENUMERIC;
-            goto fail;
-        }
+    if ((rc = analyze(emb)) != ES_OK) goto fail;
+    if (emb->nvar > 0)
         emb->BA = cholmod_l_allocate_dense((size_t)emb->nvar, 1, (size_t)emb->nvar, CHOLMOD_REAL,
                                            &emb->cm);
-    }
     emb->B3 = cholmod_l_allocate_dense((size_t)(3 * emb->nv), 3, (size_t)(3 * emb->nv),
                                        CHOLMOD_REAL, &emb->cm);
     emb->B1 = cholmod_l_allocate_dense((size_t)emb->nv, 3, (size_t)emb->nv, CHOLMOD_REAL,
@@ -369,7 +491,8 @@ void es_embedder_free(es_embedder *emb)
                     emb->xyz_try, emb->xyz_best, emb->init_copy, emb->ltarget, emb->lpath,
                     emb->res, emb->grad, emb->diag, emb->pcg,
                     emb->jw, emb->fanwork, emb->fanr, emb->fanth, emb->fanal, emb->vclos,
-                    emb->verr, emb->flap, emb->omega, emb->prior_alpha, emb->vdev};
+                    emb->verr, emb->flap, emb->omega, emb->prior_alpha, emb->vdev,
+                    emb->perm, emb->pinv, emb->eslot, emb->eswap, emb->vslot};
     for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++) es__free(ctx, bufs[i]);
     es__free(ctx, emb);
 }

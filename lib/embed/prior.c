@@ -143,6 +143,7 @@ es_status es_embed_prior_solve(es_ctx *ctx, es_embedder *emb, const double *targ
     if (!emb) ES_FAIL(ctx, ES_EINVAL, "embed: no embedder");
     if (!prior || !prior->xyz) ES_FAIL(ctx, ES_EINVAL, "embed: the prior's positions are required");
     if (prior->xyz == xyz) ES_FAIL(ctx, ES_EINVAL, "embed: the prior's positions are the output array");
+    if (prior->start == xyz) ES_FAIL(ctx, ES_EINVAL, "embed: the start positions are the output array");
     if (!target) ES_FAIL(ctx, ES_EINVAL, "embed: NULL target");
     if (!opts) {
         es_embed_opts_init(&dflt);
@@ -153,6 +154,10 @@ es_status es_embed_prior_solve(es_ctx *ctx, es_embedder *emb, const double *targ
     for (int64_t i = 0; i < 3 * emb->nv; i++)
         if (!isfinite(prior->xyz[i]))
             ES_FAIL(ctx, ES_EINVAL, "embed: the prior's position of vertex %lld is not finite",
+                    (long long)(i / 3));
+    for (int64_t i = 0; prior->start && i < 3 * emb->nv; i++)
+        if (!isfinite(prior->start[i]))
+            ES_FAIL(ctx, ES_EINVAL, "embed: the start position of vertex %lld is not finite",
                     (long long)(i / 3));
     if (prior->alpha) {
         for (int64_t e = 0; e < emb->ne; e++) {
@@ -177,7 +182,7 @@ es_status es_embed_prior_solve(es_ctx *ctx, es_embedder *emb, const double *targ
     ext.bp = bend ? &bp : NULL;
     /* a closed mesh without the term: the dihedral path from the prior's
      * dihedrals, which is what interpolation does */
-    ext.start_xyz = bend ? prior->xyz : NULL;
+    ext.start_xyz = bend ? (prior->start ? prior->start : prior->xyz) : NULL;
     ext.start_auto = 1;
     ext.start_max_rms = opts->prior_start_max_rms;
     ext.align_ref = prior->xyz;

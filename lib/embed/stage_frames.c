@@ -46,7 +46,7 @@ static void compute_fan_frames(es_embedder *emb, const double *alpha)
 
 es_status es__stage_frames(es_embedder *emb, const double *alpha)
 {
-    double *x = emb->H3->x, *b = emb->B3->x;
+    double *x = emb->H3->x, *b = emb->pcg;   /* 3 right-hand sides in vertex order */
     int64_t n3 = 3 * emb->nv;
     int st;
     compute_fan_frames(emb, alpha);
@@ -67,7 +67,7 @@ es_status es__stage_frames(es_embedder *emb, const double *alpha)
         if (!emb->pinned[a] && !emb->pinned[c]) {
             for (int r = 0; r < 3; r++)
                 for (int q = 0; q < 3; q++)
-                    x[es__pos_off(emb->H3, 3, emb->rank, e, c, r, q)] = -R[3 * r + q];
+                    x[es__h3_off(emb, e, r, q)] = -R[3 * r + q];
         } else if (emb->pinned[a] && !emb->pinned[c]) {
             /* rhs_c += R^T h_a, h_a = e_col */
             for (int col = 0; col < 3; col++)
@@ -77,16 +77,17 @@ es_status es__stage_frames(es_embedder *emb, const double *alpha)
                 for (int r = 0; r < 3; r++) b[3 * a + r + n3 * col] += R[3 * r + col];
         }
         for (int r = 0; r < 3; r++) {
-            if (!emb->pinned[a]) x[es__pos_diag(emb->H3, 3, emb->nlow, a, r, r)] += 1.0;
-            if (!emb->pinned[c]) x[es__pos_diag(emb->H3, 3, emb->nlow, c, r, r)] += 1.0;
+            if (!emb->pinned[a]) x[es__h3_diag(emb, a, r, r)] += 1.0;
+            if (!emb->pinned[c]) x[es__h3_diag(emb, c, r, r)] += 1.0;
         }
     }
     for (int64_t v = 0; v < emb->nv; v++)
         if (emb->pinned[v] || emb->off[v + 1] == emb->off[v])
             for (int r = 0; r < 3; r++) {
-                x[es__pos_diag(emb->H3, 3, emb->nlow, v, r, r)] = 1.0;
+                x[es__h3_diag(emb, v, r, r)] = 1.0;
                 b[3 * v + r + n3 * r] = 1.0;
             }
+    es__h3_permute(emb, b, emb->B3->x, 3);
     st = es__factor_solve(emb, emb->H3, emb->L3, emb->B3);
     if (st < 0) return ES_ENUMERIC;
     if (st > 0) ES_FAIL(emb->ctx, ES_ENUMERIC, "embed: frame system is singular");
@@ -95,7 +96,7 @@ es_status es__stage_frames(es_embedder *emb, const double *alpha)
         for (int64_t v = 0; v < emb->nv; v++) {
             double *G = emb->G + 9 * v;
             for (int r = 0; r < 3; r++)
-                for (int q = 0; q < 3; q++) G[3 * r + q] = s[3 * v + q + n3 * r];
+                for (int q = 0; q < 3; q++) G[3 * r + q] = s[3 * emb->pinv[v] + q + n3 * r];
             es__mat3_nearest_rotation(G);
         }
     }

@@ -7,150 +7,215 @@
  * README) and the edges between two boundary vertices (failure B); this
  * stage closes both. Its matrix is the Gauss-Newton matrix plus the
  * curvature of the stretched edges' residuals, in H3's pattern, solved by
- * CG on a lagged factor while that converges and by refactorization
- * otherwise. Rigid motions (and, on open meshes, flexes) are held by the
- * damping, so the result stays near the stage-3 mesh; with a prior, the
- * bending term (bending.c) holds the flexes near the data's dihedrals.
+ * a numeric factorization, or by CG on the factor of an earlier matrix
+ * at the lags where that has converged. Rigid motions (and, on
+ * open meshes, flexes) are held by the damping, so the result stays near
+ * the stage-3 mesh; with a prior, the bending term (bending.c) holds the
+ * flexes near the data's dihedrals. It stops as soon as the lengths meet
+ * the accuracy asked for (es__refine_opts).
  */
 #include "embed/embed_pkg.h"
 
 #include <math.h>
 #include <string.h>
 
-/* The cost stage 4 minimizes: sum_e r_e^2 of the relative residuals. */
-static double length_cost(const es_embedder *emb, const double *xyz, const double *L)
+es__refine_opts es__refine_opts_from(const es_embed_opts *o)
 {
-    double c = 0;
+    es__refine_opts r = {o->refine_max_iter, o->refine_rtol, o->refine_tol, o->refine_rms_tol,
+                         o->refine_max_tol, o->verbose};
+    return r;
+}
+
+/* The cost stage 4 minimizes, sum_e r_e^2 of the relative residuals (plus
+ * the bending term when bp is active), and the report's measures of the
+ * same positions: the RMS ratio and the max relative error. */
+typedef struct fit {
+    double cost, rms, max;
+} fit;
+
+static fit evaluate(const es_embedder *emb, const double *xyz, const double *L,
+                    const es__bend_prior *bp)
+{
+    double c = 0, ss = 0, sl = 0, mx = 0;
+    fit f;
     for (int64_t e = 0; e < emb->ne; e++) {
         const double *a = xyz + 3 * emb->edges[2 * e], *b = xyz + 3 * emb->edges[2 * e + 1];
         double d0 = b[0] - a[0], d1 = b[1] - a[1], d2 = b[2] - a[2];
-        double r = (sqrt(d0 * d0 + d1 * d1 + d2 * d2) - L[e]) / L[e];
+        double d = sqrt(d0 * d0 + d1 * d1 + d2 * d2) - L[e], r = d / L[e];
         c += r * r;
+        ss += d * d;
+        sl += L[e];
+        if (!(fabs(r) <= mx)) mx = fabs(r);
     }
-    return c;
+    f.cost = bp ? c + es__bend_cost(emb, bp, xyz) : c;
+    f.rms = sqrt(ss / (double)emb->ne) / (sl / (double)emb->ne);
+    f.max = mx;
+    return f;
 }
 
-/* The cost with the bending prior's term when bp is active. */
-static double refine_cost(const es_embedder *emb, const double *xyz, const double *L,
-                          const es__bend_prior *bp)
+/* H3 (undamped) and the half-gradient g of the cost at xyz. */
+static void assemble(es_embedder *emb, const double *L, const double *xyz,
+                     const es__bend_prior *bp, double *g)
 {
-    double c = length_cost(emb, xyz, L);
-    if (bp) c += es__bend_cost(emb, bp, xyz);
-    return c;
+    double *x = emb->H3->x;
+    memset(x, 0, emb->H3->nzmax * sizeof(double));
+    memset(g, 0, (size_t)(3 * emb->nv) * sizeof(double));
+    for (int64_t e = 0; e < emb->ne; e++) {
+        int64_t a = emb->edges[2 * e], b = emb->edges[2 * e + 1];
+        const double *pa = xyz + 3 * a, *pb = xyz + 3 * b;
+        double d[3] = {pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]}, w[3];
+        double dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), r;
+        if (!(dl > 0)) dl = 1e-300;
+        r = (dl - L[e]) / L[e];
+        for (int i = 0; i < 3; i++) w[i] = d[i] / (dl * L[e]);
+        for (int i = 0; i < 3; i++) {
+            g[3 * a + i] -= w[i] * r;
+            g[3 * b + i] += w[i] * r;
+        }
+        /* Gauss-Newton w w^T plus the residual's own curvature
+         * r (I - u u^T) / (|d| l), u = d / |d|, where that is positive
+         * semi-definite: on stretched edges (r > 0). Gauss-Newton alone
+         * sees no curvature across an edge, so on nearly flexible meshes
+         * the flexes crawl (linear convergence at a non-zero residual);
+         * the stretched-edge term gives them their true stiffness.
+         * Compressed edges (r < 0) would make the matrix indefinite and
+         * are left out, as in projected Newton methods (the full Hessian
+         * stalled at its first iteration on the midpoints of real pairs). */
+        double sc = r > 0 ? r / (dl * L[e]) : 0, dd = dl * dl;
+        for (int q = 0; q < 3; q++)
+            for (int p = 0; p < 3; p++) {
+                double h = w[p] * w[q] + sc * ((p == q) - d[p] * d[q] / dd);
+                x[es__h3_off(emb, e, p, q)] -= h;
+                if (p <= q) {
+                    x[es__h3_diag(emb, a, p, q)] += h;
+                    x[es__h3_diag(emb, b, p, q)] += h;
+                }
+            }
+    }
+    if (bp) es__bend_assemble(emb, xyz, bp, g);
 }
 
-es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz,
-                           es__bend_prior *bp, int max_iter, double rtol, double tol,
-                           int verbose, int64_t *iters)
+/* How many CG steps on the factor of a matrix `lag` iterations old may
+ * take, 0 for none. Near the solution the lagged factor needed 6-11 steps
+ * where it converged at all, and on the faces it converged one iteration
+ * after a factorization and failed after two, so trying every iteration
+ * wasted a CG run on every other one: CG is tried only at lags where it
+ * has converged before in this refinement. The rule sees only the
+ * iterates, never the clock, so a solve gives the same mesh on every run
+ * and whatever the embedder solved before. */
+static int cg_budget(const es_embedder *emb, int lag)
+{
+    return lag <= emb->cg_lag_ok ? 12 : 0;
+}
+
+/* Whether a CG run on a factor `lag` iterations old converged: the lags
+ * allowed next grow by one on success, shrink below a failure. */
+static void cg_outcome(es_embedder *emb, int lag, int steps)
+{
+    if (steps >= 0) {
+        if (lag >= emb->cg_lag_ok) emb->cg_lag_ok = lag + 1;
+    } else {
+        emb->cg_lag_ok = lag - 1 > 0 ? lag - 1 : 0;
+    }
+}
+
+/* Factorize the damped H3 and solve H3 stepp = bp (H3's order) in place of
+ * the right-hand side. Returns 0, 1 if not positive definite, -1 on a
+ * CHOLMOD failure. */
+static int factor_step(es_embedder *emb, const double *bp, double *stepp)
+{
+    int64_t n3 = 3 * emb->nv;
+    int st;
+    memcpy(emb->B3->x, bp, (size_t)n3 * sizeof(double));
+    emb->B3->ncol = 1;
+    st = es__factor_solve(emb, emb->H3, emb->L3, emb->B3);
+    emb->B3->ncol = 3;
+    emb->nfactor++;
+    if (st == 0) memcpy(stepp, emb->X->x, (size_t)n3 * sizeof(double));
+    return st;
+}
+
+/* Write the damped (or, lambda < 0, the undamped) diagonal into H3. */
+static void set_diagonal(es_embedder *emb, const double *dg, double mean, double lambda)
+{
+    double *x = emb->H3->x;
+    for (int64_t i = 0; i < 3 * emb->nv; i++) {
+        int64_t v = i / 3, k = i % 3;
+        double d = emb->vweight[v] == 0 ? mean : dg[i];
+        x[es__h3_diag(emb, v, (int)k, (int)k)] =
+            lambda < 0 ? (emb->vweight[v] == 0 ? 0 : dg[i]) : d + lambda * (d + 1e-8 * mean) + 1e-300;
+    }
+}
+
+es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz, es__bend_prior *bp,
+                           const es__refine_opts *ro, int64_t *iters)
 {
     double hist[4] = {0, 0, 0, 0}, c_prev = 0;
-    const int pcg_max = 12, pcg_give_up = 2;
-    int pcg_fail = 0;
     int64_t nv = emb->nv, n3 = 3 * nv, ne = emb->ne;
-    double *x = emb->H3->x, *g = emb->grad, *dg = emb->diag, *step = emb->pcg + 4 * n3;
-    double *hd = step + n3, lambda = 1e-4, c, ctol = tol * tol * (double)ne;
-    int have_factor = 0, it_hold = 0;
+    double *x = emb->H3->x, *g = emb->grad, *dg = emb->diag;
+    double *step = emb->pcg + 4 * n3, *hp = step + n3, *stepp = hp + n3;
+    double lambda = 1e-4, ctol = ro->tol * ro->tol * (double)ne;
+    int it_hold = 0, lag = -1;   /* lag: iterations since the last factorization (-1: none) */
+    const int accuracy = ro->rms_tol > 0 && ro->max_tol > 0;
+    fit cur;
     /* mu decays within the run (bp->decay < 1) down to bp->mu_min: while it
      * does, the cost changes from one iteration to the next, so it is
      * evaluated afresh and the relative stopping rule waits */
     int annealing = bp && bp->decay > 0 && bp->decay < 1 && bp->mu > bp->mu_min;
     if (bp && !(bp->mu > 0)) bp = NULL;
-    c = refine_cost(emb, xyz, L, bp);
-    for (int it = 0; it < max_iter && c > ctol; it++) {
-        double c_new = c, mean = 0, pred, rho = 0;
+    emb->cg_lag_ok = 1;   /* learnt afresh in every refinement */
+    cur = evaluate(emb, xyz, L, bp);
+    for (int it = 0; it < ro->max_iter && cur.cost > ctol; it++) {
+        double mean = 0, pred, rho = 0;
+        fit nxt = cur;
         int accepted = 0, st, used = -1;
+        if (accuracy && cur.rms <= ro->rms_tol && cur.max <= ro->max_tol) break;
         if (bp && annealing && it > 0) {
             bp->mu = fmax(bp->mu * bp->decay, bp->mu_min);
             annealing = bp->mu > bp->mu_min;
-            c = refine_cost(emb, xyz, L, bp);
+            cur = evaluate(emb, xyz, L, bp);
             c_prev = 0;
             if (!annealing) it_hold = it;   /* the stopping rule counts from here */
         }
-        memset(x, 0, emb->H3->nzmax * sizeof(double));
-        memset(g, 0, (size_t)n3 * sizeof(double));
-        for (int64_t e = 0; e < ne; e++) {
-            int64_t a = emb->edges[2 * e], b = emb->edges[2 * e + 1];
-            const double *pa = xyz + 3 * a, *pb = xyz + 3 * b;
-            double d[3] = {pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]}, w[3];
-            double dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), r;
-            if (!(dl > 0)) dl = 1e-300;
-            r = (dl - L[e]) / L[e];
-            for (int i = 0; i < 3; i++) w[i] = d[i] / (dl * L[e]);
-            for (int i = 0; i < 3; i++) {
-                g[3 * a + i] -= w[i] * r;
-                g[3 * b + i] += w[i] * r;
-            }
-            /* Gauss-Newton w w^T plus the residual's own curvature
-             * r (I - u u^T) / (|d| l), u = d / |d|, where that is positive
-             * semi-definite: on stretched edges (r > 0). Gauss-Newton alone
-             * sees no curvature across an edge, so on nearly flexible meshes
-             * the flexes crawl (linear convergence at a non-zero residual);
-             * the stretched-edge term gives them their true stiffness.
-             * Compressed edges (r < 0) would make the matrix indefinite and
-             * are left out, as in projected Newton methods (the full Hessian
-             * stalled at its first iteration on the midpoints of real pairs). */
-            {
-                double sc = r > 0 ? r / (dl * L[e]) : 0, dd = dl * dl;
-                for (int q = 0; q < 3; q++)
-                    for (int p = 0; p < 3; p++) {
-                        double h = w[p] * w[q] + sc * ((p == q) - d[p] * d[q] / dd);
-                        x[es__pos_off(emb->H3, 3, emb->rank, e, b, p, q)] -= h;
-                        if (p <= q) {
-                            x[es__pos_diag(emb->H3, 3, emb->nlow, a, p, q)] += h;
-                            x[es__pos_diag(emb->H3, 3, emb->nlow, b, p, q)] += h;
-                        }
-                    }
-            }
-        }
-        if (bp) es__bend_assemble(emb, xyz, bp, g);
+        assemble(emb, L, xyz, bp, g);
         for (int64_t i = 0; i < n3; i++) {
-            dg[i] = x[es__pos_diag(emb->H3, 3, emb->nlow, i / 3, (int)(i % 3), (int)(i % 3))];
+            dg[i] = x[es__h3_diag(emb, i / 3, (int)(i % 3), (int)(i % 3))];
             mean += dg[i];
         }
         mean /= (double)n3;
+        if (lag >= 0) lag++;
         for (int tries = 0; tries < 20 && !accepted; tries++) {
             /* forcing term after Eisenstat and Walker (1996): loose while the
              * cost crawls, tight when it falls fast (quadratic phase) */
-            double eta = fmin(0.1, fmax(1e-10, c_prev > 0 ? c / c_prev : 0.1));
-            for (int64_t i = 0; i < n3; i++) {
-                double v = emb->vweight[i / 3] == 0 ? mean : dg[i];
-                x[es__pos_diag(emb->H3, 3, emb->nlow, i / 3, (int)(i % 3), (int)(i % 3))] =
-                    v + lambda * (v + 1e-8 * mean) + 1e-300;
-                hd[i] = -g[i];
-            }
-            /* a lagged factor helps while the matrix drifts slowly; once it has
-             * failed twice in a row (the damping has fallen so far that the
-             * near-flexes dominate), every try would pay for a failed PCG run
-             * and a factorization, so factorize directly from then on */
+            double eta = fmin(0.1, fmax(1e-10, c_prev > 0 ? cur.cost / c_prev : 0.1));
+            int budget = lag >= 0 ? cg_budget(emb, lag) : 0;
+            set_diagonal(emb, dg, mean, lambda);
+            for (int64_t v = 0; v < nv; v++)
+                for (int r = 0; r < 3; r++) hp[3 * emb->pinv[v] + r] = -g[3 * v + r];
             used = -1;
-            if (have_factor && pcg_fail < pcg_give_up) {
-                used = es__lagged_pcg(emb, emb->H3, emb->L3, emb->B3, hd, step, eta, pcg_max);
-                pcg_fail = used < 0 ? pcg_fail + 1 : 0;
+            if (budget > 0) {
+                used = es__lagged_pcg(emb, emb->H3, emb->L3, emb->B3, hp, stepp, eta, budget);
+                cg_outcome(emb, lag, used);
             }
             if (used < 0) {
-                memcpy(emb->B3->x, hd, (size_t)n3 * sizeof(double));
-                emb->B3->ncol = 1;
-                st = es__factor_solve(emb, emb->H3, emb->L3, emb->B3);
-                emb->B3->ncol = 3;
+                st = factor_step(emb, hp, stepp);
                 if (st < 0) return ES_ENUMERIC;
-                have_factor = st == 0;
-                emb->nfactor++;
-                if (st == 0) memcpy(step, emb->X->x, (size_t)n3 * sizeof(double));
+                lag = st == 0 ? 0 : -1;
             } else {
                 st = 0;
             }
             /* restore the undamped diagonal for the model and matvecs */
-            for (int64_t i = 0; i < n3; i++)
-                x[es__pos_diag(emb->H3, 3, emb->nlow, i / 3, (int)(i % 3), (int)(i % 3))] =
-                    emb->vweight[i / 3] == 0 ? 0 : dg[i];
+            set_diagonal(emb, dg, mean, -1);
             if (st == 0) {
                 double *xt = emb->xyz_try;
+                es__h3_unpermute(emb, stepp, step, 1);
                 for (int64_t i = 0; i < n3; i++) xt[i] = xyz[i] + step[i];
-                c_new = refine_cost(emb, xt, L, bp);
-                es__sym_matvec(emb->H3, step, hd);
-                pred = -2.0 * es__dot(g, step, n3) - es__dot(step, hd, n3);
-                rho = pred > 0 ? (c - c_new) / pred : -1;
-                if (isfinite(c_new) && c_new < c && rho > 0) {
+                nxt = evaluate(emb, xt, L, bp);
+                es__sym_matvec(emb->H3, stepp, hp);
+                double gs = es__dot(g, step, n3), shs = es__dot(stepp, hp, n3);
+                pred = -2.0 * gs - shs;
+                rho = pred > 0 ? (cur.cost - nxt.cost) / pred : -1;
+                if (isfinite(nxt.cost) && nxt.cost < cur.cost && rho > 0) {
                     memcpy(xyz, xt, (size_t)n3 * sizeof *xyz);
                     accepted = 1;
                     /* Nielsen's gain-ratio rule (1999) let lambda creep up on
@@ -168,13 +233,12 @@ es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz,
                  * factorizations: 0-28 % less refinement time on nine
                  * meshes of 2K-54K vertices, RMS error equal or lower. */
                 if (isfinite(pred) && pred > 0) {
-                    double gs = es__dot(g, step, n3), shs = es__dot(step, hd, n3);
                     for (double t = 0.5; t > 0.1 && !accepted; t *= 0.5) {
                         double pt = -2.0 * t * gs - t * t * shs;
                         for (int64_t i = 0; i < n3; i++) xt[i] = xyz[i] + t * step[i];
-                        c_new = refine_cost(emb, xt, L, bp);
-                        rho = pt > 0 ? (c - c_new) / pt : -1;
-                        if (isfinite(c_new) && c_new < c && rho > 0.25) {
+                        nxt = evaluate(emb, xt, L, bp);
+                        rho = pt > 0 ? (cur.cost - nxt.cost) / pt : -1;
+                        if (isfinite(nxt.cost) && nxt.cost < cur.cost && rho > 0.25) {
                             memcpy(xyz, xt, (size_t)n3 * sizeof *xyz);
                             accepted = 1;
                         }
@@ -189,20 +253,18 @@ es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz,
             int64_t done = 3 + (int64_t)it, total = emb->progress_total;
             es__progress(emb->ctx, "embedding", done < total ? done : total - 1, total);
         }
-        if (verbose)
-            es__info(emb->ctx, "embed: refine %d cost %.6g -> %.6g lambda %.3g rho %.3g pcg %d",
-                     it, c, c_new, lambda, rho, used);
+        if (ro->verbose)
+            es__info(emb->ctx, "embed: refine %d cost %.6g -> %.6g lambda %.3g rho %.3g pcg %d "
+                     "rms %.4g %% max %.4g %%", it, cur.cost, nxt.cost, lambda, rho, used,
+                     100 * nxt.rms, 100 * nxt.max);
         if (!accepted) break;
         /* relative stopping rule over a window of 3 iterations (oracle README,
          * failure D: an absolute rule stops too early or too late) */
-        hist[it % 4] = c_new;
-        c_prev = c;
-        if (it >= it_hold + 3 && !annealing &&
-            hist[(it - 3) % 4] - c_new < 3.0 * rtol * c_new) {
-            c = c_new;
+        hist[it % 4] = nxt.cost;
+        c_prev = cur.cost;
+        cur = nxt;
+        if (it >= it_hold + 3 && !annealing && hist[(it - 3) % 4] - nxt.cost < 3.0 * ro->rtol * nxt.cost)
             break;
-        }
-        c = c_new;
     }
     return ES_OK;
 }

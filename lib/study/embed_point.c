@@ -155,7 +155,7 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
         goto done;
     res->scale = o->scale > 0 ? o->scale : own;
     if (prior) {
-        es_embed_prior pr = {init_xyz, alpha, sd};
+        es_embed_prior pr = {init_xyz, alpha, sd, NULL};
         es_embed_opts eo = o->embed;
         eo.prior_exact = one_mesh(ctx, o->point);
         if ((rc = point_prior(ctx, s, mesh, w, init_xyz, alpha, sd, res->init,

@@ -170,7 +170,7 @@ static es_status embed_frame(walk *wk, int64_t i, double t, const double *v, dou
     double *alpha = prior + 3 * nv, *sd = alpha + ne;
     char params[1024], heading[64], init[64];
     es_embed_report rep;
-    es_embed_prior pr = {prior, alpha, sd};
+    es_embed_prior pr = {prior, alpha, sd, NULL};
     es_status rc;
     if ((rc = es_study_prior(ctx, wk->rows, w, prior, alpha, sd)) != ES_OK ||
         (rc = es_embed_prior_solve(ctx, wk->emb, v, scale, &pr, &o->embed, res, &rep)) != ES_OK ||

@@ -629,6 +629,42 @@ static void test_interp(es_ctx *ctx)
         }
         ES_CHECK_CLOSE(s, 0.5 * (sa + sb), 1e-12, 0);
         ES_CHECK_CLOSE(len[5], (0.5 * la[5] / sa + 0.5 * lb[5] / sb) * 0.5 * (sa + sb), 1e-12, 0);
+        /* the accuracy stop (refine_rms_tol, refine_max_tol): tolerances the
+         * linear stages already meet stop the refinement before its first
+         * iteration; tolerances between the start and the full run's result
+         * are met, in fewer iterations, as the lengths of the output
+         * measured here (not the report) confirm */
+        {
+            es_embed_opts o;
+            es_embed_report ra;
+            double *lo = malloc((size_t)ne * sizeof *lo), mx = 0, ss = 0, sl = 0;
+            es_embed_opts_init(&o);
+            ES_CHECK(o.refine_rms_tol == 0 && o.refine_max_tol == 0);
+            o.refine_rms_tol = o.refine_max_tol = 1;
+            ES_CHECK_OK(ctx, es_interp_embed(ctx, emb, 2, in, w, NULL, &o, out, &ra, NULL));
+            ES_CHECK_MSG(ra.refine_iters == 0, "loose tolerances: %lld iterations",
+                         (long long)ra.refine_iters);
+            ES_CHECK(r.refine_iters >= 3 && ra.rms_ratio > 2 * r.rms_ratio);
+            o.refine_rms_tol = 0.5 * (ra.rms_ratio + r.rms_ratio);
+            o.refine_max_tol = 0.5 * (ra.max_rel + r.max_rel);
+            ES_CHECK_OK(ctx, es_interp_embed(ctx, emb, 2, in, w, NULL, &o, out, &ra, NULL));
+            ES_CHECK_OK(ctx, es_interp_targets(ctx, mesh, 2, in, w, len, NULL, NULL));
+            ES_CHECK_OK(ctx, es_edge_lengths(ctx, mesh, out, lo));
+            for (int64_t e = 0; e < ne; e++) {
+                double d = lo[e] - len[e];
+                mx = fmax(mx, fabs(d) / len[e]);
+                ss += d * d;
+                sl += len[e];
+            }
+            ss = sqrt(ss / (double)ne) / (sl / (double)ne);
+            fprintf(stderr, "torus midpoint: full %lld it rms %g max %g; stopped at rms <= %g, "
+                    "max <= %g: %lld it rms %g max %g (measured %g %g)\n",
+                    (long long)r.refine_iters, r.rms_ratio, r.max_rel, o.refine_rms_tol,
+                    o.refine_max_tol, (long long)ra.refine_iters, ra.rms_ratio, ra.max_rel, ss, mx);
+            ES_CHECK(ss <= o.refine_rms_tol * (1 + 1e-9) && mx <= o.refine_max_tol * (1 + 1e-9));
+            ES_CHECK(ra.refine_iters >= 1 && ra.refine_iters < r.refine_iters);
+            free(lo);
+        }
         /* endpoints come back; extrapolation stays finite */
         ES_CHECK_OK(ctx, es_interp_sequence(ctx, emb, t.xyz, b, 0.0, 1.2, 3, NULL, out, rs));
         ES_CHECK(aligned_rms(ctx, t.nv, out, t.xyz) <= 1e-8 * es_bbox_diagonal(t.nv, t.xyz));

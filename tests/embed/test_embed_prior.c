@@ -145,7 +145,7 @@ static void test_open(es_ctx *ctx)
         ES_CHECK_OK(ctx, es_dihedral_angles(ctx, mesh, f.xyz, al[0]));
         ES_CHECK_OK(ctx, es_dihedral_angles(ctx, mesh, b, al[1]));
         /* a row: its own mesh comes back, in its own frame */
-        es_embed_prior pr = {prior, pal, psd};
+        es_embed_prior pr = {prior, pal, psd, NULL};
         ES_CHECK_OK(ctx, es_embed_prior_from_rows(ctx, nv, ne, 2, xs, (const double *const *)al,
                                                   w1, prior, pal, psd));
         ES_CHECK_OK(ctx, es_edge_lengths(ctx, mesh, f.xyz, len));
@@ -165,6 +165,33 @@ static void test_open(es_ctx *ctx)
                 "(max %.3g)\n", r.bend_ratio, r.prior_rms, r.prior_max);
         ES_CHECK(r.has_prior && r.bend_ratio > 0.9 && r.bend_ratio < 1.1);
         ES_CHECK(r.prior_rms <= r.prior_max && r.prior_rms <= 1e-2);
+        {   /* a warm start (pr.start: a walk's previous frame) from this result:
+             * with the accuracy stop at what it already meets, no iteration and
+             * the same mesh (up to the start's rescaling to the target's length
+             * sum and the alignment to the prior: 1e-8 x diag measured); NULL
+             * starts from the prior, and the solve is the same as before */
+            double *prev = malloc(3 * (size_t)nv * sizeof *prev), *out2 = malloc(3 * (size_t)nv * sizeof *out2);
+            es_embed_opts o;
+            es_embed_report r2;
+            memcpy(prev, out, 3 * (size_t)nv * sizeof *prev);
+            es_embed_opts_init(&o);
+            o.refine_rms_tol = 1.01 * r.rms_ratio;
+            o.refine_max_tol = 1.01 * r.max_rel;
+            pr.start = prev;
+            ES_CHECK_OK(ctx, es_embed_prior_solve(ctx, emb, len, 0, &pr, &o, out2, &r2));
+            ES_CHECK_MSG(r2.refine_iters == 0 && plain_rms(nv, out2, prev) <= 1e-6 * diag,
+                         "warm start: %lld iterations, %g x diag from the start",
+                         (long long)r2.refine_iters, plain_rms(nv, out2, prev) / diag);
+            ES_CHECK_FAILS(ctx, es_embed_prior_solve(ctx, emb, len, 0, &pr, &o, prev, &r2),
+                           ES_EINVAL, "start positions are the output");
+            prev[5] = NAN;
+            ES_CHECK_FAILS(ctx, es_embed_prior_solve(ctx, emb, len, 0, &pr, &o, out2, &r2),
+                           ES_EINVAL, "start position of vertex 1");
+            pr.start = NULL;
+            ES_CHECK_OK(ctx, es_embed_prior_solve(ctx, emb, len, 0, &pr, NULL, out2, &r2));
+            ES_CHECK(plain_rms(nv, out2, out) == 0 && r2.refine_iters == r.refine_iters);
+            free(prev), free(out2);
+        }
         {   /* the per-vertex deviations are the report's */
             const double *dev = es_embedder_vertex_deviation(emb);
             double ss = 0, mx = 0;
@@ -224,7 +251,7 @@ static void test_closed(es_ctx *ctx)
         xs[1] = b;
         ES_CHECK_OK(ctx, es_dihedral_angles(ctx, mesh, s.xyz, al[0]));
         ES_CHECK_OK(ctx, es_dihedral_angles(ctx, mesh, b, al[1]));
-        es_embed_prior pr = {prior, pal, NULL};
+        es_embed_prior pr = {prior, pal, NULL, NULL};
         ES_CHECK_OK(ctx, es_embed_prior_from_rows(ctx, nv, ne, 2, xs, (const double *const *)al,
                                                   w, prior, pal, NULL));
         ES_CHECK_OK(ctx, es_interp_targets(ctx, mesh, 2, xs, w, len, NULL, NULL));
@@ -251,7 +278,8 @@ static void test_bad_arguments(es_ctx *ctx)
         double *len = malloc((size_t)ne * sizeof *len), *out = malloc(3 * (size_t)nv * sizeof *out);
         double *bad = malloc(3 * (size_t)nv * sizeof *bad), w[1] = {NAN};
         const double *xs[1] = {s.xyz};
-        es_embed_prior none = {NULL, NULL, NULL}, self = {out, NULL, NULL}, nan = {bad, NULL, NULL};
+        es_embed_prior none = {NULL, NULL, NULL, NULL}, self = {out, NULL, NULL, NULL},
+                       nan = {bad, NULL, NULL, NULL};
         es_edge_lengths(ctx, mesh, s.xyz, len);
         memcpy(bad, s.xyz, 3 * (size_t)nv * sizeof *bad);
         bad[7] = NAN;

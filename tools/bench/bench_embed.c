@@ -16,6 +16,8 @@
  *                                   and the 54K face against the number of
  *                                   refinement iterations (the trade-off
  *                                   behind --refine-iters)
+ *   EDGESPACE_BENCH_TOL=RMS,MAX (fractions): the accuracy stop for the
+ *   midpoint and the prior cases.
  */
 #include <edgespace/edgespace.h>
 
@@ -124,9 +126,14 @@ static void run(es_ctx *ctx, const char *dir, const char *a, const char *b, int 
             goto done;
         }
         /* midpoint */
+        es_embed_opts mo;
+        es_embed_opts_init(&mo);
+        if (getenv("EDGESPACE_BENCH_TOL"))   /* the accuracy stop, as fractions */
+            (void)sscanf(getenv("EDGESPACE_BENCH_TOL"), "%lf,%lf", &mo.refine_rms_tol,
+                         &mo.refine_max_tol);
         w0 = bench_wall_s();
         c0 = bench_process_cpu_s();
-        if (es_interp_embed(ctx, emb, 2, in, w, NULL, NULL, out, &r, NULL)) goto fail;
+        if (es_interp_embed(ctx, emb, 2, in, w, NULL, &mo, out, &r, NULL)) goto fail;
         print_row(dir, "midpoint t=0.5", nv, bench_wall_s() - w0, bench_process_cpu_s() - c0,
                   tw_new, &r, 0);
         double cpu_interp = bench_process_cpu_s() - c0;
@@ -141,13 +148,13 @@ static void run(es_ctx *ctx, const char *dir, const char *a, const char *b, int 
             es_dihedral_angles(ctx, mesh, xyz, a2);
             es_dihedral_angles(ctx, mesh, bb, a2 + ne);
             const double *rows[2] = {xyz, bb}, *alr[2] = {a2, a2 + ne};
-            es_embed_prior pr = {prior, prior + 3 * nv, prior + 3 * nv + ne};
+            es_embed_prior pr = {prior, prior + 3 * nv, prior + 3 * nv + ne, NULL};
             es_embed_prior_from_rows(ctx, nv, ne, 2, rows, alr, w, prior, prior + 3 * nv,
                                      prior + 3 * nv + ne);
             es_interp_targets(ctx, mesh, 2, in, w, len, NULL, NULL);
             w0 = bench_wall_s();
             c0 = bench_process_cpu_s();
-            if (es_embed_prior_solve(ctx, emb, len, 0, &pr, NULL, out, &r)) goto fail;
+            if (es_embed_prior_solve(ctx, emb, len, 0, &pr, &mo, out, &r)) goto fail;
             double cpu_prior = bench_process_cpu_s() - c0;
             print_row(dir, "prior t=0.5", nv, bench_wall_s() - w0, cpu_prior, tw_new, &r, 0);
             printf("%-22s %-19s %7lld  prior / interp CPU %.2f; bending %.3f x the prior's, "

@@ -11,7 +11,9 @@
  *
  *   bench_walk [levels [frames [rows]]]   (defaults 0, 20, 30; data from
  *                                          ../shared/data/face-study)
- *   EDGESPACE_VERBOSE=1 prints the refinement's iterations.
+ *   EDGESPACE_VERBOSE=1 prints the refinement's iterations;
+ *   EDGESPACE_BENCH_TOL=RMS,MAX (fractions) sets the accuracy stop;
+ *   EDGESPACE_BENCH_WARM=1 starts each walk frame from the previous one.
  */
 #include <edgespace/edgespace.h>
 
@@ -106,11 +108,16 @@ int main(int argc, char **argv)
     double *len = malloc(sizeof(double) * (size_t)ne), *w = malloc(sizeof(double) * (size_t)n);
     double *prior = malloc(sizeof(double) * (size_t)(3 * nv + 2 * ne));
     double *out = malloc(sizeof(double) * (size_t)(3 * nv)), scale;
-    es_embed_prior pr = {prior, prior + 3 * nv, prior + 3 * nv + ne};
+    es_embed_prior pr = {prior, prior + 3 * nv, prior + 3 * nv + ne, NULL};
     es_embed_report r;
     es_embed_opts eo;
     es_embed_opts_init(&eo);
     eo.verbose = getenv("EDGESPACE_VERBOSE") != NULL;
+    if (getenv("EDGESPACE_BENCH_TOL") &&   /* the accuracy stop, as fractions */
+        sscanf(getenv("EDGESPACE_BENCH_TOL"), "%lf,%lf", &eo.refine_rms_tol,
+               &eo.refine_max_tol) == 2)
+        printf("# refinement stops at rms <= %.3g %%, max <= %.3g %%\n", 100 * eo.refine_rms_tol,
+               100 * eo.refine_max_tol);
     printf("# face-study x %lld rows, %d subdivisions: %lld vertices, %lld edges\n",
            (long long)n, levels, (long long)nv, (long long)ne);
     double w0 = bench_wall_s(), c0 = bench_process_cpu_s();
@@ -142,6 +149,8 @@ int main(int argc, char **argv)
     if (es_study_pca(ctx, s, "walk", NULL, &po, "bench", NULL, NULL, NULL) != ES_OK)
         return fail(ctx, "pca");
     double tw = 0, tc = 0, worst_rms = 0, worst_max = 0;
+    double *prev = malloc(sizeof(double) * (size_t)(3 * nv));
+    int warm = getenv("EDGESPACE_BENCH_WARM") != NULL;
     int64_t iters = 0;
     for (int f = 0; f < frames; f++) {
         char expr[64];
@@ -150,22 +159,26 @@ int main(int argc, char **argv)
         if (es_study_point_weights(ctx, s, expr, "walk", len, &scale, w) != ES_OK)
             return fail(ctx, expr);
         w0 = bench_wall_s(), c0 = bench_process_cpu_s();
+        /* warm (EDGESPACE_BENCH_WARM): from the previous frame's positions */
+        pr.start = warm && f > 0 ? prev : NULL;
         if (es_study_prior(ctx, rows, w, prior, prior + 3 * nv, prior + 3 * nv + ne) != ES_OK ||
             es_embed_prior_solve(ctx, emb, len, scale, &pr, &eo, out, &r) != ES_OK)
             return fail(ctx, "walk frame");
+        memcpy(prev, out, sizeof(double) * (size_t)(3 * nv));
         tw += bench_wall_s() - w0, tc += bench_process_cpu_s() - c0;
         iters += r.refine_iters;
         if (!r.n_bad_faces) worst_rms = fmax(worst_rms, r.rms_ratio), worst_max = fmax(worst_max, r.max_rel);
     }
     printf("walk along PC 1: %d frames  wall %6.3f s  cpu %6.3f s  %.1f frames/s (wall)  "
-           "%.1f it/frame  worst realizable rms %.4f %%  max %.3f %%\n", frames, tw, tc,
-           frames / tw, (double)iters / frames, 100 * worst_rms, 100 * worst_max);
+           "%.1f it/frame  worst realizable rms %.4f %%  max %.3f %%%s\n", frames, tw, tc,
+           frames / tw, (double)iters / frames, 100 * worst_rms, 100 * worst_max,
+           warm ? "  (warm: each frame from the last)" : "");
     es_study_rows_free(rows);
     es_embedder_free(emb);
     es_mesh_free(mesh);
     es_store_abort(s);
     remove(path);
-    free(len), free(w), free(prior), free(out);
+    free(len), free(w), free(prior), free(out), free(prev);
     es_ctx_free(ctx);
     return 0;
 }

@@ -68,6 +68,12 @@ typedef struct es_embed_opts {
                                  the RMS relative edge error is below refine_tol
                                  (defaults 1e-3, 1e-13) */
     double refine_tol;
+    double refine_rms_tol;    /* stage 4 also stops as soon as the edge lengths meet both:
+                                 RMS ratio <= refine_rms_tol and max relative error <=
+                                 refine_max_tol (the report's rms_ratio and max_rel; a
+                                 start that meets them is not refined at all). 0 in
+                                 either: run to the other rules (defaults 0, 0) */
+    double refine_max_tol;
     int continuation_steps;   /* > 0 and initial positions given: run stage 4 along the
                                  length path from the initial mesh in this many steps
                                  instead of stages 1-3 (default 0) */
@@ -259,6 +265,9 @@ typedef struct es_embed_prior {
                                the output array */
     const double *alpha;    /* E: prior dihedrals (NULL: those of xyz) */
     const double *sd;       /* E: the rows' spread per edge (NULL: none) */
+    const double *start;    /* 3 x V: on open meshes, refine from these positions instead
+                               of xyz, e.g. a walk's previous frame (NULL: xyz); must
+                               not be the output array */
 } es_embed_prior;
 
 /* Embed target lengths (E; scale as es_embed_solve) near a prior. The
