@@ -71,7 +71,7 @@ static es_status embed_point(es_ctx *ctx, es_store *s, es_embedder *emb,
     int64_t n = es_store_nrows(s), E = es_store_nedges(s), V3 = 3 * es_store_nverts(s);
     double *target = work, *w = work + E, *pxyz = w + n, *alpha = pxyz + V3, *sd = alpha + E;
     double scale;
-    es_embed_prior pr = {pxyz, alpha, sd};
+    es_embed_prior pr = {pxyz, alpha, sd, NULL};
     es_status rc;
     if ((rc = es_study_point_weights(ctx, s, spec, pca, target, &scale, w)) != ES_OK ||
         (rc = es_study_prior(ctx, rows, w, pxyz, alpha, sd)) != ES_OK)
