@@ -2,7 +2,7 @@
  * a group /analysis/<kind>/<name> begun with its provenance (command, tool
  * version, time, parameters, the rows it used) and filled with datasets
  * (matrices, vectors, integers, strings) and string attributes, read back
- * by path, tested for and listed.
+ * by path, tested for, listed and deleted.
  *
  * Paths are at most 8 components, each checked like an HDF5 link name, so
  * a result path from a command line can neither climb out of /analysis nor
@@ -14,6 +14,7 @@
 #include "store/store_pkg.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -251,15 +252,24 @@ es_status es_store_put_strings(es_ctx *ctx, es_store *s, const char *path,
     return rc;
 }
 
+/* What an attribute holds: text, or a number stored as one (float64 or
+ * int64) so that readers (h5py, R) get numbers. */
+typedef struct attr_value {
+    int type;           /* 0 string, 1 float64, 2 int64 */
+    const char *s;
+    double d;
+    int64_t i;
+} attr_value;
+
 static es_status put_attr_impl(es_ctx *ctx, es_store *s, const char *path, const char *key,
-                               const char *value)
+                               const attr_value *v)
 {
     char parts[8][128], full[700];
     es_status rc;
     hid_t obj;
     int np = split_path(ctx, path, parts, &rc);
     if (np < 0) return rc;
-    if (np < 2 || !key || !*key || !value)
+    if (np < 2 || !key || !*key || (v->type == 0 && !v->s))
         ES_FAIL(ctx, ES_EINVAL, "store: bad attribute '%s' on '%s'", key ? key : "", path);
     if ((rc = es__store_begin_write(s))) return rc;
     full_path(full, sizeof full, path);
@@ -267,7 +277,9 @@ static es_status put_attr_impl(es_ctx *ctx, es_store *s, const char *path, const
         ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
     if ((obj = H5Oopen(s->file, full, H5P_DEFAULT)) < 0)
         return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
-    rc = es__h5_write_attr_str(ctx, obj, key, value);
+    rc = v->type == 1 ? es__h5_write_attr_f64(ctx, obj, key, v->d)
+         : v->type == 2 ? es__h5_write_attr_i64(ctx, obj, key, v->i)
+                        : es__h5_write_attr_str(ctx, obj, key, v->s);
     H5Oclose(obj);
     if (rc) s->broken = true;
     return rc;
@@ -277,8 +289,29 @@ es_status es_store_put_attr(es_ctx *ctx, es_store *s, const char *path, const ch
                             const char *value)
 {
     es_status rc;
+    attr_value v = {0, value, 0, 0};
     if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
-    H5E_BEGIN_TRY { rc = put_attr_impl(ctx, s, path, key, value); } H5E_END_TRY
+    H5E_BEGIN_TRY { rc = put_attr_impl(ctx, s, path, key, &v); } H5E_END_TRY
+    return rc;
+}
+
+es_status es_store_put_attr_double(es_ctx *ctx, es_store *s, const char *path, const char *key,
+                                   double value)
+{
+    es_status rc;
+    attr_value v = {1, NULL, value, 0};
+    if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    H5E_BEGIN_TRY { rc = put_attr_impl(ctx, s, path, key, &v); } H5E_END_TRY
+    return rc;
+}
+
+es_status es_store_put_attr_int(es_ctx *ctx, es_store *s, const char *path, const char *key,
+                                int64_t value)
+{
+    es_status rc;
+    attr_value v = {2, NULL, 0, value};
+    if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    H5E_BEGIN_TRY { rc = put_attr_impl(ctx, s, path, key, &v); } H5E_END_TRY
     return rc;
 }
 
@@ -406,6 +439,21 @@ es_status es_store_get_attr(es_ctx *ctx, es_store *s, const char *path, const ch
     return rc;
 }
 
+es_status es_store_get_attr_double(es_ctx *ctx, es_store *s, const char *path,
+                                   const char *key, double *value)
+{
+    char buf[128], *end = NULL;
+    es_status rc = es_store_get_attr(ctx, s, path, key, buf, sizeof buf);
+    if (rc != ES_OK) return rc;
+    /* a number, or (stores written before numeric attributes) its text */
+    double v = strtod(buf, &end);
+    if (end == buf || *end)
+        ES_FAIL(ctx, ES_EFORMAT, "store: attribute '%s' of %s is '%s', not a number", key, path,
+                buf);
+    *value = v;
+    return ES_OK;
+}
+
 int es_store_has(es_store *s, const char *path)
 {
     char full[700];
@@ -468,5 +516,46 @@ es_status es_store_list_results(es_ctx *ctx, es_store *s, const char *kind, char
     *names = NULL;
     *n = 0;
     H5E_BEGIN_TRY { rc = list_impl(ctx, s, kind, names, n); } H5E_END_TRY
+    return rc;
+}
+
+static es_status delete_impl(es_ctx *ctx, es_store *s, const char *kind, const char *name)
+{
+    char full[600], group[300];
+    es_status rc;
+    if (es__h5_bad_name(kind) || es__h5_bad_name(name) || strlen(kind) > 120 ||
+        strlen(name) > 120)
+        ES_FAIL(ctx, ES_EINVAL, "store: bad result kind/name '%s/%s'", kind ? kind : "",
+                name ? name : "");
+    snprintf(group, sizeof group, "/analysis/%s", kind);
+    snprintf(full, sizeof full, "%s/%s", group, name);
+    if (!link_exists(s->file, full))
+        ES_FAIL(ctx, ES_ENOTFOUND, "store: no result %s/%s in '%s'", kind, name, s->path);
+    if ((rc = es__store_begin_write(s))) return rc;
+    if (H5Ldelete(s->file, full, H5P_DEFAULT) < 0) {
+        s->broken = true;
+        return es__h5_fail(ctx, ES_EIO, "store: cannot delete %s", full);
+    }
+    /* the last result of its kind takes the kind's group with it */
+    H5G_info_t info;
+    hid_t g = H5Gopen2(s->file, group, H5P_DEFAULT);
+    if (g < 0 || H5Gget_info(g, &info) < 0) {
+        es__h5_close(g);
+        s->broken = true;
+        return es__h5_fail(ctx, ES_EIO, "store: cannot read %s", group);
+    }
+    H5Gclose(g);
+    if (info.nlinks == 0 && H5Ldelete(s->file, group, H5P_DEFAULT) < 0) {
+        s->broken = true;
+        return es__h5_fail(ctx, ES_EIO, "store: cannot delete %s", group);
+    }
+    return ES_OK;
+}
+
+es_status es_store_delete_result(es_ctx *ctx, es_store *s, const char *kind, const char *name)
+{
+    es_status rc;
+    if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    H5E_BEGIN_TRY { rc = delete_impl(ctx, s, kind, name); } H5E_END_TRY
     return rc;
 }

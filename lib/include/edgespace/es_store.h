@@ -196,6 +196,12 @@ ES_API es_status es_store_put_strings(es_ctx *ctx, es_store *store, const char *
                                       const char *const *s, int64_t n);
 ES_API es_status es_store_put_attr(es_ctx *ctx, es_store *store, const char *path,
                                    const char *key, const char *value);
+/* Numeric attributes, stored as numbers (scalar float64 / int64), so that
+ * h5py, R and the CSV tables read numbers. */
+ES_API es_status es_store_put_attr_double(es_ctx *ctx, es_store *store, const char *path,
+                                          const char *key, double value);
+ES_API es_status es_store_put_attr_int(es_ctx *ctx, es_store *store, const char *path,
+                                       const char *key, int64_t value);
 /* Read back: *m->data / *v allocated with the ctx allocator (es_free). */
 ES_API es_status es_store_get_matrix(es_ctx *ctx, es_store *store, const char *path,
                                      es_mat *m);
@@ -203,9 +209,14 @@ ES_API es_status es_store_get_vector(es_ctx *ctx, es_store *store, const char *p
                                      double **v, int64_t *n);
 ES_API es_status es_store_get_ints(es_ctx *ctx, es_store *store, const char *path,
                                    int64_t **v, int64_t *n);
-/* Attribute value copied into buf (truncated to n bytes with NUL). */
+/* Attribute value copied into buf (truncated to n bytes with NUL); a
+ * numeric attribute as text (%.17g, or the integer). */
 ES_API es_status es_store_get_attr(es_ctx *ctx, es_store *store, const char *path,
                                    const char *key, char *buf, size_t n);
+/* A numeric attribute, or one stored as the text of a number (results
+ * written before numeric attributes existed); ES_EFORMAT otherwise. */
+ES_API es_status es_store_get_attr_double(es_ctx *ctx, es_store *store, const char *path,
+                                          const char *key, double *value);
 /* 1 if the result or dataset exists, else 0. */
 ES_API int es_store_has(es_store *store, const char *path);
 /* Names of the results of one kind, in name order; kind NULL or "": the
@@ -213,6 +224,13 @@ ES_API int es_store_has(es_store *store, const char *path);
  * the array. */
 ES_API es_status es_store_list_results(es_ctx *ctx, es_store *store, const char *kind,
                                        char ***names, int64_t *n);
+/* Delete /analysis/<kind>/<name> (and the kind's group when it was the last
+ * of its kind) in the working copy; like every write it becomes visible
+ * at es_store_commit/es_store_close, and a failure leaves the store as it
+ * was. HDF5 does not give the bytes back: the file keeps its size until it
+ * is repacked (h5repack). ES_ENOTFOUND if there is no such result. */
+ES_API es_status es_store_delete_result(es_ctx *ctx, es_store *store, const char *kind,
+                                        const char *name);
 
 #ifdef __cplusplus
 }
