@@ -410,6 +410,40 @@ es_status es_store_get_ints(es_ctx *ctx, es_store *s, const char *path, int64_t 
     return rc;
 }
 
+static es_status get_strings_impl(es_ctx *ctx, es_store *s, const char *path, char ***out,
+                                  int64_t *n)
+{
+    char parts[8][128], full[700];
+    es_status rc;
+    hsize_t dims[2] = {0, 0};
+    if (split_path(ctx, path, parts, &rc) < 0) return rc;
+    full_path(full, sizeof full, path);
+    if (!link_exists(s->file, full)) ES_FAIL(ctx, ES_ENOTFOUND, "store: no dataset %s", full);
+    int64_t count = es__h5_dataset_rows(s->file, full, 1, dims);
+    if (count < 0) ES_FAIL(ctx, ES_EFORMAT, "store: %s is not a 1-D dataset", full);
+    char **v = es__calloc(ctx, (size_t)(count > 0 ? count : 1), sizeof *v);
+    if (!v) return ES_ENOMEM;
+    if ((rc = es__h5_read_strings(ctx, s->file, full, count, v)) != ES_OK) {
+        for (int64_t i = 0; i < count; i++) es__free(ctx, v[i]);
+        es__free(ctx, v);
+        return rc;
+    }
+    *out = v;
+    *n = count;
+    return ES_OK;
+}
+
+es_status es_store_get_strings(es_ctx *ctx, es_store *s, const char *path, char ***v,
+                               int64_t *n)
+{
+    es_status rc;
+    if (!s || !v || !n) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument");
+    *v = NULL;
+    *n = 0;
+    H5E_BEGIN_TRY { rc = get_strings_impl(ctx, s, path, v, n); } H5E_END_TRY
+    return rc;
+}
+
 static es_status get_attr_impl(es_ctx *ctx, es_store *s, const char *path, const char *key,
                                char *buf, size_t n)
 {

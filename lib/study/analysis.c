@@ -601,6 +601,17 @@ es_status es_study_resolve(es_ctx *ctx, void *ud, es_point_leaf kind, const char
         return resolve_pc(ctx, r, index, vec, scale, w);
     case ES_POINT_DIFF:
         return resolve_diff(ctx, r, arg, vec, w);
+    case ES_POINT_COEF: {
+        /* "MODEL/COEF": a model name holds no '/' */
+        const char *slash = strchr(arg, '/');
+        char model[256];
+        if (!slash || (size_t)(slash - arg) >= sizeof model)
+            ES_FAIL(ctx, ES_EINVAL, "bad coefficient '%s'", arg);
+        memcpy(model, arg, (size_t)(slash - arg));
+        model[slash - arg] = '\0';
+        *scale = NAN;
+        return es_study_model_coef(ctx, st, model, slash + 1, vec, w);
+    }
     }
     ES_FAIL(ctx, ES_EINVAL, "unknown leaf kind %d", (int)kind);
 }

@@ -4,6 +4,10 @@
 
 #ifndef ES_MODULE_STUDY
 #error "study/study_pkg.h is private to lib/study/ (see lib/README.md)"
+/* Store a model as model/<o->name> (model_results.c). */
+es_status es__model_save(es_ctx *ctx, es_store *s, const es_study_model_opts *o,
+                         const es_study_model_result *r);
+
 #endif
 
 #include "core/core_private.h"
@@ -23,5 +27,9 @@ es_status es__table_begin(es_ctx *ctx, const char *path, es__table_out *t);
 es_status es__table_end(es_ctx *ctx, es__table_out *t, es_status rc);
 /* ",<value>" with 17 significant digits (round trip). */
 void es__table_number(FILE *f, double v);
+
+/* Store a model as model/<o->name> (model_results.c). */
+es_status es__model_save(es_ctx *ctx, es_store *s, const es_study_model_opts *o,
+                         const es_study_model_result *r);
 
 #endif

@@ -209,6 +209,9 @@ ES_API es_status es_store_get_vector(es_ctx *ctx, es_store *store, const char *p
                                      double **v, int64_t *n);
 ES_API es_status es_store_get_ints(es_ctx *ctx, es_store *store, const char *path,
                                    int64_t **v, int64_t *n);
+/* A 1-D string dataset: *v gets n strings (es_free each and the array). */
+ES_API es_status es_store_get_strings(es_ctx *ctx, es_store *store, const char *path,
+                                      char ***v, int64_t *n);
 /* Attribute value copied into buf (truncated to n bytes with NUL); a
  * numeric attribute as text (%.17g, or the integer). */
 ES_API es_status es_store_get_attr(es_ctx *ctx, es_store *store, const char *path,
