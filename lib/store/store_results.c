@@ -542,6 +542,47 @@ static es_status list_impl(es_ctx *ctx, es_store *s, const char *kind, char ***n
     return ES_OK;
 }
 
+static herr_t attr_cb(hid_t loc, const char *name, const H5A_info_t *info, void *data)
+{
+    (void)info;
+    return list_cb(loc, name, NULL, data);
+}
+
+static es_status attrs_impl(es_ctx *ctx, es_store *s, const char *path, char ***keys, int64_t *n)
+{
+    char parts[8][128], full[700];
+    es_status rc;
+    name_list l = {ctx, NULL, 0, 0, ES_OK};
+    if (split_path(ctx, path, parts, &rc) < 0) return rc;
+    full_path(full, sizeof full, path);
+    if (!link_exists(s->file, full)) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
+    hid_t obj = H5Oopen(s->file, full, H5P_DEFAULT);
+    if (obj < 0) return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
+    if (H5Aiterate2(obj, H5_INDEX_NAME, H5_ITER_INC, NULL, attr_cb, &l) < 0) {
+        rc = l.rc ? l.rc : es__h5_fail(ctx, ES_EIO, "store: cannot list the attributes of %s",
+                                       full);
+        H5Oclose(obj);
+        for (int64_t i = 0; i < l.n; i++) es__free(ctx, l.names[i]);
+        es__free(ctx, l.names);
+        return rc;
+    }
+    H5Oclose(obj);
+    *keys = l.names;
+    *n = l.n;
+    return ES_OK;
+}
+
+es_status es_store_list_attrs(es_ctx *ctx, es_store *s, const char *path, char ***keys,
+                              int64_t *n)
+{
+    es_status rc;
+    if (!s || !keys || !n) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument");
+    *keys = NULL;
+    *n = 0;
+    H5E_BEGIN_TRY { rc = attrs_impl(ctx, s, path, keys, n); } H5E_END_TRY
+    return rc;
+}
+
 es_status es_store_list_results(es_ctx *ctx, es_store *s, const char *kind, char ***names,
                                 int64_t *n)
 {

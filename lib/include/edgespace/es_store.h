@@ -227,6 +227,11 @@ ES_API int es_store_has(es_store *store, const char *path);
  * the array. */
 ES_API es_status es_store_list_results(es_ctx *ctx, es_store *store, const char *kind,
                                        char ***names, int64_t *n);
+/* Names of the attributes of a result or dataset ("kind/name[/dataset]"),
+ * in name order; *keys NULL when there are none. es_free each and the
+ * array. */
+ES_API es_status es_store_list_attrs(es_ctx *ctx, es_store *store, const char *path,
+                                     char ***keys, int64_t *n);
 /* Delete /analysis/<kind>/<name> (and the kind's group when it was the last
  * of its kind) in the working copy; like every write it becomes visible
  * at es_store_commit/es_store_close, and a failure leaves the store as it

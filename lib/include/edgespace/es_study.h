@@ -179,6 +179,25 @@ ES_API void es_study_projection_free(es_study_projection *p);
 ES_API es_status es_study_write_projection_table(es_ctx *ctx, const es_study_projection *p,
                                                  const char *path);
 
+/* Every stored result as a CSV table with labels (path "-": standard
+ * output; a file is replaced only once written whole). result is
+ * "KIND/NAME"; table NULL is the kind's default (the first listed):
+ *   mean:    means (edge table, a column per group)
+ *   pca:     scores (id, labels, PC1..), eigenvalues, components
+ *   diff:    edges (mean, sd, se, t);  point: edges (length), weights
+ *   gpa:     specimens (id, labels, centroid_size, rho, scale, PC1..),
+ *            aligned (x1..xk, y1..yk[, z1..zk]), mean, pca, loadings
+ *   compare: summary, distances_lengths, distances_procrustes, groups
+ *   embed:   report (its attributes), vertices (positions and heat maps)
+ *   model:   anova, coefficients, weights, pairwise, lsmeans, edges,
+ *            scores (CAC), permutations (F of each permutation)
+ * and every result: attributes (name, value: provenance and report).
+ * Errors: ES_ENOTFOUND naming the result or listing the kind's tables. */
+ES_API es_status es_study_export_result(es_ctx *ctx, es_store *store, const char *result,
+                                        const char *table, const char *path);
+/* The tables of a kind, ", "-separated, into buf (n bytes); returns buf. */
+ES_API const char *es_study_result_tables(const char *kind, char *buf, size_t n);
+
 /* ---- GPA and the comparison of the two spaces ----------------------------- */
 
 /* GPA of the positions of `rows` (nrows of them; rows NULL with nrows = -1:
