@@ -16,6 +16,7 @@ int cmd_diff(int argc, char **argv);
 int cmd_project(int argc, char **argv);
 int cmd_point(int argc, char **argv);
 int cmd_plot_pca(int argc, char **argv);
+int cmd_model(int argc, char **argv);
 /* -- procrustes, landmarks, comparison */
 int cmd_gpa(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
@@ -26,5 +27,6 @@ int cmd_interp(int argc, char **argv);
 /* -- plotting, rendering */
 int cmd_render(int argc, char **argv);
 int cmd_plot(int argc, char **argv);
+int cmd_variation(int argc, char **argv);
 
 #endif

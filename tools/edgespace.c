@@ -27,6 +27,7 @@ static const command commands[] = {
     {"diff", cmd_diff, "mean paired difference (to - from) with per-edge t statistics"},
     {"project", cmd_project, "scores of rows or mesh files on a stored PCA, with residuals"},
     {"point", cmd_point, "evaluate and store a point expression (mean + 2*pc:1, ...)"},
+    {"model", cmd_model, "linear model of the shapes on label columns, permutation tests"},
 #if ES_HAVE_FIGURES
     {"plot-pca", cmd_plot_pca, "PCA score scatter coloured by a label, or scree plot, from a store"},
 #endif
@@ -41,6 +42,7 @@ static const command commands[] = {
 #if ES_HAVE_FIGURES
     {"render", cmd_render, "draw meshes side by side to PNG/SVG/PDF"},
     {"plot", cmd_plot, "scatter, lines, scree, histogram or heat map of a CSV table"},
+    {"variation", cmd_variation, "mean +- k sd along PCs or a model coefficient, embedded, one figure"},
 #endif
     {NULL, NULL, NULL}
 };

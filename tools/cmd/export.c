@@ -1,5 +1,6 @@
 /* tools/cmd/export.c — edgespace export: a store's rows as a CSV of edge
- * lengths or as mesh files (es_export_lengths_csv, es_export_meshes). */
+ * lengths or as mesh files (es_export_lengths_csv, es_export_meshes), or a
+ * stored result as a labelled table (es_study_export_result). */
 #include "cli.h"
 #include "commands.h"
 
@@ -9,6 +10,7 @@
 
 static const char usage[] =
     "usage: edgespace export STORE (--lengths CSV | --meshes DIR) [options]\n"
+    "       edgespace export STORE --result KIND/NAME [--table TABLE] --csv PATH\n"
     "\n"
     "Write rows of a store: their edge lengths as CSV (id, scale, then one column\n"
     "per edge named by its 0-based vertex pair 'a-b'), or their positions as they\n"
@@ -20,6 +22,10 @@ static const char usage[] =
     "  -f, --format FMT      mesh format: obj (default), ply, ply-ascii, off\n"
     "  -s, --select FILTER   only rows matching col=value[,col=value...]\n"
     "                        (quote a value holding ',': col=\"a,b\")\n"
+    "  -r, --result KIND/NAME  a stored result (gpa/all, model/m, ...) as a table\n"
+    "  -t, --table TABLE     which of its tables (default: the kind's first;\n"
+    "                        'attributes' for any result; a wrong name lists them)\n"
+    "  -o, --csv PATH        where the result's table goes (- for stdout)\n"
     "  -h, --help            show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -30,8 +36,11 @@ int cmd_export(int argc, char **argv)
         {"lengths", required_argument, NULL, 'l'}, {"raw", no_argument, NULL, 'R'},
         {"meshes", required_argument, NULL, 'M'},  {"format", required_argument, NULL, 'f'},
         {"select", required_argument, NULL, 's'},  {"help", no_argument, NULL, 'h'},
+        {"result", required_argument, NULL, 'r'},  {"table", required_argument, NULL, 't'},
+        {"csv", required_argument, NULL, 'o'},
         {NULL, 0, NULL, 0}};
     const char *lengths = NULL, *meshes = NULL, *filter = NULL;
+    const char *result = NULL, *table = NULL, *csv = NULL;
     es_mesh_format fmt = ES_FORMAT_OBJ;
     es_store *s = NULL;
     es_ctx *ctx;
@@ -39,12 +48,15 @@ int cmd_export(int argc, char **argv)
     int64_t *rows = NULL, nrows = 0;
     int c, raw = 0;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "l:M:f:s:h", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "l:M:f:s:r:t:o:h", longopts, NULL)) != -1) {
         switch (c) {
         case 'l': lengths = optarg; break;
         case 'R': raw = 1; break;
         case 'M': meshes = optarg; break;
         case 's': filter = optarg; break;
+        case 'r': result = optarg; break;
+        case 't': table = optarg; break;
+        case 'o': csv = optarg; break;
         case 'f':
             if (!strcmp(optarg, "obj")) fmt = ES_FORMAT_OBJ;
             else if (!strcmp(optarg, "ply")) fmt = ES_FORMAT_PLY;
@@ -57,14 +69,21 @@ int cmd_export(int argc, char **argv)
         }
     }
     if (optind != argc - 1) return cli_usage_error("export", "give exactly one STORE");
-    if (!lengths == !meshes)
+    if (result) {
+        if (lengths || meshes || filter)
+            return cli_usage_error("export", "--result goes alone (with --table and --csv)");
+        if (!csv) return cli_usage_error("export", "--result needs --csv PATH (- for stdout)");
+    } else if (table || csv) {
+        return cli_usage_error("export", "--table and --csv go with --result KIND/NAME");
+    } else if (!lengths == !meshes)
         return cli_usage_error("export", "give one of --lengths CSV or --meshes DIR");
     if (raw && !lengths) return cli_usage_error("export", "--raw goes with --lengths");
     if (!(ctx = cli_ctx_new("export"))) return CLI_FAIL;
     if ((rc = es_store_open(ctx, argv[optind], ES_STORE_READ, &s)) ||
-        (rc = es_store_select(ctx, s, filter, &rows, &nrows)))
+        (!result && (rc = es_store_select(ctx, s, filter, &rows, &nrows))))
         goto fail;
-    if (lengths) rc = es_export_lengths_csv(ctx, s, rows, nrows, raw, lengths);
+    if (result) rc = es_study_export_result(ctx, s, result, table, csv);
+    else if (lengths) rc = es_export_lengths_csv(ctx, s, rows, nrows, raw, lengths);
     else rc = es_export_meshes(ctx, s, rows, nrows, meshes, fmt);
     if (rc) goto fail;
     es_free(ctx, rows);
