@@ -23,6 +23,7 @@ packages=(
   libopenblas-dev liblapacke-dev libsuitesparse-dev libhdf5-dev hdf5-tools libcsv-dev
   libcairo2-dev libcjson-dev
   clang libclang-rt-14-dev   # libFuzzer targets for the parsers
+  r-cran-vegan               # the oracle of edgespace model (tools/oracle/adonis2.R)
 )
 
 install_missing() {
