@@ -9,6 +9,7 @@ int cmd_synth(int argc, char **argv);
 int cmd_ingest(int argc, char **argv);
 int cmd_info(int argc, char **argv);
 int cmd_export(int argc, char **argv);
+int cmd_results(int argc, char **argv);
 /* -- statistics, point syntax */
 int cmd_mean(int argc, char **argv);
 int cmd_pca(int argc, char **argv);

@@ -21,6 +21,7 @@ static const command commands[] = {
     {"ingest", cmd_ingest, "read meshes (manifest or files) into an HDF5 store"},
     {"info", cmd_info, "describe a store: topology, rows, labels, results"},
     {"export", cmd_export, "write a store's lengths as CSV or its meshes as files"},
+    {"results", cmd_results, "list a store's analysis results, or delete some"},
     /* -- statistics, point syntax */
     {"mean", cmd_mean, "mean edge lengths of all rows, a filter, or per label value"},
     {"pca", cmd_pca, "principal components of the edge lengths (stored, CSV)"},

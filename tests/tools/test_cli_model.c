@@ -1,12 +1,13 @@
-/* tests/tools/test_cli_model.c — edgespace model, export --result and
- * variation, run as a user would on synthetic faces (6 subjects x neutral,
+/* tests/tools/test_cli_model.c — edgespace model, export --result,
+ * variation and results, run as a user would on synthetic faces (6 subjects x neutral,
  * happy, angry, with noise): help and usage errors (exit 2), failures
  * (exit 1) with their messages, a blocked two-factor model whose ANOVA CSV
  * is checked against the balanced design's closed form computed here from
  * the lengths `export --lengths` wrote (type I expression and subject SS,
  * the residual, F), the same table read back with `export --result`, the
  * tables of a GPA result with the rows' labels, the per-edge figure, and
- * the shape-variation figure along a PC and along a coefficient. */
+ * the shape-variation figure along a PC and along a coefficient, and
+ * `results` listing and deleting (all or nothing). */
 #include "core/core_private.h"
 #include "core/csv_table.h"
 #include "core/files.h"
@@ -199,6 +200,21 @@ int main(void)
     ES_RUN(&r, dir, "variation", store, "--pcs", "1,x", "-o", var);
     ES_CHECK(r.status == 2 && strstr(r.err, "--pcs wants"));
 #endif
+
+    /* results: the list, and deletion all or nothing */
+    ES_RUN(&r, dir, "results", store);
+    ES_CHECK_MSG(r.status == 0 && strstr(r.out, "model/m ") && strstr(r.out, "gpa/g ") &&
+                 strstr(r.out, "edgespace model "), "%s%s", r.out, r.err);
+    ES_RUN(&r, dir, "results", store, "--delete", "gpa/g", "--delete", "model/none");
+    ES_CHECK_MSG(r.status == 1 && strstr(r.err, "no result model/none"), "%s", r.err);
+    ES_RUN(&r, dir, "results", store, "--kind", "gpa");
+    ES_CHECK(r.status == 0 && strstr(r.out, "gpa/g ") && !strstr(r.out, "model/m"));
+    ES_RUN(&r, dir, "results", store, "--delete", "gpa/g");
+    ES_CHECK(r.status == 0 && strstr(r.out, "deleted gpa/g"));
+    ES_RUN(&r, dir, "results", store, "--kind", "gpa");
+    ES_CHECK(r.status == 0 && strstr(r.out, "no results of kind gpa"));
+    ES_RUN(&r, dir, "results", store, "--delete", "gpa");
+    ES_CHECK(r.status == 2 && strstr(r.err, "KIND/NAME"));
     es_ctx_free(ctx);
     ES_TEST_END();
 }

@@ -250,7 +250,7 @@ ES_API es_status es_study_compare_write(es_ctx *ctx, const es_compare_result *re
 /* ---- linear models ------------------------------------------------------------
  * es_model.h on a store: the response is the rows' normalized edge lengths
  * (edge-length space) or the aligned coordinates of a stored GPA result
- * (Procrustes space: the residual tangent coordinates, procGPA's default);
+ * (Procrustes space: its `aligned` configurations);
  * every variable of the formula is a label column, except `size` when no
  * label column has that name: each row's scale (sum of raw edge lengths)
  * in edge-length space, its centroid size in Procrustes space, so that
