@@ -161,7 +161,7 @@ int main(int argc, char **argv)
         run_case("face_lengths", store, "~ expression + subject", NULL, "subject", "I", lengths,
                  1, spec, 999);
         run_case("face_procrustes", store, "~ expression + subject", "g", "subject", "I",
-                 aligned, 2, spec, 999);
+                 aligned, 3, spec, 999);
     } else {
         ES_CHECK(landmarks("rats", store, aligned, spec, sizeof store));
         run_case("rats", store, "~ time + factor(rat_no)", "g", "rat_no", "I", aligned, 2, spec,

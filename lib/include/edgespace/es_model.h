@@ -6,16 +6,18 @@
  * per-variable (per-edge) tests with Benjamini-Hochberg FDR, and the common
  * allometric component.
  *
- * datasets-spec/models.md is the reference of the formula syntax and of the
- * statistics. The method is geomorph's procD.lm / RRPP's lm.rrpp (Collyer,
- * Sekora & Adams 2015; Adams & Collyer 2018): the response is a matrix Y of
- * N rows (shapes) by p variables (scale-normalized edge lengths, or
- * Procrustes tangent coordinates), the statistics are traces of projections
+ * datasets-spec/analysis-results.md ("model/<name>") describes the formula
+ * syntax and the statistics as the command offers them. The method is
+ * geomorph's procD.lm / RRPP's lm.rrpp (Collyer, Sekora & Adams 2015;
+ * Adams & Collyer 2018): the response is a matrix Y of N rows (shapes) by
+ * p variables (scale-normalized edge lengths, or Procrustes-aligned
+ * coordinates), the statistics are traces of projections
  * of Y (Goodall's F, Anderson's PERMANOVA on Euclidean distances), and for
  * each term the residuals of its reduced model are permuted among the rows
  * (Freedman & Lane 1983) and added back to the reduced model's fitted
  * values. vegan's adonis2 permutes the rows themselves (ES_PERM_RAW); both
- * are offered, and agree with R to rounding (tests/oracle/).
+ * are offered, and agree with R to rounding (tools/oracle/adonis2.R,
+ * tests/tools/test_model_oracle.c).
  *
  * Everything works on the N x N geometry of the rows: the response enters
  * once, through an es_source, as its principal coordinates Z (N x r, Z Z^T =
