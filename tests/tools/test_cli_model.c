@@ -119,6 +119,18 @@ int main(void)
     ES_CHECK(r.status == 0);
     ES_RUN(&r, dir, "ingest", store, "--manifest", manifest, "-q");
     ES_CHECK(r.status == 0);
+    /* export takes --where like every command (--select is the same) */
+    ES_RUN(&r, dir, "export", store, "--lengths", lengths, "--where", "expression=happy");
+    ES_CHECK_MSG(r.status == 0, "%s", r.err);
+    {
+        es__csv_table th = {0};
+        es_ctx *c2 = NULL;
+        if (es_ctx_new(&c2) != ES_OK) return 1;
+        ES_CHECK_OK(c2, es__csv_read(c2, "lengths", lengths, 0, &th));
+        ES_CHECK(th.nrecords == 1 + S && !strcmp(es__csv_field(&th, 1, 0), "face_s01_happy"));
+        es__csv_table_clear(c2, &th);
+        es_ctx_free(c2);
+    }
     ES_RUN(&r, dir, "export", store, "--lengths", lengths);
     ES_CHECK(r.status == 0);
     ES_RUN(&r, dir, "model", store, "~ expresion");

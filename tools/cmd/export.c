@@ -21,6 +21,7 @@ static const char usage[] =
     "  -M, --meshes DIR      write meshes into DIR (created if absent)\n"
     "  -f, --format FMT      mesh format: obj (default), ply, ply-ascii, off\n"
     "  -s, --select FILTER   only rows matching col=value[,col=value...]\n"
+    "                        (--where FILTER, as in the other commands)\n"
     "                        (quote a value holding ',': col=\"a,b\")\n"
     "  -r, --result KIND/NAME  a stored result (gpa/all, model/m, ...) as a table\n"
     "  -t, --table TABLE     which of its tables (default: the kind's first;\n"
@@ -37,7 +38,7 @@ int cmd_export(int argc, char **argv)
         {"meshes", required_argument, NULL, 'M'},  {"format", required_argument, NULL, 'f'},
         {"select", required_argument, NULL, 's'},  {"help", no_argument, NULL, 'h'},
         {"result", required_argument, NULL, 'r'},  {"table", required_argument, NULL, 't'},
-        {"csv", required_argument, NULL, 'o'},
+        {"csv", required_argument, NULL, 'o'},    {"where", required_argument, NULL, 's'},
         {NULL, 0, NULL, 0}};
     const char *lengths = NULL, *meshes = NULL, *filter = NULL;
     const char *result = NULL, *table = NULL, *csv = NULL;
