@@ -20,6 +20,7 @@
 
 enum { S = 6, X = 3, N = S * X };
 
+#if ES_HAVE_FIGURES
 static int is_png(const char *path)
 {
     unsigned char b[8] = {0};
@@ -28,6 +29,7 @@ static int is_png(const char *path)
     if (f) fclose(f);
     return n == 8 && b[0] == 0x89 && b[1] == 'P' && b[2] == 'N' && b[3] == 'G';
 }
+#endif
 
 /* Field c of the record whose first field is `key` (NAN when absent). */
 static double csv_value(const es__csv_table *t, const char *key, int64_t c)
