@@ -21,12 +21,14 @@ static const command commands[] = {
     {"ingest", cmd_ingest, "read meshes (manifest or files) into an HDF5 store"},
     {"info", cmd_info, "describe a store: topology, rows, labels, results"},
     {"export", cmd_export, "write a store's lengths as CSV or its meshes as files"},
+    {"results", cmd_results, "list a store's analysis results, or delete some"},
     /* -- statistics, point syntax */
     {"mean", cmd_mean, "mean edge lengths of all rows, a filter, or per label value"},
     {"pca", cmd_pca, "principal components of the edge lengths (stored, CSV)"},
     {"diff", cmd_diff, "mean paired difference (to - from) with per-edge t statistics"},
     {"project", cmd_project, "scores of rows or mesh files on a stored PCA, with residuals"},
     {"point", cmd_point, "evaluate and store a point expression (mean + 2*pc:1, ...)"},
+    {"model", cmd_model, "linear model of the shapes on label columns, permutation tests"},
 #if ES_HAVE_FIGURES
     {"plot-pca", cmd_plot_pca, "PCA score scatter coloured by a label, or scree plot, from a store"},
 #endif
@@ -41,6 +43,7 @@ static const command commands[] = {
 #if ES_HAVE_FIGURES
     {"render", cmd_render, "draw meshes side by side to PNG/SVG/PDF"},
     {"plot", cmd_plot, "scatter, lines, scree, histogram or heat map of a CSV table"},
+    {"variation", cmd_variation, "mean +- k sd along PCs or a model coefficient, embedded, one figure"},
 #endif
     {NULL, NULL, NULL}
 };

@@ -35,6 +35,7 @@ packages=(
   jupyter-nbconvert python3-ipykernel
   # R, for the tests that run datasets-spec/store-format.md's R snippets
   r-cran-hdf5r r-bioc-rhdf5
+  r-cran-vegan               # the oracle of edgespace model (tools/oracle/adonis2.R)
 )
 
 install_missing() {

@@ -9,6 +9,7 @@
  *     primary := NUMBER | '(' sum ')' | 'lerp' '(' sum ',' sum ',' sum ')'
  *              | 'mean' ['[' NAME '=' VALUE (',' NAME '=' VALUE)* ']']
  *              | 'row:' ID | 'file:' PATH | 'pc:' INTEGER | 'diff:' NAME
+ *              | 'coef:' NAME ':' COEF
  * Numbers are constants, so each sub-expression is either a number or a
  * linear form sum c_i leaf_i; the parser checks the types as it goes (a
  * number cannot be added to a point, two points cannot be multiplied) and
@@ -140,6 +141,12 @@ static es_status word(parser *p, int (*ok)(char), const char *what, const char *
     *w = p->s + at;
     *len = p->pos - at;
     return ES_OK;
+}
+
+/* A coefficient's name: "age", "expression=happy", "a=x:b=y". */
+static int coef_char(char c)
+{
+    return is_id_char(c) || c == '=' || c == ':';
 }
 
 static int path_char(char c)
@@ -331,6 +338,29 @@ static es_status parse_primary(parser *p, form *f)
 #define IS(lit) (n == sizeof(lit) - 1 && !memcmp(name, lit, n))
     if (IS("mean")) return parse_mean(p, f);
     if (IS("lerp")) return parse_lerp(p, f, at);
+    if (IS("coef")) {
+        /* coef:MODEL:COEF, stored as "MODEL/COEF" (a model name has no '/') */
+        const char *mw = NULL, *cw = NULL;
+        size_t ml = 0, cl = 0;
+        es_status rc;
+        if (p->s[p->pos] != ':') return perr(p, p->pos, "expected ':' after 'coef'");
+        p->pos++;
+        if ((rc = word(p, is_id_char, "a model name", &mw, &ml)) != ES_OK) return rc;
+        if (memchr(mw, '/', ml)) return perr(p, at + 5, "a model name cannot contain '/'");
+        if (p->s[p->pos] != ':')
+            return perr(p, p->pos, "expected ':' and a coefficient after 'coef:%.*s' "
+                        "(coef:MODEL:COEF)", (int)ml, mw);
+        p->pos++;
+        if ((rc = word(p, coef_char, "a coefficient name", &cw, &cl)) != ES_OK) return rc;
+        char *a = es__malloc(p->ctx, ml + cl + 2);
+        if (!a) return ES_ENOMEM;
+        memcpy(a, mw, ml);
+        a[ml] = '/';
+        memcpy(a + ml + 1, cw, cl);
+        rc = add_term(p, 1.0, ES_POINT_COEF, a, ml + cl + 1, 0, f);
+        es__free(p->ctx, a);
+        return rc;
+    }
     if (IS("row") || IS("file") || IS("pc") || IS("diff")) {
         if (p->s[p->pos] != ':')
             return perr(p, p->pos, "expected ':' after '%.*s'", (int)n, name);
@@ -366,8 +396,8 @@ static es_status parse_primary(parser *p, form *f)
         return add_term(p, 1.0, ES_POINT_PC, "", 0, k, f);
     }
 #undef IS
-    return perr(p, at, "unknown name '%.*s' (expected mean, row:, file:, pc:, diff: or lerp)",
-                (int)n, name);
+    return perr(p, at, "unknown name '%.*s' (expected mean, row:, file:, pc:, diff:, coef: "
+                "or lerp)", (int)n, name);
 }
 
 static es_status parse_unary(parser *p, form *f)
@@ -388,11 +418,24 @@ static es_status parse_unary(parser *p, form *f)
     return rc;
 }
 
+/* A number followed by something that starts a point or a number: the
+ * multiplication sign was left out ("2 pc:1"). */
+static es_status missing_star(parser *p, const form *f)
+{
+    char c = p->s[p->pos];
+    if (f->is_num && (isalpha((unsigned char)c) || isdigit((unsigned char)c) || c == '(' ||
+                      c == '.'))
+        return perr(p, p->pos, "a '*' is missing between the number and what follows "
+                    "(write 2*pc:1, not 2 pc:1)");
+    return ES_OK;
+}
+
 static es_status parse_product(parser *p, form *f)
 {
     es_status rc = parse_unary(p, f);
     while (rc == ES_OK) {
         skip_ws(p);
+        if ((rc = missing_star(p, f)) != ES_OK) break;
         char op = p->s[p->pos];
         if (op != '*' && op != '/') break;
         size_t at = p->pos++;
@@ -457,6 +500,7 @@ static const char *leaf_prefix(es_point_leaf k)
     case ES_POINT_FILE: return "file:";
     case ES_POINT_PC: return "pc:";
     case ES_POINT_DIFF: return "diff:";
+    case ES_POINT_COEF: return "coef:";
     }
     return "?";
 }
@@ -550,6 +594,11 @@ es_status es_point_eval_rows(es_ctx *ctx, const es_point_expr *x, int64_t E, int
             if (t->kind == ES_POINT_MEAN)
                 ES_FAIL(ctx, rc, "point: mean%s%s%s: %s", *t->arg ? "[" : "", t->arg,
                         *t->arg ? "]" : "", msg);
+            if (t->kind == ES_POINT_COEF) {
+                const char *slash = strchr(t->arg, '/');
+                ES_FAIL(ctx, rc, "point: coef:%.*s:%s: %s", (int)(slash - t->arg), t->arg,
+                        slash + 1, msg);
+            }
             ES_FAIL(ctx, rc, "point: %s%s: %s", leaf_prefix(t->kind), t->arg, msg);
         }
         double c = t->coef;
@@ -561,7 +610,7 @@ es_status es_point_eval_rows(es_ctx *ctx, const es_point_expr *x, int64_t E, int
             }
             c *= s;
             in.ndirections++;
-        } else if (t->kind == ES_POINT_DIFF) {
+        } else if (t->kind == ES_POINT_DIFF || t->kind == ES_POINT_COEF) {
             in.ndirections++;
         } else {
             if (!(s > 0) || !isfinite(s)) {

@@ -1,5 +1,7 @@
 /* lib/stats/stats_pkg.h — helpers shared by stats.c, pca.c and
- * pca_randomized.c: block sizes and checked reads from an es_source. */
+ * pca_randomized.c: block sizes and checked reads from an es_source; by the
+ * linear models (formula.c, design.c, model*.c): the formula's terms, the
+ * permutations and the fitted model's bases. */
 #ifndef EDGESPACE_STATS_PKG_H
 #define EDGESPACE_STATS_PKG_H
 
@@ -8,6 +10,7 @@
 #endif
 
 #include "edgespace/es_stats.h"
+#include "edgespace/es_model.h"
 #include "core/core_private.h"
 
 /* Check the source's shape and reader. `what` names the caller. */
@@ -31,5 +34,57 @@ es_status es__pca_alloc(es_ctx *ctx, int64_t nedges, int64_t nrows, int64_t ncom
 /* Flip components so the largest-magnitude entry is positive (scores too),
  * fill explained ratios. */
 void es__pca_finish(es_pca *pca);
+
+/* ---- linear models ---- */
+
+/* The label of formula variable v ("factor(x)") and the variable mask of
+ * term j (bit v: variable v). */
+const char *es__formula_var_label(const es_formula *f, int64_t v);
+uint64_t es__formula_term_mask(const es_formula *f, int64_t j);
+
+/* Permutations within blocks (model_perm.c): es__perm_next writes the next
+ * permutation (row i takes row perm[i]'s residual), the sequence that
+ * es_model_permutations documents. */
+typedef struct es__perm {
+    es_rng rng;
+    int64_t n, nblocks;
+    int64_t *rows;       /* n: rows grouped by block, in row order within a block */
+    int64_t *start;      /* nblocks + 1: where each block starts in rows */
+    int64_t *buf;        /* n */
+} es__perm;
+es_status es__perm_init(es_ctx *ctx, es__perm *g, int64_t n, const int64_t *blocks,
+                        uint64_t seed);
+void es__perm_next(es__perm *g, int64_t *perm);
+void es__perm_clear(es_ctx *ctx, es__perm *g);
+
+/* A growing orthonormal basis (N x m, ld N, room for cap columns): x is
+ * orthogonalized against it twice (classical Gram-Schmidt, "twice is
+ * enough": Giraud et al. 2005) and appended when what is left is above
+ * 1e-7 of its norm (the tolerance of R's qr and RRPP). r (m + 1, may be
+ * NULL) gets x's coordinates: x = Q r. Returns 1 if appended. */
+int es__basis_add(int64_t n, double *q, int64_t *m, const double *x, double *r);
+
+/* What es_model_fit keeps for the analyses after it. */
+struct es_model_priv {
+    es_pca *pca;         /* the principal coordinates: scores Z (N x r), components U */
+    int64_t r;
+    double *qf, *rf;     /* the full design: X[:, kept] = Qf Rf (N x rank, rank x rank) */
+    int64_t *kept;       /* rank design columns */
+    int64_t *blocks;     /* N or NULL */
+    double zz;           /* ||Z||^2 = the total sum of squares */
+};
+
+/* The orthonormal basis (N x *m, allocated) of the design columns whose
+ * term is selected by `use` (nterms flags; the intercept always), in design
+ * order. */
+es_status es__model_basis(es_ctx *ctx, const es_design *d, const int *use, double **q,
+                          int64_t *m);
+/* Term j's bases by the model's type: *q (N x (mr + df), allocated) holds
+ * the reduced model's basis, then D, the df columns the term adds. */
+es_status es__model_term_basis(es_ctx *ctx, const es_model *m, int64_t j, double **q,
+                               int64_t *mr, int64_t *df);
+/* E = Z - Q Q^T Z (N x r), the residuals of the model of basis q. */
+es_status es__model_residuals(es_ctx *ctx, const es_model *m, const double *q, int64_t mq,
+                              double *e);
 
 #endif

@@ -200,6 +200,20 @@ es_status es__h5_write_attr_i64(es_ctx *ctx, hid_t obj, const char *key, int64_t
     return rc;
 }
 
+es_status es__h5_write_attr_f64(es_ctx *ctx, hid_t obj, const char *key, double v)
+{
+    hid_t sp = -1, a = -1;
+    es_status rc = ES_OK;
+    if (H5Aexists(obj, key) > 0) H5Adelete(obj, key);
+    if ((sp = H5Screate(H5S_SCALAR)) < 0 ||
+        (a = H5Acreate2(obj, key, H5T_IEEE_F64LE, sp, H5P_DEFAULT, H5P_DEFAULT)) < 0 ||
+        H5Awrite(a, H5T_NATIVE_DOUBLE, &v) < 0)
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot write attribute '%s'", key);
+    es__h5_close(a);
+    es__h5_close(sp);
+    return rc;
+}
+
 es_status es__h5_write_attr_str(es_ctx *ctx, hid_t obj, const char *key, const char *v)
 {
     hid_t sp = -1, a = -1, t = -1;

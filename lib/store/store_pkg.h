@@ -82,8 +82,10 @@ es_status es__h5_create_rows(es_ctx *ctx, hid_t loc, const char *name, hid_t fty
 /* Append n rows from buf (memory type mtype, the dataset's row shape). */
 es_status es__h5_append_rows(es_ctx *ctx, hid_t loc, const char *name, hid_t mtype,
                              int64_t n, const void *buf);
-/* Write (replacing) a scalar int64, a string, or a 1-D string attribute. */
+/* Write (replacing) a scalar int64, a scalar float64, a string, or a 1-D
+ * string attribute. */
 es_status es__h5_write_attr_i64(es_ctx *ctx, hid_t obj, const char *key, int64_t v);
+es_status es__h5_write_attr_f64(es_ctx *ctx, hid_t obj, const char *key, double v);
 es_status es__h5_write_attr_str(es_ctx *ctx, hid_t obj, const char *key, const char *v);
 es_status es__h5_write_attr_strs(es_ctx *ctx, hid_t obj, const char *key,
                                  const char *const *v, int64_t n);

@@ -2,7 +2,7 @@
  * a group /analysis/<kind>/<name> begun with its provenance (command, tool
  * version, time, parameters, the rows it used) and filled with datasets
  * (matrices, vectors, integers, strings) and string attributes, read back
- * by path, tested for and listed.
+ * by path, tested for, listed and deleted.
  *
  * Paths are at most 8 components, each checked like an HDF5 link name, so
  * a result path from a command line can neither climb out of /analysis nor
@@ -14,6 +14,7 @@
 #include "store/store_pkg.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -299,8 +300,17 @@ es_status es_store_put_strings(es_ctx *ctx, es_store *s, const char *path,
     return rc;
 }
 
+/* What an attribute holds: text, or a number stored as one (float64 or
+ * int64) so that readers (h5py, R) get numbers. */
+typedef struct attr_value {
+    int type;           /* 0 string, 1 float64, 2 int64 */
+    const char *s;
+    double d;
+    int64_t i;
+} attr_value;
+
 static es_status put_attr_impl(es_ctx *ctx, es_store *s, const char *path, const char *key,
-                               const char *value)
+                               const attr_value *v)
 {
     char parts[8][128], full[700];
     es_status rc;
@@ -308,7 +318,7 @@ static es_status put_attr_impl(es_ctx *ctx, es_store *s, const char *path, const
     bool e;
     int np = split_path(ctx, path, parts, &rc);
     if (np < 0) return rc;
-    if (np < 2 || !key || !*key || !value)
+    if (np < 2 || !key || !*key || (v->type == 0 && !v->s))
         ES_FAIL(ctx, ES_EINVAL, "store: bad attribute '%s' on '%s'", key ? key : "", path);
     if ((rc = es__store_begin_write(s))) return rc;
     full_path(full, sizeof full, path);
@@ -322,7 +332,10 @@ static es_status put_attr_impl(es_ctx *ctx, es_store *s, const char *path, const
             rc = es__h5_check_attrs(raw, obj, full);
         es__h5_raw_close(raw);
     }
-    if (rc == ES_OK) rc = es__h5_write_attr_str(ctx, obj, key, value);
+    if (rc == ES_OK)
+        rc = v->type == 1 ? es__h5_write_attr_f64(ctx, obj, key, v->d)
+             : v->type == 2 ? es__h5_write_attr_i64(ctx, obj, key, v->i)
+                            : es__h5_write_attr_str(ctx, obj, key, v->s);
     H5Oclose(obj);
     if (rc) s->broken = true;
     return rc;
@@ -332,8 +345,29 @@ es_status es_store_put_attr(es_ctx *ctx, es_store *s, const char *path, const ch
                             const char *value)
 {
     es_status rc;
+    attr_value v = {0, value, 0, 0};
     if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
-    H5E_BEGIN_TRY { rc = put_attr_impl(ctx, s, path, key, value); } H5E_END_TRY
+    H5E_BEGIN_TRY { rc = put_attr_impl(ctx, s, path, key, &v); } H5E_END_TRY
+    return rc;
+}
+
+es_status es_store_put_attr_double(es_ctx *ctx, es_store *s, const char *path, const char *key,
+                                   double value)
+{
+    es_status rc;
+    attr_value v = {1, NULL, value, 0};
+    if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    H5E_BEGIN_TRY { rc = put_attr_impl(ctx, s, path, key, &v); } H5E_END_TRY
+    return rc;
+}
+
+es_status es_store_put_attr_int(es_ctx *ctx, es_store *s, const char *path, const char *key,
+                                int64_t value)
+{
+    es_status rc;
+    attr_value v = {2, NULL, 0, value};
+    if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    H5E_BEGIN_TRY { rc = put_attr_impl(ctx, s, path, key, &v); } H5E_END_TRY
     return rc;
 }
 
@@ -449,6 +483,64 @@ es_status es_store_get_ints(es_ctx *ctx, es_store *s, const char *path, int64_t 
     return rc;
 }
 
+static es_status get_strings_impl(es_ctx *ctx, es_store *s, const char *path, char ***out,
+                                  int64_t *n)
+{
+    char full[700];
+    hsize_t dims[2] = {0, 1};
+    hid_t ds = -1, t = -1;
+    es__h5_raw *raw = NULL;
+    char **v = NULL;
+    int64_t count;
+    uint64_t disk, need;
+    es_status rc = get_open(ctx, s, path, 1, dims, &ds);
+    if (rc) return rc;
+    full_path(full, sizeof full, path);
+    count = (int64_t)dims[0];
+    if ((t = H5Dget_type(ds)) < 0 || H5Tget_class(t) != H5T_STRING) {
+        rc = es__fail(ctx, ES_EFORMAT, "store: '%s': %s is not strings", s->path, full);
+        goto done;
+    }
+    if ((rc = es__h5_raw_open(ctx, ds, s->path, &raw))) goto done;
+    /* the strings' descriptors (or fixed-length strings) must be in the
+     * file before an array of their count is allocated */
+    disk = H5Tis_variable_str(t) > 0 ? es__h5_raw_vlen_size(raw) : H5Tget_size(t);
+    if ((rc = es__h5_check_chunks(ctx, ds, s->path, path, disk))) goto done;
+    if (count < 0 || __builtin_mul_overflow((uint64_t)count, disk, &need) ||
+        es__h5_covered_bytes(ds, 1, disk) < need) {
+        rc = es__fail(ctx, ES_EFORMAT, "store: '%s' is corrupt: %s claims more strings than the "
+                      "file holds", s->path, full);
+        goto done;
+    }
+    if (!(v = es__calloc(ctx, (size_t)(count > 0 ? count : 1), sizeof *v))) {
+        rc = ES_ENOMEM;
+        goto done;
+    }
+    if ((rc = es__h5_read_strings(ctx, raw, s->file, full, count, v)) != ES_OK) {
+        for (int64_t i = 0; i < count; i++) es__free(ctx, v[i]);
+        es__free(ctx, v);
+        goto done;
+    }
+    *out = v;
+    *n = count;
+done:
+    es__h5_raw_close(raw);
+    es__h5_close(t);
+    H5Dclose(ds);
+    return rc;
+}
+
+es_status es_store_get_strings(es_ctx *ctx, es_store *s, const char *path, char ***v,
+                               int64_t *n)
+{
+    es_status rc;
+    if (!s || !v || !n) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument");
+    *v = NULL;
+    *n = 0;
+    H5E_BEGIN_TRY { rc = get_strings_impl(ctx, s, path, v, n); } H5E_END_TRY
+    return rc;
+}
+
 static es_status get_attr_impl(es_ctx *ctx, es_store *s, const char *path, const char *key,
                                char *buf, size_t n)
 {
@@ -494,6 +586,21 @@ es_status es_store_get_attr(es_ctx *ctx, es_store *s, const char *path, const ch
     if (!s || !key || !buf) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument");
     H5E_BEGIN_TRY { rc = get_attr_impl(ctx, s, path, key, buf, n); } H5E_END_TRY
     return rc;
+}
+
+es_status es_store_get_attr_double(es_ctx *ctx, es_store *s, const char *path,
+                                   const char *key, double *value)
+{
+    char buf[128], *end = NULL;
+    es_status rc = es_store_get_attr(ctx, s, path, key, buf, sizeof buf);
+    if (rc != ES_OK) return rc;
+    /* a number, or (stores written before numeric attributes) its text */
+    double v = strtod(buf, &end);
+    if (end == buf || *end)
+        ES_FAIL(ctx, ES_EFORMAT, "store: attribute '%s' of %s is '%s', not a number", key, path,
+                buf);
+    *value = v;
+    return ES_OK;
 }
 
 int es_store_has(es_store *s, const char *path)
@@ -567,6 +674,59 @@ static es_status list_impl(es_ctx *ctx, es_store *s, const char *kind, char ***n
     return ES_OK;
 }
 
+static herr_t attr_cb(hid_t loc, const char *name, const H5A_info_t *info, void *data)
+{
+    (void)info;
+    return list_cb(loc, name, NULL, data);
+}
+
+static es_status attrs_impl(es_ctx *ctx, es_store *s, const char *path, char ***keys, int64_t *n)
+{
+    char parts[8][128], full[700];
+    es_status rc;
+    name_list l = {ctx, NULL, 0, 0, ES_OK};
+    if (split_path(ctx, path, parts, &rc) < 0) return rc;
+    full_path(full, sizeof full, path);
+    bool e;
+    if ((rc = find_link(ctx, s, full, &e))) return rc;
+    if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
+    hid_t obj = H5Oopen(s->file, full, H5P_DEFAULT);
+    if (obj < 0) return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
+    {   /* the attribute messages checked before HDF5 decodes them */
+        es__h5_raw *raw = NULL;
+        if ((rc = es__h5_raw_open(ctx, obj, s->path, &raw)) == ES_OK)
+            rc = es__h5_check_attrs(raw, obj, full);
+        es__h5_raw_close(raw);
+        if (rc) {
+            H5Oclose(obj);
+            return rc;
+        }
+    }
+    if (H5Aiterate2(obj, H5_INDEX_NAME, H5_ITER_INC, NULL, attr_cb, &l) < 0) {
+        rc = l.rc ? l.rc : es__h5_fail(ctx, ES_EIO, "store: cannot list the attributes of %s",
+                                       full);
+        H5Oclose(obj);
+        for (int64_t i = 0; i < l.n; i++) es__free(ctx, l.names[i]);
+        es__free(ctx, l.names);
+        return rc;
+    }
+    H5Oclose(obj);
+    *keys = l.names;
+    *n = l.n;
+    return ES_OK;
+}
+
+es_status es_store_list_attrs(es_ctx *ctx, es_store *s, const char *path, char ***keys,
+                              int64_t *n)
+{
+    es_status rc;
+    if (!s || !keys || !n) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument");
+    *keys = NULL;
+    *n = 0;
+    H5E_BEGIN_TRY { rc = attrs_impl(ctx, s, path, keys, n); } H5E_END_TRY
+    return rc;
+}
+
 es_status es_store_list_results(es_ctx *ctx, es_store *s, const char *kind, char ***names,
                                 int64_t *n)
 {
@@ -575,5 +735,47 @@ es_status es_store_list_results(es_ctx *ctx, es_store *s, const char *kind, char
     *names = NULL;
     *n = 0;
     H5E_BEGIN_TRY { rc = list_impl(ctx, s, kind, names, n); } H5E_END_TRY
+    return rc;
+}
+
+static es_status delete_impl(es_ctx *ctx, es_store *s, const char *kind, const char *name)
+{
+    char full[600], group[300];
+    es_status rc;
+    if (es__h5_bad_name(kind) || es__h5_bad_name(name) || strlen(kind) > 120 ||
+        strlen(name) > 120)
+        ES_FAIL(ctx, ES_EINVAL, "store: bad result kind/name '%s/%s'", kind ? kind : "",
+                name ? name : "");
+    snprintf(group, sizeof group, "/analysis/%s", kind);
+    snprintf(full, sizeof full, "%s/%s", group, name);
+    bool e;
+    if ((rc = find_link(ctx, s, full, &e))) return rc;
+    if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result %s/%s in '%s'", kind, name, s->path);
+    if ((rc = es__store_begin_write(s))) return rc;
+    if (H5Ldelete(s->file, full, H5P_DEFAULT) < 0) {
+        s->broken = true;
+        return es__h5_fail(ctx, ES_EIO, "store: cannot delete %s", full);
+    }
+    /* the last result of its kind takes the kind's group with it */
+    H5G_info_t info;
+    hid_t g = H5Gopen2(s->file, group, H5P_DEFAULT);
+    if (g < 0 || H5Gget_info(g, &info) < 0) {
+        es__h5_close(g);
+        s->broken = true;
+        return es__h5_fail(ctx, ES_EIO, "store: cannot read %s", group);
+    }
+    H5Gclose(g);
+    if (info.nlinks == 0 && H5Ldelete(s->file, group, H5P_DEFAULT) < 0) {
+        s->broken = true;
+        return es__h5_fail(ctx, ES_EIO, "store: cannot delete %s", group);
+    }
+    return ES_OK;
+}
+
+es_status es_store_delete_result(es_ctx *ctx, es_store *s, const char *kind, const char *name)
+{
+    es_status rc;
+    if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    H5E_BEGIN_TRY { rc = delete_impl(ctx, s, kind, name); } H5E_END_TRY
     return rc;
 }

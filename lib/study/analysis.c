@@ -225,11 +225,9 @@ static es_status save_pca(es_ctx *ctx, es_store *store, const char *name, const 
         (rc = es_store_put_ints(ctx, store, path, rows, N)) != ES_OK)
         goto done;
     snprintf(path, sizeof path, "pca/%s", name);
-    char ks[32];
-    snprintf(ks, sizeof ks, "%lld", (long long)K);
     if ((rc = es_store_put_attr(ctx, store, path, "method", method_name(p->method))) != ES_OK ||
         (rc = es_store_put_attr(ctx, store, path, "filter", filter ? filter : "")) != ES_OK ||
-        (rc = es_store_put_attr(ctx, store, path, "ncomp", ks)) != ES_OK)
+        (rc = es_store_put_attr_int(ctx, store, path, "ncomp", K)) != ES_OK)
         goto done;
 done:
     es__free(ctx, st);
@@ -622,6 +620,17 @@ es_status es_study_resolve(es_ctx *ctx, void *ud, es_point_leaf kind, const char
         return resolve_pc(ctx, r, index, vec, scale, w);
     case ES_POINT_DIFF:
         return resolve_diff(ctx, r, arg, vec, w);
+    case ES_POINT_COEF: {
+        /* "MODEL/COEF": a model name holds no '/' */
+        const char *slash = strchr(arg, '/');
+        char model[256];
+        if (!slash || (size_t)(slash - arg) >= sizeof model)
+            ES_FAIL(ctx, ES_EINVAL, "bad coefficient '%s'", arg);
+        memcpy(model, arg, (size_t)(slash - arg));
+        model[slash - arg] = '\0';
+        *scale = NAN;
+        return es_study_model_coef(ctx, st, model, slash + 1, vec, w);
+    }
     }
     ES_FAIL(ctx, ES_EINVAL, "unknown leaf kind %d", (int)kind);
 }
@@ -656,7 +665,7 @@ es_status es_study_point(es_ctx *ctx, es_store *store, const char *name, const c
         goto done;
     if (scale > 0) in.scale = scale;
     if (name) {
-        char p[PATH_MAX_LEN], buf[64];
+        char p[PATH_MAX_LEN];
         es_provenance prov = {command ? command : "es_study_point", NULL, -1, expr};
         if ((rc = es_store_result_begin(ctx, store, "point", name, &prov)) != ES_OK ||
             (rc = dpath(ctx, p, "point", name, "lengths")) != ES_OK ||
@@ -667,20 +676,21 @@ es_status es_study_point(es_ctx *ctx, es_store *store, const char *name, const c
             (rc = es_store_put_vector(ctx, store, p, w, N)) != ES_OK)
             goto done;
         snprintf(p, sizeof p, "point/%s", name);
-        struct { const char *k; char v[64]; } at[6];
-        snprintf(at[0].v, 64, "%.17g", in.weight);
-        if (in.checked) snprintf(at[1].v, 64, "%d", in.validity.valid);
-        else snprintf(at[1].v, 64, "unchecked (no faces)");
-        snprintf(at[2].v, 64, "%lld", (long long)in.validity.n_bad_faces);
-        snprintf(at[3].v, 64, "%lld", (long long)in.validity.n_nonpositive);
-        snprintf(at[4].v, 64, "%.17g", in.validity.worst_violation);
-        snprintf(at[5].v, 64, "%lld", (long long)in.validity.worst_face);
-        at[0].k = "weight", at[1].k = "valid", at[2].k = "n_bad_faces";
-        at[3].k = "n_nonpositive", at[4].k = "worst_violation", at[5].k = "worst_face";
-        (void)buf;
-        if ((rc = es_store_put_attr(ctx, store, p, "expression", expr)) != ES_OK) goto done;
-        for (int i = 0; i < 6; i++)
-            if ((rc = es_store_put_attr(ctx, store, p, at[i].k, at[i].v)) != ES_OK) goto done;
+        /* valid is 1 or 0, or the text "unchecked (no faces)" on a truss */
+        if ((rc = es_store_put_attr(ctx, store, p, "expression", expr)) != ES_OK ||
+            (rc = es_store_put_attr_double(ctx, store, p, "weight", in.weight)) != ES_OK ||
+            (rc = in.checked ? es_store_put_attr_int(ctx, store, p, "valid", in.validity.valid)
+                             : es_store_put_attr(ctx, store, p, "valid",
+                                                 "unchecked (no faces)")) != ES_OK ||
+            (rc = es_store_put_attr_int(ctx, store, p, "n_bad_faces",
+                                        in.validity.n_bad_faces)) != ES_OK ||
+            (rc = es_store_put_attr_int(ctx, store, p, "n_nonpositive",
+                                        in.validity.n_nonpositive)) != ES_OK ||
+            (rc = es_store_put_attr_double(ctx, store, p, "worst_violation",
+                                           in.validity.worst_violation)) != ES_OK ||
+            (rc = es_store_put_attr_int(ctx, store, p, "worst_face",
+                                        in.validity.worst_face)) != ES_OK)
+            goto done;
     }
     if (info) *info = in;
     if (weights) memcpy(weights, w, (size_t)N * sizeof *weights);

@@ -118,7 +118,7 @@ es_status es_study_compare(es_ctx *ctx, es_store *store, const char *gpa_name,
         goto done;
     if (!name) name = gpa_name;
     if (*name) {
-        char params[512], grp[512], v[64];
+        char params[512], grp[512];
         es_compare_opts o;
         if (opts) o = *opts; else es_compare_opts_init(&o);
         snprintf(params, sizeof params, "gpa=%s; by=%s; permutations=%lld", gpa_name,
@@ -137,12 +137,9 @@ es_status es_study_compare(es_ctx *ctx, es_store *store, const char *gpa_name,
             PUT(es_store_put_matrix(ctx, store, P("p_procrustes"), (es_mat){r->p_proc, ng, ng, ng}));
             PUT(es_store_put_strings(ctx, store, P("group_names"), (const char *const *)gnames, ng));
         }
-        snprintf(v, sizeof v, "%.17g", r->mantel_rho);
-        PUT(es_store_put_attr(ctx, store, grp, "spearman_rho", v));
-        snprintf(v, sizeof v, "%.17g", r->mantel_p);
-        PUT(es_store_put_attr(ctx, store, grp, "mantel_p", v));
-        snprintf(v, sizeof v, "%.17g", r->nn_agreement);
-        PUT(es_store_put_attr(ctx, store, grp, "nn_agreement", v));
+        PUT(es_store_put_attr_double(ctx, store, grp, "spearman_rho", r->mantel_rho));
+        PUT(es_store_put_attr_double(ctx, store, grp, "mantel_p", r->mantel_p));
+        PUT(es_store_put_attr_double(ctx, store, grp, "nn_agreement", r->nn_agreement));
         PUT(es_store_put_attr(ctx, store, grp, "gpa", gpa_name));
         PUT(es_store_put_attr(ctx, store, grp, "by", by ? by : ""));
 #undef PUT

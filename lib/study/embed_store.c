@@ -77,7 +77,7 @@ es_status es_study_store_embedding(es_ctx *ctx, es_store *store, const char *nam
 {
     const es_mesh *mesh = es_embedder_mesh(emb);
     int64_t nv = es_mesh_nverts(mesh), ne = es_mesh_nedges(mesh);
-    char path[512], val[64];
+    char path[512];
     double *tn = NULL, sum = 0;
     es_status rc;
     struct { const char *key; double v; } attrs[] = {
@@ -115,10 +115,9 @@ es_status es_study_store_embedding(es_ctx *ctx, es_store *store, const char *nam
     es__free(ctx, tn);
     if (rc != ES_OK) return rc;
     snprintf(path, sizeof path, "embed/%s", name);
-    for (size_t i = 0; i < sizeof attrs / sizeof attrs[0]; i++) {
-        snprintf(val, sizeof val, "%.17g", attrs[i].v);
-        if ((rc = es_store_put_attr(ctx, store, path, attrs[i].key, val)) != ES_OK) return rc;
-    }
+    for (size_t i = 0; i < sizeof attrs / sizeof attrs[0]; i++)
+        if ((rc = es_store_put_attr_double(ctx, store, path, attrs[i].key, attrs[i].v)) != ES_OK)
+            return rc;
     if (init && (rc = es_store_put_attr(ctx, store, path, "init", init)) != ES_OK) return rc;
 #undef P
     return ES_OK;

@@ -25,22 +25,6 @@ static void free_bufs(es_ctx *ctx, gpa_bufs *b)
     for (size_t i = 0; i < sizeof own / sizeof own[0]; i++) es__free(ctx, own[i]);
 }
 
-static es_status put_attr_g(es_ctx *ctx, es_store *s, const char *path, const char *key,
-                            double v)
-{
-    char buf[64];
-    snprintf(buf, sizeof buf, "%.17g", v);
-    return es_store_put_attr(ctx, s, path, key, buf);
-}
-
-static es_status put_attr_i(es_ctx *ctx, es_store *s, const char *path, const char *key,
-                            int64_t v)
-{
-    char buf[32];
-    snprintf(buf, sizeof buf, "%lld", (long long)v);
-    return es_store_put_attr(ctx, s, path, key, buf);
-}
-
 es_status es_study_gpa(es_ctx *ctx, es_store *store, const char *name, const int64_t *rows,
                            int64_t nrows, const es_gpa_opts *opts, int64_t npc,
                            const char *command, es_gpa_report *report)
@@ -139,15 +123,15 @@ es_status es_study_gpa(es_ctx *ctx, es_store *store, const char *name, const int
     PUT(es_store_put_vector(ctx, store, P("pc_percent"), b.pct, npc));
     PUT(es_store_put_matrix(ctx, store, P("pc_scores"), (es_mat){sct, npc, n, npc}));
     PUT(es_store_put_matrix(ctx, store, P("pc_loadings"), (es_mat){b.load, kd, npc, kd}));
-    PUT(put_attr_i(ctx, store, grp, "dim", d));
-    PUT(put_attr_i(ctx, store, grp, "k", k));
-    PUT(put_attr_i(ctx, store, grp, "iterations", rep.iterations));
-    PUT(put_attr_i(ctx, store, grp, "converged", rep.converged));
-    PUT(put_attr_g(ctx, store, grp, "rot_change", rep.rot_change));
-    PUT(put_attr_g(ctx, store, grp, "scale_change", rep.scale_change));
-    PUT(put_attr_g(ctx, store, grp, "gss", rep.gss));
-    PUT(put_attr_g(ctx, store, grp, "rmsrho", rep.rmsrho));
-    PUT(put_attr_g(ctx, store, grp, "total_ss", rep.total_ss));
+    PUT(es_store_put_attr_int(ctx, store, grp, "dim", d));
+    PUT(es_store_put_attr_int(ctx, store, grp, "k", k));
+    PUT(es_store_put_attr_int(ctx, store, grp, "iterations", rep.iterations));
+    PUT(es_store_put_attr_int(ctx, store, grp, "converged", rep.converged));
+    PUT(es_store_put_attr_double(ctx, store, grp, "rot_change", rep.rot_change));
+    PUT(es_store_put_attr_double(ctx, store, grp, "scale_change", rep.scale_change));
+    PUT(es_store_put_attr_double(ctx, store, grp, "gss", rep.gss));
+    PUT(es_store_put_attr_double(ctx, store, grp, "rmsrho", rep.rmsrho));
+    PUT(es_store_put_attr_double(ctx, store, grp, "total_ss", rep.total_ss));
     PUT(es_store_put_attr(ctx, store, grp, "layout", "aligned rows: x-block, y-block[, z-block]"));
 #undef PUT
 #undef P

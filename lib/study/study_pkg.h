@@ -24,4 +24,51 @@ es_status es__table_end(es_ctx *ctx, es__table_out *t, es_status rc);
 /* ",<value>" with 17 significant digits (round trip). */
 void es__table_number(FILE *f, double v);
 
+/* "id,<every label column>,<names...>": one line per store row rows[i]
+ * (n of them) with values[i + k n] in column k. */
+es_status es__write_row_table(es_ctx *ctx, es_store *st, const char *path, int64_t n,
+                              const int64_t *rows, int64_t ncol, const char *const *names,
+                              const double *values);
+/* n names "<prefix>1" .. "<prefix>n" (es__free_names). */
+es_status es__numbered_names(es_ctx *ctx, const char *prefix, int64_t n, char ***names);
+void es__free_names(es_ctx *ctx, char **names, int64_t n);
+
+/* Reading a result's parts: "<kind>/<name>/<ds>" into buf; the dataset
+ * read by type; a stored matrix (dataset [a][b], es_mat b x a) transposed
+ * to a x b column-major (row i = dataset row i). */
+es_status es__result_path(es_ctx *ctx, char *buf, size_t n, const char *kind, const char *name,
+                          const char *ds);
+es_status es__result_vector(es_ctx *ctx, es_store *s, const char *kind, const char *name,
+                            const char *ds, double **v, int64_t *n);
+es_status es__result_matrix(es_ctx *ctx, es_store *s, const char *kind, const char *name,
+                            const char *ds, es_mat *m);
+es_status es__result_ints(es_ctx *ctx, es_store *s, const char *kind, const char *name,
+                          const char *ds, int64_t **v, int64_t *n);
+es_status es__result_strings(es_ctx *ctx, es_store *s, const char *kind, const char *name,
+                             const char *ds, char ***v, int64_t *n);
+double *es__transpose_mat(es_ctx *ctx, es_mat m);
+
+/* The tables of GPA and model results (export_tables.c): (ctx, store, kind,
+ * name, path). */
+#define ES__TABLE(fn) es_status fn(es_ctx *ctx, es_store *s, const char *kind, \
+                                   const char *name, const char *path)
+ES__TABLE(es__t_gpa_specimens);
+ES__TABLE(es__t_gpa_aligned);
+ES__TABLE(es__t_gpa_mean);
+ES__TABLE(es__t_gpa_pca);
+ES__TABLE(es__t_gpa_loadings);
+ES__TABLE(es__t_model_anova);
+ES__TABLE(es__t_model_coefficients);
+ES__TABLE(es__t_model_weights);
+ES__TABLE(es__t_model_pairwise);
+ES__TABLE(es__t_model_lsmeans);
+ES__TABLE(es__t_model_edges);
+ES__TABLE(es__t_model_scores);
+ES__TABLE(es__t_model_permutations);
+#undef ES__TABLE
+
+/* Store a model as model/<o->name> (model_results.c). */
+es_status es__model_save(es_ctx *ctx, es_store *s, const es_study_model_opts *o,
+                         const es_study_model_result *r);
+
 #endif

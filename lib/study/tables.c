@@ -99,10 +99,14 @@ es_status es_study_write_diff_table(es_ctx *ctx, es_store *store, const es_diff 
     return rc;
 }
 
-static es_status write_scores(es_ctx *ctx, es_store *st, const es_pca *p, const int64_t *rows,
-                              const char *path)
+es_status es__write_row_table(es_ctx *ctx, es_store *st, const char *path, int64_t n,
+                              const int64_t *rows, int64_t ncol, const char *const *names,
+                              const double *values)
 {
-    const int64_t N = p->nrows, K = p->ncomp, ncols = es_store_ncolumns(st);
+    const int64_t ncols = es_store_ncolumns(st), N = es_store_nrows(st);
+    for (int64_t i = 0; i < n; i++)
+        if (rows[i] < 0 || rows[i] >= N)
+            ES_FAIL(ctx, ES_EFORMAT, "table: row %lld is not in the store", (long long)rows[i]);
     es__table_out t;
     es_status rc = es__table_begin(ctx, path, &t);
     if (rc != ES_OK) return rc;
@@ -111,18 +115,55 @@ static es_status write_scores(es_ctx *ctx, es_store *st, const es_pca *p, const 
         fputc(',', t.f);
         es_csv_write_field(t.f, es_store_column_name(st, c));
     }
-    for (int64_t k = 0; k < K; k++) fprintf(t.f, ",PC%lld", (long long)(k + 1));
+    for (int64_t k = 0; k < ncol; k++) {
+        fputc(',', t.f);
+        es_csv_write_field(t.f, names[k]);
+    }
     fputc('\n', t.f);
-    for (int64_t i = 0; i < N; i++) {
+    for (int64_t i = 0; i < n; i++) {
         es_csv_write_field(t.f, es_store_row_id(st, rows[i]));
         for (int64_t c = 0; c < ncols; c++) {
             fputc(',', t.f);
             es_csv_write_field(t.f, es_store_label(st, rows[i], c));
         }
-        for (int64_t k = 0; k < K; k++) es__table_number(t.f, p->scores[i + k * N]);
+        for (int64_t k = 0; k < ncol; k++) es__table_number(t.f, values[i + k * n]);
         fputc('\n', t.f);
     }
     return es__table_end(ctx, &t, ES_OK);
+}
+
+es_status es__numbered_names(es_ctx *ctx, const char *prefix, int64_t n, char ***names)
+{
+    size_t len = strlen(prefix) + 24;
+    *names = es__calloc(ctx, (size_t)(n > 0 ? n : 1), sizeof **names);
+    if (!*names) return ES_ENOMEM;
+    for (int64_t k = 0; k < n; k++) {
+        if (!((*names)[k] = es__malloc(ctx, len))) {
+            es__free_names(ctx, *names, n);
+            *names = NULL;
+            return ES_ENOMEM;
+        }
+        snprintf((*names)[k], len, "%s%lld", prefix, (long long)(k + 1));
+    }
+    return ES_OK;
+}
+
+void es__free_names(es_ctx *ctx, char **names, int64_t n)
+{
+    for (int64_t k = 0; names && k < n; k++) es__free(ctx, names[k]);
+    es__free(ctx, names);
+}
+
+static es_status write_scores(es_ctx *ctx, es_store *st, const es_pca *p, const int64_t *rows,
+                              const char *path)
+{
+    char **names = NULL;
+    es_status rc = es__numbered_names(ctx, "PC", p->ncomp, &names);
+    if (rc != ES_OK) return rc;
+    rc = es__write_row_table(ctx, st, path, p->nrows, rows, p->ncomp,
+                             (const char *const *)names, p->scores);
+    es__free_names(ctx, names, p->ncomp);
+    return rc;
 }
 
 static es_status write_eigenvalues(es_ctx *ctx, const es_pca *p, const char *path)

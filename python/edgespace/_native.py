@@ -85,7 +85,11 @@ def declarations(incdir):
         # the extern "C" wrapper, which sits between preprocessor lines
         t = re.sub(r'#ifdef\s+__cplusplus\s*\n\s*(extern\s+"C"\s*\{|\})\s*\n\s*#endif', "", t)
         t = re.sub(r"\\\n", " ", t)
-        t = "\n".join(line for line in t.split("\n") if not line.lstrip().startswith("#"))
+        # preprocessor lines go, except integer constants (array sizes such
+        # as ES_VARIATION_MAX_AXES), which cffi's cdef reads
+        t = "\n".join(line for line in t.split("\n")
+                      if not line.lstrip().startswith("#")
+                      or re.fullmatch(r"\s*#\s*define\s+\w+\s+\d+\s*", line))
         t = re.sub(r"\bES_API\b", "", t)
         t = re.sub(r"__attribute__\s*\(\(.*?\)\)", "", t)
         out.append(t)

@@ -29,7 +29,8 @@ LEVEL["synth"] = LEVEL["figure"]          # beside figure, above study
 PUBLIC = {
     "es_core.h": "core", "es_mesh.h": "mesh", "es_geom.h": "mesh", "es_io.h": "meshio",
     "es_store.h": "store", "es_ingest.h": "ingest", "es_landmarks.h": "ingest",
-    "es_stats.h": "stats", "es_point.h": "stats", "es_procrustes.h": "procrustes",
+    "es_stats.h": "stats", "es_point.h": "stats", "es_model.h": "stats",
+    "es_procrustes.h": "procrustes",
     "es_compare.h": "procrustes", "es_embed.h": "embed", "es_interp.h": "embed",
     "es_study.h": "study", "es_plot.h": "figure", "es_render.h": "figure",
     "es_figure.h": "figure", "es_synth.h": "synth",

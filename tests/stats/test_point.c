@@ -48,6 +48,14 @@ static es_status resolve(es_ctx *ctx, void *ud, es_point_leaf kind, const char *
         v[1] = -0.01;
         w[0] = -1, w[1] = 1;
         return ES_OK;
+    case ES_POINT_COEF:
+        /* coef:m:age and coef:m:"expression=happy:age" */
+        if (strcmp(arg, "m/age") && strcmp(arg, "m/expression=happy:age"))
+            ES_FAIL(ctx, ES_ENOTFOUND, "no coefficient '%s'", arg);
+        v[2] = 0.02;
+        v[3] = -0.02;
+        w[1] = 0.5, w[2] = -0.5;
+        return ES_OK;
     }
     return ES_EINVAL;
 }
@@ -75,6 +83,10 @@ static void test_eval(es_ctx *ctx)
     const double a[E] = {0.1, 0.2, 0.3, 0.4}, b[E] = {0.4, 0.3, 0.2, 0.1};
     double w[E];
     eval_ok(ctx, "mean", (double[E]){0.25, 0.25, 0.25, 0.25}, 15, 1);
+    /* a coefficient is a direction: it keeps the mean's scale and weight */
+    eval_ok(ctx, "mean + 2*coef:m:age", (double[E]){0.25, 0.25, 0.29, 0.21}, 15, 1);
+    eval_ok(ctx, "mean - coef:m:expression=happy:age", (double[E]){0.25, 0.25, 0.23, 0.27}, 15,
+            1);
     eval_ok(ctx, "mean + 2*pc:1", (double[E]){1.25, 0.25, 0.25, 0.25}, 15, 1);
     eval_ok(ctx, "mean - 3 * pc:2 / 2", (double[E]){0.25, -1.25, 0.25, 0.25}, 15, 1);
     eval_ok(ctx, "mean[ g = x , h=y-1 ] + diff:smile",
@@ -209,6 +221,11 @@ static void test_errors(es_ctx *ctx)
         {"mean + pc:2b", "column 11: expected a component number >= 1"},
         {"diff:", "column 6: expected a difference name"},
         {"2pc:1 + mean", "column 2: expected an operator after the number"},
+        {"mean + 2 pc:1", "column 10: a '*' is missing between the number and what follows"},
+        {"mean + 2 (pc:1)", "column 10: a '*' is missing"},
+        {"coef:m", "column 7: expected ':' and a coefficient after 'coef:m'"},
+        {"coef:m:", "column 8: expected a coefficient name"},
+        {"coef m:a", "column 5: expected ':' after 'coef'"},
         {"1e+ * mean", "column 1: malformed number"},
         {". * mean", "column 1: malformed number"},
         {"lerp row:a", "column 6: expected '(', found 'r'"},

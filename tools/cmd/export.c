@@ -1,6 +1,7 @@
 /* tools/cmd/export.c — edgespace export: a store's rows as a CSV of edge
  * lengths or as mesh files (es_export_lengths_csv, es_export_meshes), or a
- * stored PCA as a statismo shape model (es_study_export_statismo). */
+ * stored PCA as a statismo shape model (es_study_export_statismo), or a
+ * stored result as a labelled table (es_study_export_result). */
 #include "cli.h"
 #include "commands.h"
 
@@ -13,6 +14,7 @@ static const char usage[] =
     "usage: edgespace export STORE (--lengths CSV | --meshes DIR) [options]\n"
     "       edgespace export STORE --statismo MODEL.h5 [--pca NAME | --gpa NAME]\n"
     "                        [--components K] [--sd C] [--noise-variance V]\n"
+    "       edgespace export STORE --result KIND/NAME [--table TABLE] --csv PATH\n"
     "\n"
     "Write rows of a store: their edge lengths as CSV (id, scale, then one column\n"
     "per edge named by its 0-based vertex pair 'a-b'), or their positions as they\n"
@@ -23,6 +25,7 @@ static const char usage[] =
     "  -M, --meshes DIR      write meshes into DIR (created if absent)\n"
     "  -f, --format FMT      mesh format: obj (default), ply, ply-ascii, off\n"
     "  -s, --select FILTER   only rows matching col=value[,col=value...]\n"
+    "                        (--where FILTER, as in the other commands)\n"
     "                        (quote a value holding ',': col=\"a,b\")\n"
     "      --statismo FILE   write a statismo shape model (datasets-spec/statismo.md)\n"
     "                        that statismo and scalismo load: of an edge-length PCA\n"
@@ -33,6 +36,10 @@ static const char usage[] =
     "      --sd C            the step along each PC, in sd (default 1)\n"
     "      --noise-variance V  the model's noise variance (default: 0 for a PCA,\n"
     "                        the PPCA estimate for a GPA)\n"
+    "  -r, --result KIND/NAME  a stored result (gpa/all, model/m, ...) as a table\n"
+    "  -t, --table TABLE     which of its tables (default: the kind's first;\n"
+    "                        'attributes' for any result; a wrong name lists them)\n"
+    "  -o, --csv PATH        where the result's table goes (- for stdout)\n"
     "  -h, --help            show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -80,8 +87,11 @@ int cmd_export(int argc, char **argv)
         {"statismo", required_argument, NULL, 'S'}, {"pca", required_argument, NULL, 'P'},
         {"gpa", required_argument, NULL, 'G'},      {"components", required_argument, NULL, 'k'},
         {"sd", required_argument, NULL, 'c'}, {"noise-variance", required_argument, NULL, 'n'},
+        {"result", required_argument, NULL, 'r'},  {"table", required_argument, NULL, 't'},
+        {"csv", required_argument, NULL, 'o'},    {"where", required_argument, NULL, 's'},
         {NULL, 0, NULL, 0}};
     const char *lengths = NULL, *meshes = NULL, *filter = NULL, *statismo = NULL;
+    const char *result = NULL, *table = NULL, *csv = NULL;
     es_study_statismo_opts so;
     es_mesh_format fmt = ES_FORMAT_OBJ;
     es_store *s = NULL;
@@ -91,12 +101,15 @@ int cmd_export(int argc, char **argv)
     int c, raw = 0;
     es_study_statismo_opts_init(&so);
     optind = 1;
-    while ((c = getopt_long(argc, argv, "l:M:f:s:h", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "l:M:f:s:r:t:o:h", longopts, NULL)) != -1) {
         switch (c) {
         case 'l': lengths = optarg; break;
         case 'R': raw = 1; break;
         case 'M': meshes = optarg; break;
         case 's': filter = optarg; break;
+        case 'r': result = optarg; break;
+        case 't': table = optarg; break;
+        case 'o': csv = optarg; break;
         case 'f':
             if (!strcmp(optarg, "obj")) fmt = ES_FORMAT_OBJ;
             else if (!strcmp(optarg, "ply")) fmt = ES_FORMAT_PLY;
@@ -124,18 +137,25 @@ int cmd_export(int argc, char **argv)
         }
     }
     if (optind != argc - 1) return cli_usage_error("export", "give exactly one STORE");
-    if (statismo) return export_statismo(argv[optind], statismo, &so, filter || lengths || meshes,
-                                         argc, argv);
+    if (statismo) return export_statismo(argv[optind], statismo, &so,
+                                         filter || lengths || meshes || result, argc, argv);
     if (so.pca_name || so.gpa_name)
         return cli_usage_error("export", "--pca and --gpa go with --statismo");
-    if (!lengths == !meshes)
+    if (result) {
+        if (lengths || meshes || filter)
+            return cli_usage_error("export", "--result goes alone (with --table and --csv)");
+        if (!csv) return cli_usage_error("export", "--result needs --csv PATH (- for stdout)");
+    } else if (table || csv) {
+        return cli_usage_error("export", "--table and --csv go with --result KIND/NAME");
+    } else if (!lengths == !meshes)
         return cli_usage_error("export", "give one of --lengths CSV or --meshes DIR");
     if (raw && !lengths) return cli_usage_error("export", "--raw goes with --lengths");
     if (!(ctx = cli_ctx_new("export"))) return CLI_FAIL;
     if ((rc = es_store_open(ctx, argv[optind], ES_STORE_READ, &s)) ||
-        (rc = es_store_select(ctx, s, filter, &rows, &nrows)))
+        (!result && (rc = es_store_select(ctx, s, filter, &rows, &nrows))))
         goto fail;
-    if (lengths) rc = es_export_lengths_csv(ctx, s, rows, nrows, raw, lengths);
+    if (result) rc = es_study_export_result(ctx, s, result, table, csv);
+    else if (lengths) rc = es_export_lengths_csv(ctx, s, rows, nrows, raw, lengths);
     else rc = es_export_meshes(ctx, s, rows, nrows, meshes, fmt);
     if (rc) goto fail;
     es_free(ctx, rows);

@@ -15,6 +15,7 @@
 #include "es_landmarks.h"
 #include "es_stats.h"       /* stats */
 #include "es_point.h"
+#include "es_model.h"
 #include "es_procrustes.h"  /* procrustes */
 #include "es_compare.h"
 #include "es_embed.h"       /* embed */

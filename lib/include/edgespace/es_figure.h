@@ -15,6 +15,7 @@
 #include "es_plot.h"
 #include "es_render.h"
 #include "es_store.h"
+#include "es_study.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -139,6 +140,56 @@ ES_API es_status es_figure_render_files(es_ctx *ctx, const es_render_spec *spec,
                                         const char *const *scalar_paths,
                                         const char *const *labels, const char *out_path,
                                         es_render_report *rep);
+
+/* ---- models and shape variation ---------------------------------------------- */
+
+/* The per-edge tests of a model (es_study_model with opts.edge_term) drawn
+ * on the mean mesh of its rows (the Procrustes mean of their positions, in
+ * the store's frame): each edge coloured by -log10 of its FDR q-value
+ * (faces show the mean of their three edges), the number of edges with
+ * q < 0.05 in the title. ES_EINVAL when r has no per-edge tests. */
+ES_API es_status es_figure_edge_tests(es_ctx *ctx, es_store *store,
+                                      const es_study_model_result *r, const char *out_path);
+
+#define ES_VARIATION_MAX_AXES 8
+
+/* What es_figure_variation draws: one row per axis (a principal component,
+ * or a model coefficient), each of four panels: mean - k sd, the mean,
+ * mean + k sd, and the mean coloured by each vertex's displacement from
+ * the minus to the plus shape. */
+typedef struct es_figure_variation_opts {
+    const char *pca_name;      /* the PCA of the components (NULL: the only one or "default") */
+    int64_t npcs;              /* components to show (0: PC 1) */
+    const int64_t *pcs;        /* npcs 1-based component numbers */
+    const char *coef;          /* instead: "MODEL:COEF", a coefficient of a stored model in
+                                  edge-length space; k is then in its units (for a factor
+                                  level, k = 1 is the level's effect) */
+    double k;                  /* how far (2) */
+    es_embed_opts embed;       /* solver options (es_embed_opts_init) */
+    int panel;                 /* panel width and height, pixels (360) */
+    const char *title;         /* NULL: automatic */
+} es_figure_variation_opts;
+ES_API void es_figure_variation_opts_init(es_figure_variation_opts *opts);
+
+typedef struct es_figure_variation_report {
+    int64_t naxes;
+    es_embed_report mean;                              /* the mean's embedding */
+    es_embed_report minus[ES_VARIATION_MAX_AXES];      /* mean - k sd per axis */
+    es_embed_report plus[ES_VARIATION_MAX_AXES];       /* mean + k sd per axis */
+    double max_displacement[ES_VARIATION_MAX_AXES];    /* largest vertex displacement */
+    es_render_report render;
+} es_figure_variation_report;
+
+/* Embed the mean and mean +- k sd along each axis (es_study_embed: near the
+ * prior of each point's row weights, in the store's frame) and draw them in
+ * one frame (one camera and one scale for all panels) with the
+ * displacement heat map, to out_path (PNG/SVG/PDF by extension). The store
+ * needs faces and, for components, a stored PCA. rep may be NULL. Errors:
+ * those of es_study_embed (a point that leaves edge-length space: lower
+ * k), es_render; ES_EINVAL for more than ES_VARIATION_MAX_AXES axes. */
+ES_API es_status es_figure_variation(es_ctx *ctx, es_store *store,
+                                     const es_figure_variation_opts *opts, const char *out_path,
+                                     es_figure_variation_report *rep);
 
 #ifdef __cplusplus
 }

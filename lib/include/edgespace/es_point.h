@@ -12,6 +12,9 @@
  *   pc:K                        principal component K >= 1, in units of
  *                               its standard deviation       (a direction)
  *   diff:NAME                   a stored mean difference     (a direction)
+ *   coef:MODEL:COEF             a coefficient of a stored linear model
+ *                               (es_study_model; COEF a design column such
+ *                               as age or expression=happy)  (a direction)
  * The expression is parsed once (es_point_parse), then evaluated through a
  * resolver callback that looks the leaves up (es_point_eval), so that the
  * syntax is independent of the store.
@@ -42,7 +45,8 @@ typedef enum es_point_leaf {
     ES_POINT_ROW,       /* arg: the row id */
     ES_POINT_FILE,      /* arg: the path */
     ES_POINT_PC,        /* index: K (1-based), arg "" */
-    ES_POINT_DIFF       /* arg: the difference's name */
+    ES_POINT_DIFF,      /* arg: the difference's name */
+    ES_POINT_COEF       /* arg: "MODEL/COEF", the model's name and the coefficient's */
 } es_point_leaf;
 
 typedef struct es_point_expr es_point_expr;
@@ -63,11 +67,12 @@ ES_API void es_point_expr_term(const es_point_expr *expr, int64_t i, double *coe
  *    shape's scale (mean scale of the rows for MEAN);
  *  PC: the unit component K, and *scale = its standard deviation
  *    (sqrt of the eigenvalue), by which the evaluator multiplies it;
- *  DIFF: the difference vector; *scale is ignored.
+ *  DIFF, COEF: the difference or coefficient vector; *scale is ignored.
  * weights: NULL, or the nrows entries given to es_point_eval_rows, zero on
  *    entry: the leaf as a combination of the stored rows it comes from,
  *    vec ~ sum_i weights[i] row_i (normalized lengths), exactly for means,
- *    rows, components and differences, by ridge regression for a file. A
+ *    rows, components, differences and coefficients, by ridge regression
+ *    for a file. A
  *    shape's weights sum to 1, a direction's to 0. Evaluating them costs
  *    nothing extra for most leaves, so the embedding can apply the same
  *    weights to the rows' dihedrals and positions (its prior).

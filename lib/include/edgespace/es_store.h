@@ -225,6 +225,12 @@ ES_API es_status es_store_put_strings(es_ctx *ctx, es_store *store, const char *
                                       const char *const *s, int64_t n);
 ES_API es_status es_store_put_attr(es_ctx *ctx, es_store *store, const char *path,
                                    const char *key, const char *value);
+/* Numeric attributes, stored as numbers (scalar float64 / int64), so that
+ * h5py, R and the CSV tables read numbers. */
+ES_API es_status es_store_put_attr_double(es_ctx *ctx, es_store *store, const char *path,
+                                          const char *key, double value);
+ES_API es_status es_store_put_attr_int(es_ctx *ctx, es_store *store, const char *path,
+                                       const char *key, int64_t value);
 /* Read back: *m->data / *v allocated with the ctx allocator (es_free). */
 ES_API es_status es_store_get_matrix(es_ctx *ctx, es_store *store, const char *path,
                                      es_mat *m);
@@ -232,9 +238,17 @@ ES_API es_status es_store_get_vector(es_ctx *ctx, es_store *store, const char *p
                                      double **v, int64_t *n);
 ES_API es_status es_store_get_ints(es_ctx *ctx, es_store *store, const char *path,
                                    int64_t **v, int64_t *n);
-/* Attribute value copied into buf (truncated to n bytes with NUL). */
+/* A 1-D string dataset: *v gets n strings (es_free each and the array). */
+ES_API es_status es_store_get_strings(es_ctx *ctx, es_store *store, const char *path,
+                                      char ***v, int64_t *n);
+/* Attribute value copied into buf (truncated to n bytes with NUL); a
+ * numeric attribute as text (%.17g, or the integer). */
 ES_API es_status es_store_get_attr(es_ctx *ctx, es_store *store, const char *path,
                                    const char *key, char *buf, size_t n);
+/* A numeric attribute, or one stored as the text of a number (results
+ * written before numeric attributes existed); ES_EFORMAT otherwise. */
+ES_API es_status es_store_get_attr_double(es_ctx *ctx, es_store *store, const char *path,
+                                          const char *key, double *value);
 /* 1 if the result or dataset exists, else 0. */
 ES_API int es_store_has(es_store *store, const char *path);
 /* Names of the results of one kind, in name order; kind NULL or "": the
@@ -242,6 +256,18 @@ ES_API int es_store_has(es_store *store, const char *path);
  * the array. */
 ES_API es_status es_store_list_results(es_ctx *ctx, es_store *store, const char *kind,
                                        char ***names, int64_t *n);
+/* Names of the attributes of a result or dataset ("kind/name[/dataset]"),
+ * in name order; *keys NULL when there are none. es_free each and the
+ * array. */
+ES_API es_status es_store_list_attrs(es_ctx *ctx, es_store *store, const char *path,
+                                     char ***keys, int64_t *n);
+/* Delete /analysis/<kind>/<name> (and the kind's group when it was the last
+ * of its kind) in the working copy; like every write it becomes visible
+ * at es_store_commit/es_store_close, and a failure leaves the store as it
+ * was. HDF5 does not give the bytes back: the file keeps its size until it
+ * is repacked (h5repack). ES_ENOTFOUND if there is no such result. */
+ES_API es_status es_store_delete_result(es_ctx *ctx, es_store *store, const char *kind,
+                                        const char *name);
 
 /* ---- statismo shape models --------------------------------------------
  * A linear shape model mean + sum_k b_k sqrt(variance_k) basis_k (b ~

@@ -31,6 +31,7 @@
 #include "es_interp.h"
 #include "es_procrustes.h"
 #include "es_compare.h"
+#include "es_model.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -180,6 +181,25 @@ ES_API void es_study_projection_free(es_study_projection *p);
 ES_API es_status es_study_write_projection_table(es_ctx *ctx, const es_study_projection *p,
                                                  const char *path);
 
+/* Every stored result as a CSV table with labels (path "-": standard
+ * output; a file is replaced only once written whole). result is
+ * "KIND/NAME"; table NULL is the kind's default (the first listed):
+ *   mean:    means (edge table, a column per group)
+ *   pca:     scores (id, labels, PC1..), eigenvalues, components
+ *   diff:    edges (mean, sd, se, t);  point: edges (length), weights
+ *   gpa:     specimens (id, labels, centroid_size, rho, scale, PC1..),
+ *            aligned (x1..xk, y1..yk[, z1..zk]), mean, pca, loadings
+ *   compare: summary, distances_lengths, distances_procrustes, groups
+ *   embed:   report (its attributes), vertices (positions and heat maps)
+ *   model:   anova, coefficients, weights, pairwise, lsmeans, edges,
+ *            scores (CAC), permutations (F of each permutation)
+ * and every result: attributes (name, value: provenance and report).
+ * Errors: ES_ENOTFOUND naming the result or listing the kind's tables. */
+ES_API es_status es_study_export_result(es_ctx *ctx, es_store *store, const char *result,
+                                        const char *table, const char *path);
+/* The tables of a kind, ", "-separated, into buf (n bytes); returns buf. */
+ES_API const char *es_study_result_tables(const char *kind, char *buf, size_t n);
+
 /* ---- GPA and the comparison of the two spaces ----------------------------- */
 
 /* GPA of the positions of `rows` (nrows of them; rows NULL with nrows = -1:
@@ -228,6 +248,69 @@ ES_API es_status es_study_compare(es_ctx *ctx, es_store *store, const char *gpa_
 ES_API es_status es_study_compare_write(es_ctx *ctx, const es_compare_result *res,
                                   const char *const *ids, const int64_t *group,
                                   const char *const *group_names, const char *dir);
+
+/* ---- linear models ------------------------------------------------------------
+ * es_model.h on a store: the response is the rows' normalized edge lengths
+ * (edge-length space) or the aligned coordinates of a stored GPA result
+ * (Procrustes space: its `aligned` configurations);
+ * every variable of the formula is a label column, except `size` when no
+ * label column has that name: each row's scale (sum of raw edge lengths)
+ * in edge-length space, its centroid size in Procrustes space, so that
+ * "~ log(size) + group" is the allometric model. Stored as
+ * /analysis/model/<name> (datasets-spec/analysis-results.md). */
+typedef struct es_study_model_opts {
+    const char *formula;       /* "~ expression + subject" (required) */
+    const char *gpa;           /* the GPA result whose coordinates are the response; NULL:
+                                  normalized edge lengths */
+    const char *where;         /* rows: "col=value,..." (with gpa: among the GPA's rows) */
+    const char *block;         /* label column: permute only within its values (repeated
+                                  measures: the subject), or NULL */
+    es_ss_type ss_type;        /* ES_SS_TYPE_I */
+    es_perm_scheme scheme;     /* ES_PERM_RRPP */
+    int64_t permutations;      /* 999 */
+    es_contrasts contrasts;    /* treatment */
+    const char *pairwise;      /* a categorical variable: its LS means compared, or NULL */
+    const char *edge_term;     /* a term: per-edge tests with FDR (edge-length space) */
+    int64_t edge_permutations; /* -1: permutations */
+    const char *name;          /* store as model/<name> (NULL: store nothing) */
+    const char *command;       /* provenance */
+} es_study_model_opts;
+ES_API void es_study_model_opts_init(es_study_model_opts *opts);
+
+/* Everything a model on a store made; arrays owned (es_study_model_free). */
+typedef struct es_study_model_result {
+    es_ctx *ctx;
+    es_formula *formula;
+    es_design *design;
+    es_model *model;
+    es_model_pairwise *pairwise;   /* with opts->pairwise, else NULL */
+    double *edge_f, *edge_p, *edge_q;   /* E each with opts->edge_term, else NULL */
+    double *cac, *cac_scores;      /* p and N when log(size) is a term, else NULL */
+    int64_t nrows;
+    int64_t *rows;                 /* N store rows, in model order */
+    const char **ids;              /* N row ids (borrowed from the store) */
+} es_study_model_result;
+ES_API void es_study_model_free(es_study_model_result *r);
+
+/* Fit and test the model (es_model_fit), then what opts asks for after it,
+ * and store it when opts->name is given (the store open for writing; the
+ * caller commits). Errors: ES_ENOTFOUND (a label column, the GPA result),
+ * ES_EINVAL (no rows, per-edge tests in Procrustes space, a store without
+ * edges in edge-length space), those of es_model.h. */
+ES_API es_status es_study_model(es_ctx *ctx, es_store *store, const es_study_model_opts *opts,
+                                es_study_model_result **out);
+
+/* The analysis-of-variance table as CSV: term, df, ss, ms, r2, f, p, then
+ * the rows Residual (df, ss, ms) and Total (df, ss). */
+ES_API es_status es_study_write_model_table(es_ctx *ctx, const es_study_model_result *r,
+                                            const char *path);
+
+/* Coefficient `coef` (a design column name, e.g. "age" or "expression=happy")
+ * of stored model `model` in edge-length space: its E values (vec) and its row
+ * weights (weights, es_store_nrows entries, added to). What the point
+ * syntax's coef:MODEL:COEF resolves to. */
+ES_API es_status es_study_model_coef(es_ctx *ctx, es_store *store, const char *model,
+                                     const char *coef, double *vec, double *weights);
 
 /* ---- embeddings ------------------------------------------------------------- */
 

@@ -1,0 +1,378 @@
+/* lib/stats/formula.c — model formulas ("~ log(size) + species * sex"): a
+ * recursive-descent parser into a set of terms, each term a set of
+ * variables held as a bit mask.
+ *
+ * Grammar (datasets-spec/models.md):
+ *     formula := ['~'] sum
+ *     sum     := product ('+' product)*
+ *     product := inter ('*' inter)*          a*b = a + b + a:b
+ *     inter   := atom (':' atom)*            a:b = every union of a term of
+ *                                            a with a term of b
+ *     atom    := '(' sum ')' | NAME | factor '(' NAME ')' | log '(' NAME ')'
+ * NAME is letters, digits, '_' and '.', or any text in double quotes. The
+ * terms are then ordered by degree, written order within a degree, as R's
+ * terms() orders them, so that sequential sums of squares follow R's.
+ */
+#include "stats/stats_pkg.h"
+
+#include <ctype.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MAX_VARS 64
+
+typedef struct fvar {
+    char *name;        /* the label column */
+    char *label;       /* "x", "factor(x)", "log(x)" */
+    es_var_kind kind;
+} fvar;
+
+struct es_formula {
+    es_ctx *ctx;
+    int64_t nvars;
+    fvar vars[MAX_VARS];
+    int64_t nterms;
+    uint64_t *terms;   /* masks, model order */
+    char **labels;     /* nterms */
+};
+
+/* A set of terms under construction. */
+typedef struct tset {
+    uint64_t *m;
+    int64_t n, cap;
+} tset;
+
+typedef struct fparser {
+    es_ctx *ctx;
+    const char *s;
+    size_t pos;
+    es_formula *f;
+    int depth;
+} fparser;
+
+static es_status ferr(fparser *p, size_t at, const char *fmt, ...) ES__PRINTF(3, 4);
+static es_status ferr(fparser *p, size_t at, const char *fmt, ...)
+{
+    char msg[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    return es__fail(p->ctx, ES_EFORMAT, "formula: column %zu: %s", at + 1, msg);
+}
+
+static void ws(fparser *p)
+{
+    while (p->s[p->pos] && isspace((unsigned char)p->s[p->pos])) p->pos++;
+}
+
+static const char *what(fparser *p, char *buf, size_t n)
+{
+    char c = p->s[p->pos];
+    if (!c) return "the end of the formula";
+    snprintf(buf, n, "'%c'", c);
+    return buf;
+}
+
+static es_status tset_add(es_ctx *ctx, tset *t, uint64_t m)
+{
+    for (int64_t i = 0; i < t->n; i++)
+        if (t->m[i] == m) return ES_OK;
+    if (t->n == t->cap) {
+        int64_t cap = t->cap ? 2 * t->cap : 8;
+        uint64_t *nm = es__realloc(ctx, t->m, (size_t)cap * sizeof *nm);
+        if (!nm) return ES_ENOMEM;
+        t->m = nm;
+        t->cap = cap;
+    }
+    t->m[t->n++] = m;
+    return ES_OK;
+}
+
+static void tset_clear(es_ctx *ctx, tset *t)
+{
+    es__free(ctx, t->m);
+    memset(t, 0, sizeof *t);
+}
+
+static int name_char(char c)
+{
+    return isalnum((unsigned char)c) || c == '_' || c == '.';
+}
+
+/* A column name at p->pos: a run of name characters or a quoted string. */
+static es_status read_name(fparser *p, const char **w, size_t *len)
+{
+    size_t at = p->pos;
+    if (p->s[at] == '"') {
+        const char *end = strchr(p->s + at + 1, '"');
+        if (!end) return ferr(p, at, "unterminated quoted column name");
+        *w = p->s + at + 1;
+        *len = (size_t)(end - *w);
+        p->pos = (size_t)(end - p->s) + 1;
+        if (!*len) return ferr(p, at, "empty column name");
+        return ES_OK;
+    }
+    while (name_char(p->s[p->pos])) p->pos++;
+    if (p->pos == at) {
+        char b[8];
+        return ferr(p, at, "expected a column name, found %s", what(p, b, sizeof b));
+    }
+    *w = p->s + at;
+    *len = p->pos - at;
+    return ES_OK;
+}
+
+/* The index of variable (name, kind), added if new. */
+static es_status var_index(fparser *p, size_t at, const char *w, size_t len, es_var_kind kind,
+                           int64_t *idx)
+{
+    es_formula *f = p->f;
+    for (int64_t v = 0; v < f->nvars; v++)
+        if (f->vars[v].kind == kind && strlen(f->vars[v].name) == len &&
+            !memcmp(f->vars[v].name, w, len)) {
+            *idx = v;
+            return ES_OK;
+        }
+    if (f->nvars == MAX_VARS) return ferr(p, at, "more than %d variables", MAX_VARS);
+    fvar *v = &f->vars[f->nvars];
+    v->name = es__malloc(p->ctx, len + 1);
+    v->label = es__malloc(p->ctx, len + 9);
+    if (!v->name || !v->label) {
+        es__free(p->ctx, v->name);
+        es__free(p->ctx, v->label);
+        v->name = v->label = NULL;
+        return ES_ENOMEM;
+    }
+    memcpy(v->name, w, len);
+    v->name[len] = '\0';
+    v->kind = kind;
+    snprintf(v->label, len + 9, "%s%s%s", kind == ES_VAR_FACTOR ? "factor(" :
+             kind == ES_VAR_LOG ? "log(" : "", v->name, kind == ES_VAR_AUTO ? "" : ")");
+    *idx = f->nvars++;
+    return ES_OK;
+}
+
+static es_status parse_sum(fparser *p, tset *out);
+
+static es_status parse_atom(fparser *p, tset *out)
+{
+    ws(p);
+    size_t at = p->pos;
+    es_status rc;
+    if (++p->depth > 100) return ferr(p, at, "formula nested too deeply");
+    if (p->s[at] == '(') {
+        p->pos++;
+        if ((rc = parse_sum(p, out)) != ES_OK) return rc;
+        ws(p);
+        if (p->s[p->pos] != ')') {
+            char b[8];
+            return ferr(p, p->pos, "expected ')' to close the '(' at column %zu, found %s",
+                        at + 1, what(p, b, sizeof b));
+        }
+        p->pos++;
+        p->depth--;
+        return ES_OK;
+    }
+    const char *w = NULL;
+    size_t len = 0;
+    if ((rc = read_name(p, &w, &len)) != ES_OK) return rc;
+    es_var_kind kind = ES_VAR_AUTO;
+    size_t after = p->pos;
+    ws(p);
+    if (p->s[p->pos] == '(' && p->s[at] != '"') {
+        if (len == 6 && !memcmp(w, "factor", 6)) kind = ES_VAR_FACTOR;
+        else if (len == 3 && !memcmp(w, "log", 3)) kind = ES_VAR_LOG;
+        else
+            return ferr(p, at, "unknown function '%.*s' (factor() and log() are known)",
+                        (int)len, w);
+        p->pos++;
+        ws(p);
+        at = p->pos;
+        if ((rc = read_name(p, &w, &len)) != ES_OK) return rc;
+        ws(p);
+        if (p->s[p->pos] != ')') {
+            char b[8];
+            return ferr(p, p->pos, "expected ')' after the column name, found %s",
+                        what(p, b, sizeof b));
+        }
+        p->pos++;
+    } else {
+        p->pos = after;
+    }
+    int64_t v = 0;
+    if ((rc = var_index(p, at, w, len, kind, &v)) != ES_OK) return rc;
+    p->depth--;
+    return tset_add(p->ctx, out, (uint64_t)1 << v);
+}
+
+/* out = every union of a term of a with a term of b */
+static es_status cross(es_ctx *ctx, const tset *a, const tset *b, tset *out)
+{
+    es_status rc = ES_OK;
+    for (int64_t i = 0; i < a->n && rc == ES_OK; i++)
+        for (int64_t j = 0; j < b->n && rc == ES_OK; j++) rc = tset_add(ctx, out, a->m[i] | b->m[j]);
+    return rc;
+}
+
+static es_status parse_inter(fparser *p, tset *out)
+{
+    es_status rc = parse_atom(p, out);
+    while (rc == ES_OK) {
+        ws(p);
+        if (p->s[p->pos] != ':') break;
+        p->pos++;
+        tset b = {0}, c = {0};
+        if ((rc = parse_atom(p, &b)) == ES_OK && (rc = cross(p->ctx, out, &b, &c)) == ES_OK) {
+            tset_clear(p->ctx, out);
+            *out = c;
+            c.m = NULL;
+        }
+        tset_clear(p->ctx, &b);
+        tset_clear(p->ctx, &c);
+    }
+    return rc;
+}
+
+static es_status parse_product(fparser *p, tset *out)
+{
+    es_status rc = parse_inter(p, out);
+    while (rc == ES_OK) {
+        ws(p);
+        if (p->s[p->pos] != '*') break;
+        p->pos++;
+        tset b = {0}, c = {0};
+        if ((rc = parse_inter(p, &b)) == ES_OK) {
+            for (int64_t i = 0; rc == ES_OK && i < out->n; i++) rc = tset_add(p->ctx, &c, out->m[i]);
+            for (int64_t i = 0; rc == ES_OK && i < b.n; i++) rc = tset_add(p->ctx, &c, b.m[i]);
+            if (rc == ES_OK) rc = cross(p->ctx, out, &b, &c);
+        }
+        if (rc == ES_OK) {
+            tset_clear(p->ctx, out);
+            *out = c;
+            c.m = NULL;
+        }
+        tset_clear(p->ctx, &b);
+        tset_clear(p->ctx, &c);
+    }
+    return rc;
+}
+
+static es_status parse_sum(fparser *p, tset *out)
+{
+    es_status rc = parse_product(p, out);
+    while (rc == ES_OK) {
+        ws(p);
+        char c = p->s[p->pos];
+        if (c == '-')
+            return ferr(p, p->pos, "removing terms with '-' is not supported; list the terms "
+                        "to keep");
+        if (c != '+') break;
+        p->pos++;
+        tset b = {0};
+        if ((rc = parse_product(p, &b)) == ES_OK)
+            for (int64_t i = 0; rc == ES_OK && i < b.n; i++) rc = tset_add(p->ctx, out, b.m[i]);
+        tset_clear(p->ctx, &b);
+    }
+    return rc;
+}
+
+void es_formula_free(es_formula *f)
+{
+    if (!f) return;
+    for (int64_t v = 0; v < f->nvars; v++) {
+        es__free(f->ctx, f->vars[v].name);
+        es__free(f->ctx, f->vars[v].label);
+    }
+    for (int64_t j = 0; f->labels && j < f->nterms; j++) es__free(f->ctx, f->labels[j]);
+    es__free(f->ctx, f->labels);
+    es__free(f->ctx, f->terms);
+    es__free(f->ctx, f);
+}
+
+/* Order by degree (stable) and make the labels. */
+static es_status finish(es_ctx *ctx, es_formula *f, const tset *t)
+{
+    f->terms = es__alloc_array(ctx, t->n, sizeof *f->terms);
+    f->labels = es__calloc(ctx, (size_t)t->n, sizeof *f->labels);
+    if (!f->terms || !f->labels) return ES_ENOMEM;
+    f->nterms = 0;
+    for (int deg = 1; deg <= MAX_VARS; deg++)
+        for (int64_t i = 0; i < t->n; i++)
+            if (__builtin_popcountll(t->m[i]) == deg) f->terms[f->nterms++] = t->m[i];
+    for (int64_t j = 0; j < f->nterms; j++) {
+        size_t len = 1;
+        for (int64_t v = 0; v < f->nvars; v++)
+            if (f->terms[j] >> v & 1) len += strlen(f->vars[v].label) + 1;
+        char *s = es__malloc(ctx, len);
+        if (!s) return ES_ENOMEM;
+        s[0] = '\0';
+        for (int64_t v = 0; v < f->nvars; v++)
+            if (f->terms[j] >> v & 1) {
+                if (*s) strcat(s, ":");
+                strcat(s, f->vars[v].label);
+            }
+        f->labels[j] = s;
+    }
+    return ES_OK;
+}
+
+es_status es_formula_parse(es_ctx *ctx, const char *text, es_formula **out)
+{
+    *out = NULL;
+    if (!text) ES_FAIL(ctx, ES_EINVAL, "formula: no formula");
+    es_formula *f = es__calloc(ctx, 1, sizeof *f);
+    if (!f) return ES_ENOMEM;
+    f->ctx = ctx;
+    fparser p = {ctx, text, 0, f, 0};
+    tset t = {0};
+    es_status rc;
+    ws(&p);
+    const char *tilde = strchr(text, '~');
+    if (tilde && tilde != text + p.pos) {
+        rc = ferr(&p, p.pos, "the response is the store's shapes: write the formula as "
+                  "'~ terms', without a left-hand side");
+        goto done;
+    }
+    if (text[p.pos] == '~') p.pos++;
+    ws(&p);
+    if (!text[p.pos]) {
+        rc = ferr(&p, p.pos, "the formula has no terms (write e.g. '~ group')");
+        goto done;
+    }
+    if ((rc = parse_sum(&p, &t)) != ES_OK) goto done;
+    ws(&p);
+    if (text[p.pos]) {
+        char b[8];
+        rc = ferr(&p, p.pos, "unexpected %s (terms are joined by '+', '*' or ':')",
+                  what(&p, b, sizeof b));
+        goto done;
+    }
+    if ((rc = finish(ctx, f, &t)) != ES_OK) goto done;
+    *out = f;
+    f = NULL;
+done:
+    tset_clear(ctx, &t);
+    es_formula_free(f);
+    return rc;
+}
+
+int64_t es_formula_nvars(const es_formula *f) { return f ? f->nvars : 0; }
+
+const char *es_formula_var(const es_formula *f, int64_t v, es_var_kind *kind)
+{
+    if (!f || v < 0 || v >= f->nvars) return NULL;
+    if (kind) *kind = f->vars[v].kind;
+    return f->vars[v].name;
+}
+
+int64_t es_formula_nterms(const es_formula *f) { return f ? f->nterms : 0; }
+
+const char *es_formula_term(const es_formula *f, int64_t j)
+{
+    return f && j >= 0 && j < f->nterms ? f->labels[j] : NULL;
+}
+
+const char *es__formula_var_label(const es_formula *f, int64_t v) { return f->vars[v].label; }
+uint64_t es__formula_term_mask(const es_formula *f, int64_t j) { return f->terms[j]; }
