@@ -49,6 +49,10 @@ es_status es__spd_new(es_ctx *ctx, es__spd **out)
     s->started = 1;
     s->cm.print = 0;
     s->cm.error_handler = NULL;
+    /* LL' also for the simplicial factors CHOLMOD picks for small matrices
+     * (its default there is LDL', which factorizes indefinite matrices
+     * without complaint) */
+    s->cm.final_ll = 1;
     *out = s;
     return ES_OK;
 }
