@@ -1,0 +1,152 @@
+/* lib/include/edgespace/es_morph.h — the other papers' ways between shapes,
+ * beside the project's own (edge-length interpolation, each frame embedded:
+ * es_interp.h, es_embed.h), on the same topology and arrays:
+ *
+ *  - multi-scale geometry interpolation (Winkler, Drieseberg, Alexa and
+ *    Hormann 2010, ../shared/papers/multi-scale-geometry-interpolation):
+ *    lengths and dihedrals interpolated per wedge, the mesh put together
+ *    from a hierarchy of overlapping patches by multi-registration and
+ *    least-squares blending, one factorization per patch and topology;
+ *  - morphing in shape space (Wuhrer, Bose, Shu, O'Rourke and Brunton
+ *    2010, morphing-triangular-meshes-in-shape-space): lengths interpolated
+ *    linearly and face normals by SLERP, the mesh rebuilt by walking a
+ *    minimum spanning tree of the dual graph, averaging the candidate
+ *    positions of each vertex;
+ *  - data-driven paths (Gao, Chen, Lai and Xia 2017,
+ *    data-driven-shape-interpolation): a path through a collection of
+ *    example shapes (a K-nearest-neighbour graph, Dijkstra, then an
+ *    iterative smoothing that keeps it near the examples), each point of
+ *    it a combination of the examples;
+ *  - conformal factors to the sphere (edge-length-interpolation Section 5,
+ *    after Springborn, Schroeder and Pinkall 2008): the discrete conformal
+ *    map of a closed genus-0 mesh to a mesh inscribed in the sphere, whose
+ *    factors, scaled from 0 to 1, give the lengths of a conformal morph.
+ *
+ * Where a paper is silent the choice made is written at the function. The
+ * quality of a mesh made by any of them is measured as the embedder's
+ * (es_morph_report fills an es_embed_report), so the methods compare on one
+ * scale.
+ */
+#ifndef EDGESPACE_ES_MORPH_H
+#define EDGESPACE_ES_MORPH_H
+
+#include "es_core.h"
+#include "es_mesh.h"
+#include "es_embed.h"
+#include "es_interp.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The interpolation methods `edgespace interp --method` offers. */
+typedef enum es_morph_method {
+    ES_MORPH_EDGE_LENGTH = 0,   /* the project's: lengths interpolated, each frame embedded */
+    ES_MORPH_MULTISCALE,        /* Winkler et al. 2010 */
+    ES_MORPH_SHAPE_SPACE,       /* Wuhrer et al. 2010 */
+    ES_MORPH_DATA_DRIVEN        /* Gao et al. 2017, each frame embedded */
+} es_morph_method;
+
+/* "edge-length", "multiscale", "shape-space", "data-driven". */
+ES_API const char *es_morph_method_name(es_morph_method method);
+/* The method of a name; ES_ENOTFOUND lists the known names. */
+ES_API es_status es_morph_method_from_name(es_ctx *ctx, const char *name,
+                                           es_morph_method *out);
+
+/* ---- the quality of a mesh ----------------------------------------------------
+ * How well positions xyz (3 x V) realize target lengths (E), on the
+ * embedder's scale: rms_ratio, max_rel, p99_rel, worst_edge, n_bad_faces
+ * (target faces breaking the triangle inequality), scale (sum of the
+ * target), realized (max_rel <= realized_rtol and no bad face), and
+ * closure_after (eq. 3 at the output's dihedrals and the target's corner
+ * angles); the iteration and stage fields are 0 and t_total is left as
+ * the caller set it. vertex_closure and vertex_edge_error (V each, may be
+ * NULL) get what es_embedder_vertex_closure / _edge_error give for an
+ * embedding. */
+ES_API es_status es_morph_report(es_ctx *ctx, const es_mesh *mesh, const double *target,
+                                 const double *xyz, double realized_rtol,
+                                 es_embed_report *report, double *vertex_closure,
+                                 double *vertex_edge_error);
+
+/* ---- multi-scale geometry interpolation (Winkler et al. 2010) ----------------
+ * Preprocessing (es_multiscale_new, once per topology): the mesh is split
+ * into `patches` overlapping patches by region growing from random seed
+ * faces (the context's seed), each patch in turn, until a patch has at most
+ * leaf_faces faces (Sec. 3.3); neighbouring patches overlap by the faces
+ * along their common border (each part grown by the faces across its
+ * border edges: the paper's "strip of width one" on each side). Every
+ * inner patch's blending matrix M^T M (Sec. 3.2, eq. 2; one row per edge
+ * and occurrence in a child, one vertex per connected piece held) depends
+ * on the topology only and is factorized here.
+ * A solve (es_multiscale_solve) from target lengths l and dihedrals alpha
+ * (E each, es_geom.h's signed bending angle; boundary edges ignored):
+ *  1. leaves: the faces glued greedily along a breadth-first walk of the
+ *     patch's faces, each new face placed by its three lengths and its
+ *     dihedral with the face it is reached from (a vertex already placed
+ *     keeps its place; the blending above evens such gaps out, Sec. 3.3);
+ *  2. each inner patch, bottom up: its children registered simultaneously
+ *     (Williams and Bennamoun 2000: the translations eliminated in closed
+ *     form, one 3 x 3 polar decomposition per child and pass; the first
+ *     child fixed). The paper starts every rotation at the identity; here
+ *     each child is first placed by Kabsch onto the children placed before
+ *     it, always the one sharing most vertices with them next, because the
+ *     leaves' frames are arbitrary and 4 passes from the identity left
+ *     deep hierarchies visibly unregistered (a mesh's own lengths and
+ *     dihedrals came back 7 % of its diagonal off; placed first: 1e-12).
+ *     Then `passes` passes over all (Sec. 3.1: 4), then the children are
+ *     blended by least squares on the edges with their directions and the
+ *     target lengths (eq. 3);
+ *  3. the root patch is the mesh.
+ * Vertices in no face come out at the origin. The output's placement and
+ * orientation are arbitrary (those of the first leaf): align it. */
+typedef struct es_multiscale es_multiscale;
+
+typedef struct es_multiscale_opts {
+    int64_t patches;      /* children per patch, m (6, the paper's choice) */
+    int64_t leaf_faces;   /* a patch of at most this many faces is a leaf (0: m) */
+    int passes;           /* registration passes after the first (4, Sec. 3.1) */
+} es_multiscale_opts;
+
+ES_API void es_multiscale_opts_init(es_multiscale_opts *opts);
+
+typedef struct es_multiscale_info {
+    int64_t levels;         /* depth of the hierarchy (the root is level 0) */
+    int64_t nodes, leaves;  /* patches in all, of them leaves */
+    int64_t max_leaf;       /* faces in the largest leaf */
+    double t_split;         /* preprocessing: building the hierarchy (s) */
+    double t_factor;        /* preprocessing: factorizing the blending matrices (s) */
+    double t_leaves;        /* last solve: gluing the leaves (s) */
+    double t_register;      /* last solve: multi-registration (s) */
+    double t_blend;         /* last solve: blending (s) */
+} es_multiscale_info;
+
+/* Build the hierarchy of `mesh` (borrowed; must outlive the object). opts
+ * NULL: defaults. ES_EINVAL on a mesh without faces or options out of range
+ * (patches < 2, passes < 0). */
+ES_API es_status es_multiscale_new(es_ctx *ctx, const es_mesh *mesh,
+                                   const es_multiscale_opts *opts, es_multiscale **out);
+ES_API void es_multiscale_free(es_multiscale *ms);
+ES_API void es_multiscale_get_info(const es_multiscale *ms, es_multiscale_info *info);
+
+/* Positions xyz (3 x V) from target lengths len (E, positive) and dihedrals
+ * alpha (E). ES_EINVAL names an edge whose length is not finite and
+ * positive or whose dihedral is not finite. */
+ES_API es_status es_multiscale_solve(es_ctx *ctx, es_multiscale *ms, const double *len,
+                                     const double *alpha, double *xyz);
+
+/* Interpolate nin inputs (positions 3 x V each) with weights w as Winkler
+ * et al. do (Sec. 3, 3.4): lengths and dihedrals as es_interp_targets makes
+ * them (the weighted mean of the scale-normalized lengths at the weighted
+ * mean scale; dihedrals along the shortest arc), solved, and rigidly
+ * aligned (each connected component) to align_to (NULL: input r, the one
+ * of largest weight). Weights outside [0, 1] extrapolate (Sec. 3.5) while
+ * every length stays positive. info may be NULL. */
+ES_API es_status es_multiscale_interp(es_ctx *ctx, es_multiscale *ms, int64_t nin,
+                                      const double *const *xyz, const double *w,
+                                      const double *align_to, double *out,
+                                      es_interp_info *info);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
