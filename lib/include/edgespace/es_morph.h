@@ -146,6 +146,47 @@ ES_API es_status es_multiscale_interp(es_ctx *ctx, es_multiscale *ms, int64_t ni
                                       const double *align_to, double *out,
                                       es_interp_info *info);
 
+/* ---- morphing in shape space (Wuhrer et al. 2010) ----------------------------
+ * Two poses A and B (B rigidly aligned to A first, each connected component
+ * on its own, as Sec. 3 and 5 do) are points of a shape space of edge
+ * lengths and unit face normals; frame t has lengths (1 - t) l_A + t l_B
+ * (or the caller's) and normals SLERPed from A's to B's (an antipodal pair
+ * turns about the face's first edge). The mesh is rebuilt by walking a
+ * minimum spanning tree of the dual graph (arc weight: the change of the
+ * dihedral across the edge from A to B, Sec. 5) depth first from the face
+ * of each component's first vertex and first edge, whose position and
+ * direction are interpolated linearly and by SLERP. Crossing an arc from a
+ * placed face, the new face's third vertex gets candidate positions from
+ * the latest candidate of the shared edge's more recently updated end and
+ * every candidate of the other (the averaging algorithm, Sec. 6), each
+ * placed by the face's lengths in the plane of its normal (on the line of
+ * the two candidates, centred at their midpoint); a vertex ends at the mean
+ * of its candidates. On a triangulated polygon (the dual graph a tree)
+ * every vertex has one candidate and frame t realizes its lengths exactly
+ * (Theorem 1). Vertices in no face come out at the origin. */
+typedef struct es_shape_space es_shape_space;
+
+typedef struct es_shape_space_info {
+    int64_t dual_arcs;      /* interior edges: arcs of the dual graph */
+    int64_t tree_arcs;      /* arcs of the spanning forest */
+    int64_t candidates;     /* candidate positions made by the last frame */
+    int64_t max_candidates; /* most candidates of one vertex in the last frame */
+} es_shape_space_info;
+
+/* The shape-space points of poses xa and xb (3 x V each, copied; B is
+ * aligned to A) and the spanning forest. The mesh is borrowed. ES_EINVAL
+ * on a non-finite position or a degenerate face (no normal). */
+ES_API es_status es_shape_space_new(es_ctx *ctx, const es_mesh *mesh, const double *xa,
+                                    const double *xb, es_shape_space **out);
+ES_API void es_shape_space_free(es_shape_space *ss);
+ES_API void es_shape_space_get_info(const es_shape_space *ss, es_shape_space_info *info);
+
+/* Frame t (any real: outside [0, 1] extrapolates) into xyz (3 x V, in A's
+ * frame). len: the frame's lengths (E), or NULL for (1 - t) l_A + t l_B;
+ * ES_EINVAL names an edge whose length is not positive. */
+ES_API es_status es_shape_space_frame(es_ctx *ctx, es_shape_space *ss, const double *len,
+                                      double t, double *xyz);
+
 #ifdef __cplusplus
 }
 #endif
