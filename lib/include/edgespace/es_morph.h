@@ -35,6 +35,72 @@
 #include "es_embed.h"
 #include "es_interp.h"
 
+/* ---- data-driven paths (Gao et al. 2017) -------------------------------------
+ * A path from example src to example dst through a collection of n
+ * examples, given by their coordinates x (dim x n, column-major, leading
+ * dimension ldx; the caller's: edgespace uses the rows' edge-length PCA
+ * scores with every component, where distances are those of the lengths):
+ *  1. the K-nearest-neighbour graph of the examples (L2), made connected
+ *     by adding the shortest arc between the part holding example 0 and
+ *     the rest, again until one part is left (Sec. 3.2.1, "similar to
+ *     Prim's algorithm");
+ *  2. Dijkstra from src to dst on it, the polyline resampled evenly by
+ *     length to `samples` points (the ends held);
+ *  3. iterations of eq. 2: each inner sample pulled toward its k~ nearest
+ *     examples with weights exp(-distance / sigma), gamma times the squared
+ *     lengths of the path's segments, lambda times its Laplacian (the
+ *     paper's weights, L(i, i-1) = -d_{i-1} / (d_{i-1} + d_i), which at a
+ *     fixed point are the uniform Laplacian, so the samples spread evenly),
+ *     delta times the distance from the previous iterate; one SPD solve
+ *     per iteration, until the mean move of a sample is below eps or
+ *     max_iter;
+ *  4. the path resampled evenly by length to nframes frames (Sec. 3.2.3).
+ * The paper's sigma, gamma, lambda, delta and eps (0.01, 0.01, 100, 1e-4,
+ * 1e-3) are in its coordinates' units, which it does not state; here the
+ * coordinates are measured in `scale`, the mean length of the graph's
+ * K-nearest-neighbour arcs, and sigma defaults to 1 of it (0.01 of it
+ * left every weight below e^-50: a straight line). */
+typedef struct es_data_path_opts {
+    int64_t knn;        /* K: neighbours of each example in the graph (6) */
+    int64_t near;       /* k~: examples pulling each sample (6) */
+    int64_t samples;    /* points of the path while it is optimized (200) */
+    double sigma;       /* weight fall-off, in units of scale (1) */
+    double gamma;       /* segment lengths (0.01) */
+    double lambda;      /* Laplacian (100) */
+    double delta;       /* distance from the previous iterate (1e-4) */
+    double eps;         /* convergence: mean move of a sample, in scale (1e-3) */
+    int max_iter;       /* (200) */
+} es_data_path_opts;
+
+ES_API void es_data_path_opts_init(es_data_path_opts *opts);
+
+typedef struct es_data_path_info {
+    double scale;           /* the unit: mean length of a K-nearest-neighbour arc */
+    int64_t arcs;           /* arcs of the connected graph (undirected) */
+    int64_t bridges;        /* of them added to connect it */
+    int64_t hops;           /* examples on the Dijkstra path, ends included */
+    double graph_length;    /* its length (coordinates' units) */
+    double length;          /* length of the optimized path */
+    int iterations, converged;
+    /* distance from a frame to its nearest example, in units of scale:
+     * along the path and along the straight line src -> dst (as many
+     * frames, evenly spaced) */
+    double mean_near, max_near, line_mean_near, line_max_near;
+} es_data_path_info;
+
+/* Frames (dim x nframes, column-major) of the path from src to dst; frame
+ * 0 is example src and frame nframes - 1 example dst, exactly. weights
+ * (n x nframes, may be NULL): each frame as an affine combination of the
+ * examples (sum 1, least norm; exact when the frame lies in their affine
+ * span, as it does in PCA scores with every component), which is how
+ * edgespace turns a frame into lengths. info may be NULL. ES_EINVAL on
+ * src == dst or out of range, n < 2, nframes < 2, non-finite coordinates or
+ * options out of range. */
+ES_API es_status es_data_path(es_ctx *ctx, int64_t dim, int64_t n, const double *x,
+                              int64_t ldx, int64_t src, int64_t dst,
+                              const es_data_path_opts *opts, int64_t nframes, double *frames,
+                              double *weights, es_data_path_info *info);
+
 #ifdef __cplusplus
 extern "C" {
 #endif
