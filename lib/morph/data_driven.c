@@ -332,3 +332,43 @@ es_status es_data_path(es_ctx *ctx, int64_t dim, int64_t n, const double *x, int
     if (info) *info = inf;
     return rc;
 }
+
+es_status es_data_path_coords(es_ctx *ctx, int64_t dim, int64_t n, const double *x, int64_t ldx,
+                              double *coords, int64_t *ncoord)
+{
+    if (!x || !coords || !ncoord || dim < 1 || n < 1 || ldx < dim)
+        ES_FAIL(ctx, ES_EINVAL, "data-driven coordinates: %lld vectors of dimension %lld "
+                "(ld %lld)", (long long)n, (long long)dim, (long long)ldx);
+    double *c = es__alloc_array(ctx, dim * n, sizeof *c), *mu = es__calloc(ctx, (size_t)dim, 8);
+    double *g = es__alloc_array(ctx, n * n, sizeof *g), *ev = es__alloc_array(ctx, n, 8);
+    int info = -1;
+    if (c && mu && g && ev) {
+        for (int64_t j = 0; j < n; j++)
+            for (int64_t k = 0; k < dim; k++) mu[k] += x[j * ldx + k] / (double)n;
+        for (int64_t j = 0; j < n; j++)
+            for (int64_t k = 0; k < dim; k++) c[j * dim + k] = x[j * ldx + k] - mu[k];
+        cblas_dsyrk(CblasColMajor, CblasUpper, CblasTrans, (int)n, (int)dim, 1.0, c, (int)dim,
+                    0.0, g, (int)n);
+        info = LAPACKE_dsyevd(LAPACK_COL_MAJOR, 'V', 'U', (lapack_int)n, g, (lapack_int)n, ev);
+    }
+    if (info == 0) {   /* eigenvalues ascending: component r is column n-1-r */
+        int64_t r = 0;
+        double top = ev[n - 1] > 0 ? ev[n - 1] : 0;
+        for (; r < n && ev[n - 1 - r] > 1e-12 * top && top > 0; r++) {
+            const double *v = g + (n - 1 - r) * n;
+            double sq = sqrt(ev[n - 1 - r]);
+            int64_t big = 0;   /* a sign fixed by the largest entry, for reproducible output */
+            for (int64_t j = 1; j < n; j++) big = fabs(v[j]) > fabs(v[big]) ? j : big;
+            for (int64_t j = 0; j < n; j++)
+                coords[j * n + r] = (v[big] < 0 ? -v[j] : v[j]) * sq;
+        }
+        for (int64_t j = 0; j < n; j++)
+            for (int64_t k = r; k < n; k++) coords[j * n + k] = 0;
+        *ncoord = r;
+    }
+    es__free(ctx, c), es__free(ctx, mu), es__free(ctx, g), es__free(ctx, ev);
+    if (!c || !mu || !g || !ev) return ES_ENOMEM;
+    if (info != 0) ES_FAIL(ctx, ES_ENUMERIC, "data-driven coordinates: eigensolver failed (%d)",
+                           info);
+    return ES_OK;
+}

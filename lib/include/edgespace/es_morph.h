@@ -101,6 +101,16 @@ ES_API es_status es_data_path(es_ctx *ctx, int64_t dim, int64_t n, const double 
                               const es_data_path_opts *opts, int64_t nframes, double *frames,
                               double *weights, es_data_path_info *info);
 
+/* Coordinates for es_data_path from long vectors (dim x n, leading
+ * dimension ldx, e.g. the rows' normalized edge lengths): the examples'
+ * principal component scores with every component, by classical scaling
+ * of their centred Gram matrix (n x n: cheap for a store's rows however
+ * many edges), so that distances between them are those of the vectors.
+ * coords: n x n (column j = example j; the first *ncoord rows used, the
+ * components whose eigenvalue exceeds 1e-12 of the largest). */
+ES_API es_status es_data_path_coords(es_ctx *ctx, int64_t dim, int64_t n, const double *x,
+                                     int64_t ldx, double *coords, int64_t *ncoord);
+
 #ifdef __cplusplus
 extern "C" {
 #endif
