@@ -31,6 +31,16 @@ static double dist(int64_t dim, const double *a, const double *b)
     return sqrt(s);
 }
 
+/* The examples' mean mu (dim, zeroed by the caller) and the centred
+ * examples c (dim x n, packed). */
+static void centre(int64_t dim, int64_t n, const double *x, int64_t ldx, double *mu, double *c)
+{
+    for (int64_t j = 0; j < n; j++)
+        for (int64_t k = 0; k < dim; k++) mu[k] += x[j * ldx + k] / (double)n;
+    for (int64_t j = 0; j < n; j++)
+        for (int64_t k = 0; k < dim; k++) c[j * dim + k] = x[j * ldx + k] - mu[k];
+}
+
 /* Pairwise distances d (n x n) from the Gram matrix of the centred
  * coordinates (centring keeps the cancellation small). */
 static es_status pair_dist(es_ctx *ctx, int64_t dim, int64_t n, const double *x, int64_t ldx,
@@ -41,10 +51,7 @@ static es_status pair_dist(es_ctx *ctx, int64_t dim, int64_t n, const double *x,
         es__free(ctx, c), es__free(ctx, mu);
         return ES_ENOMEM;
     }
-    for (int64_t j = 0; j < n; j++)
-        for (int64_t k = 0; k < dim; k++) mu[k] += x[j * ldx + k] / (double)n;
-    for (int64_t j = 0; j < n; j++)
-        for (int64_t k = 0; k < dim; k++) c[j * dim + k] = x[j * ldx + k] - mu[k];
+    centre(dim, n, x, ldx, mu, c);
     cblas_dsyrk(CblasColMajor, CblasUpper, CblasTrans, (int)n, (int)dim, 1.0, c, (int)dim, 0.0,
                 d, (int)n);
     for (int64_t j = 0; j < n; j++)
@@ -240,10 +247,7 @@ static es_status frame_weights(es_ctx *ctx, int64_t dim, int64_t n, const double
     lapack_int rank;
     int info = -1;
     if (c && b && mu && sv) {
-        for (int64_t j = 0; j < n; j++)
-            for (int64_t k = 0; k < dim; k++) mu[k] += x[j * ldx + k] / (double)n;
-        for (int64_t j = 0; j < n; j++)
-            for (int64_t k = 0; k < dim; k++) c[j * dim + k] = x[j * ldx + k] - mu[k];
+        centre(dim, n, x, ldx, mu, c);
         for (int64_t s = 0; s < nf; s++)
             for (int64_t k = 0; k < ldb; k++) b[s * ldb + k] = k < dim ? f[s * dim + k] - mu[k] : 0;
         info = LAPACKE_dgelsd(LAPACK_COL_MAJOR, (lapack_int)dim, (lapack_int)n, (lapack_int)nf,
@@ -343,10 +347,7 @@ es_status es_data_path_coords(es_ctx *ctx, int64_t dim, int64_t n, const double 
     double *g = es__alloc_array(ctx, n * n, sizeof *g), *ev = es__alloc_array(ctx, n, 8);
     int info = -1;
     if (c && mu && g && ev) {
-        for (int64_t j = 0; j < n; j++)
-            for (int64_t k = 0; k < dim; k++) mu[k] += x[j * ldx + k] / (double)n;
-        for (int64_t j = 0; j < n; j++)
-            for (int64_t k = 0; k < dim; k++) c[j * dim + k] = x[j * ldx + k] - mu[k];
+        centre(dim, n, x, ldx, mu, c);
         cblas_dsyrk(CblasColMajor, CblasUpper, CblasTrans, (int)n, (int)dim, 1.0, c, (int)dim,
                     0.0, g, (int)n);
         info = LAPACKE_dsyevd(LAPACK_COL_MAJOR, 'V', 'U', (lapack_int)n, g, (lapack_int)n, ev);
