@@ -17,10 +17,6 @@
  *    example shapes (a K-nearest-neighbour graph, Dijkstra, then an
  *    iterative smoothing that keeps it near the examples), each point of
  *    it a combination of the examples;
- *  - conformal factors to the sphere (edge-length-interpolation Section 5,
- *    after Springborn, Schroeder and Pinkall 2008): the discrete conformal
- *    map of a closed genus-0 mesh to a mesh inscribed in the sphere, whose
- *    factors, scaled from 0 to 1, give the lengths of a conformal morph.
  *
  * Where a paper is silent the choice made is written at the function. The
  * quality of a mesh made by any of them is measured as the embedder's
