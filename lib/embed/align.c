@@ -8,6 +8,7 @@
  * or reference positions, whose placement edge lengths do not fix.
  */
 #include "embed/embed_pkg.h"
+#include "embed/embed_private.h"
 
 #include <lapacke.h>
 #include <math.h>
@@ -180,3 +181,6 @@ es_status es_kabsch_align_parts(es_ctx *ctx, int64_t nverts, double *xyz, const 
     if (rms) *rms = sqrt(ss / (double)nverts);
     return ES_OK;
 }
+
+/* For the modules above (embed_private.h): the same polar factor. */
+int es__rotation_nearest(double m[9]) { return es__mat3_nearest_rotation(m); }

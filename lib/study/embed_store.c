@@ -3,7 +3,7 @@
  * rows' dihedrals), and embeddings stored with their
  * quality report and per-vertex residuals under /analysis/embed/<name>.
  */
-#include "core/core_private.h"
+#include "study/study_pkg.h"
 #include "edgespace/es_study.h"
 #include "edgespace/es_geom.h"
 
@@ -75,7 +75,21 @@ es_status es_study_store_embedding(es_ctx *ctx, es_store *store, const char *nam
                                 const double *target, const double *xyz,
                                 const es_embed_report *r, const char *init)
 {
-    const es_mesh *mesh = es_embedder_mesh(emb);
+    if (!es_embedder_vertex_closure(emb))
+        ES_FAIL(ctx, ES_EINVAL, "embed: store result: the embedder has not solved yet");
+    return es__study_store_mesh_result(ctx, store, name, prov, es_embedder_mesh(emb),
+                                       es_embedder_vertex_closure(emb),
+                                       es_embedder_vertex_edge_error(emb),
+                                       es_embedder_vertex_deviation(emb), target, xyz, r, init);
+}
+
+es_status es__study_store_mesh_result(es_ctx *ctx, es_store *store, const char *name,
+                                      const es_provenance *prov, const es_mesh *mesh,
+                                      const double *vclos, const double *verr,
+                                      const double *vdev, const double *target,
+                                      const double *xyz, const es_embed_report *r,
+                                      const char *init)
+{
     int64_t nv = es_mesh_nverts(mesh), ne = es_mesh_nedges(mesh);
     char path[512];
     double *tn = NULL, sum = 0;
@@ -93,19 +107,14 @@ es_status es_study_store_embedding(es_ctx *ctx, es_store *store, const char *nam
         {"scale", r->scale}, {"has_prior", r->has_prior}, {"bend_out", r->bend_out},
         {"bend_prior", r->bend_prior}, {"bend_ratio", r->bend_ratio},
         {"prior_rms", r->prior_rms}, {"prior_max", r->prior_max}};
-    if (!es_embedder_vertex_closure(emb))
-        ES_FAIL(ctx, ES_EINVAL, "embed: store result: the embedder has not solved yet");
     if ((rc = es_store_result_begin(ctx, store, "embed", name, prov)) != ES_OK) return rc;
 #define P(ds) (snprintf(path, sizeof path, "embed/%s/%s", name, ds) < (int)sizeof path ? path : "")
     if ((rc = es_store_put_matrix(ctx, store, P("positions"), (es_mat){(double *)xyz, 3, nv, 3})) !=
             ES_OK ||
-        (rc = es_store_put_vector(ctx, store, P("vertex_closure"),
-                                  es_embedder_vertex_closure(emb), nv)) != ES_OK ||
-        (rc = es_store_put_vector(ctx, store, P("vertex_edge_error"),
-                                  es_embedder_vertex_edge_error(emb), nv)) != ES_OK ||
-        (es_embedder_vertex_deviation(emb) &&
-         (rc = es_store_put_vector(ctx, store, P("vertex_deviation"),
-                                   es_embedder_vertex_deviation(emb), nv)) != ES_OK))
+        (rc = es_store_put_vector(ctx, store, P("vertex_closure"), vclos, nv)) != ES_OK ||
+        (rc = es_store_put_vector(ctx, store, P("vertex_edge_error"), verr, nv)) != ES_OK ||
+        (vdev && (rc = es_store_put_vector(ctx, store, P("vertex_deviation"), vdev, nv)) !=
+                     ES_OK))
         return rc;
     tn = es__alloc_array(ctx, ne, sizeof *tn);
     if (!tn) return ES_ENOMEM;

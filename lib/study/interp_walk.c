@@ -251,6 +251,11 @@ es_status es_study_interp(es_ctx *ctx, es_store *store, const es_study_interp_op
         wk.o = &one;
     }
     if ((rc = es_store_mesh(ctx, store, &mesh)) != ES_OK) return rc;
+    if (o->method != ES_MORPH_EDGE_LENGTH) {   /* the other papers' (interp_methods.c) */
+        rc = es__study_interp_method(ctx, store, o, mesh, wk.name);
+        es_mesh_free(mesh);
+        return rc;
+    }
     wk.mesh = mesh;
     if (!(res = es__alloc_array(ctx, 3 * es_mesh_nverts(mesh), sizeof *res))) rc = ES_ENOMEM;
     if (rc == ES_OK) rc = es_embedder_new(ctx, mesh, &wk.emb);

@@ -70,5 +70,20 @@ ES__TABLE(es__t_model_permutations);
 /* Store a model as model/<o->name> (model_results.c). */
 es_status es__model_save(es_ctx *ctx, es_store *s, const es_study_model_opts *o,
                          const es_study_model_result *r);
+/* ---- embeddings and interpolation by the other papers' methods ------------ */
+
+/* Store a mesh result as /analysis/embed/<name> (what es_study_store_embedding
+ * stores, with the per-vertex values given: vdev may be NULL). */
+es_status es__study_store_mesh_result(es_ctx *ctx, es_store *store, const char *name,
+                                      const es_provenance *prov, const es_mesh *mesh,
+                                      const double *vclos, const double *verr,
+                                      const double *vdev, const double *target,
+                                      const double *xyz, const es_embed_report *r,
+                                      const char *init);
+
+/* es_study_interp for opts->method other than edge-length, between two rows
+ * (interp_methods.c); name: the result name (without the frame suffix). */
+es_status es__study_interp_method(es_ctx *ctx, es_store *store, const es_study_interp_opts *o,
+                                  const es_mesh *mesh, const char *name);
 
 #endif

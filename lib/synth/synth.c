@@ -16,25 +16,27 @@
 
 #include <stdio.h>
 
-static const char *const family_names[] = {NULL, "barbell", "tube", "tube-closed", "face"};
+static const char *const family_names[] = {NULL,   "barbell",    "tube", "tube-closed",
+                                           "face", "tube-twist", "strip"};
 
 void es_synth_opts_init(es_synth_opts *o)
 {
     o->n = 0;
     o->resolution = 0;
     o->noise = -1;
+    o->span = 1;
 }
 
 const char *es_synth_family_name(es_synth_family f)
 {
-    return f >= ES_SYNTH_BARBELL && f <= ES_SYNTH_FACE ? family_names[f] : NULL;
+    return f >= ES_SYNTH_BARBELL && f <= ES_SYNTH_STRIP ? family_names[f] : NULL;
 }
 
 es_status es_synth_family_from_name(es_ctx *ctx, const char *name, es_synth_family *out)
 {
     /* Plural forms too: the issue and the paper say "barbells", "faces". */
     size_t n = name ? strlen(name) : 0;
-    for (int f = ES_SYNTH_BARBELL; f <= ES_SYNTH_FACE; f++) {
+    for (int f = ES_SYNTH_BARBELL; f <= ES_SYNTH_STRIP; f++) {
         size_t m = strlen(family_names[f]);
         if (name && (strcmp(name, family_names[f]) == 0 ||
                      (n == m + 1 && strncmp(name, family_names[f], m) == 0 && name[m] == 's'))) {
@@ -43,7 +45,8 @@ es_status es_synth_family_from_name(es_ctx *ctx, const char *name, es_synth_fami
         }
     }
     ES_FAIL(ctx, ES_ENOTFOUND,
-            "synth: unknown family '%s' (known: barbell, tube, tube-closed, face)",
+            "synth: unknown family '%s' (known: barbell, tube, tube-closed, face, "
+            "tube-twist, strip)",
             name ? name : "(null)");
 }
 
@@ -115,6 +118,8 @@ es_status es_synth_generate(es_ctx *ctx, es_synth_family family, const es_synth_
                 (long long)o.resolution);
     if (!(o.noise < 1) || o.noise != o.noise)
         ES_FAIL(ctx, ES_EINVAL, "synth: noise %g is not < 1", o.noise);
+    if (!(o.span > 0 && o.span <= 4))
+        ES_FAIL(ctx, ES_EINVAL, "synth: span %g is not in (0, 4]", o.span);
     switch (family) {
     case ES_SYNTH_BARBELL:
         if (o.n == 1) ES_FAIL(ctx, ES_EINVAL, "synth: barbell needs n >= 2 bar lengths");
@@ -122,7 +127,12 @@ es_status es_synth_generate(es_ctx *ctx, es_synth_family family, const es_synth_
         break;
     case ES_SYNTH_TUBE:
     case ES_SYNTH_TUBE_CLOSED:
-        rc = es__synth_tube(ctx, &o, family == ES_SYNTH_TUBE_CLOSED, out);
+    case ES_SYNTH_TUBE_TWIST:
+        rc = es__synth_tube(ctx, &o, family == ES_SYNTH_TUBE_CLOSED ? 1
+                                     : family == ES_SYNTH_TUBE_TWIST ? 2 : 0, out);
+        break;
+    case ES_SYNTH_STRIP:
+        rc = es__synth_strip(ctx, &o, out);
         break;
     case ES_SYNTH_FACE:
         rc = es__synth_face(ctx, &o, out);

@@ -19,7 +19,9 @@ es_status es__synth_str(es_ctx *ctx, char **slot, const char *fmt, ...) ES__PRIN
 
 /* Generators (synth_shapes.c); opts are already defaulted and checked. */
 es_status es__synth_barbell(es_ctx *ctx, const es_synth_opts *o, es_synth_set *s);
-es_status es__synth_tube(es_ctx *ctx, const es_synth_opts *o, int closed, es_synth_set *s);
+/* kind: 0 open tube, 1 closed (capped), 2 open elliptic tube bent and twisted */
+es_status es__synth_tube(es_ctx *ctx, const es_synth_opts *o, int kind, es_synth_set *s);
+es_status es__synth_strip(es_ctx *ctx, const es_synth_opts *o, es_synth_set *s);
 es_status es__synth_face(es_ctx *ctx, const es_synth_opts *o, es_synth_set *s);
 
 #endif

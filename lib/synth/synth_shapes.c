@@ -198,23 +198,40 @@ static void bend(double theta, double len, double s, double y, double z, double 
     out[2] = z;
 }
 
-es_status es__synth_tube(es_ctx *ctx, const es_synth_opts *o, int closed, es_synth_set *s)
+/* Point (s, y, z) of the straight tube along x with its cross-section
+ * turned by angle phi * s / len about the axis (the twist grows linearly
+ * along [0, len]), then bent. */
+static void twist_bend(double theta, double phi, double len, double s, double y, double z,
+                       double *out)
+{
+    double a = phi * (s < 0 ? 0 : s > len ? 1 : s / len), c = cos(a), sn = sin(a);
+    bend(theta, len, s, c * y - sn * z, sn * y + c * z, out);
+}
+
+es_status es__synth_tube(es_ctx *ctx, const es_synth_opts *o, int kind, es_synth_set *s)
 {
     const double r = 1.0, len = 8.0;
+    const int closed = kind == 1, twisted = kind == 2;
+    /* the twisted tube's cross-section is an ellipse (half-axes 1 and 0.5),
+     * so that its twist shows: a circle would turn into itself */
+    const double ry = r, rz = twisted ? 0.5 * r : r, phi_max = twisted ? 1.5 * M_PI : 0;
     int64_t res = o->resolution ? o->resolution : 8, n = o->n ? o->n : 7;
     /* at least 3 segments around: 2 would put two faces on each side of a ring edge */
     int64_t nseg = res < 2 ? 3 : 2 * res, nring = 4 * res + 1, ncap = closed ? (res + 1) / 2 : 0;
     int64_t nr = nring + 2 * ncap, nv = nr * nseg + (closed ? 2 : 0);
     int64_t nf = 2 * nseg * (nr - 1) + (closed ? 2 * nseg : 0);
-    es_status rc = es__synth_alloc(ctx, s, nv, nf, n, 1);
+    es_status rc = es__synth_alloc(ctx, s, nv, nf, n, twisted ? 2 : 1);
     if (rc != ES_OK) return rc;
     ring_faces(nr, nseg, closed, closed, s->faces);
-    if ((rc = es__synth_str(ctx, &s->label_names[0], "theta_deg")) != ES_OK) return rc;
+    if ((rc = es__synth_str(ctx, &s->label_names[0], "theta_deg")) != ES_OK ||
+        (twisted && (rc = es__synth_str(ctx, &s->label_names[1], "twist_deg")) != ES_OK))
+        return rc;
     es_rng rng;
     es_rng_init(&rng, es_ctx_seed(ctx));
     double noise = o->noise < 0 ? 0 : o->noise;
     for (int64_t i = 0; i < n; i++) {
-        double theta = n > 1 ? M_PI * (double)i / (double)(n - 1) : 0;
+        double frac = n > 1 ? o->span * (double)i / (double)(n - 1) : 0;
+        double theta = M_PI * frac, phi = phi_max * frac;
         double *x = s->xyz + 3 * nv * i;
         int64_t v = 0;
         if (closed) bend(theta, len, -r, 0, 0, x + 3 * v++);
@@ -234,14 +251,67 @@ es_status es__synth_tube(es_ctx *ctx, const es_synth_opts *o, int closed, es_syn
             }
             for (int64_t j = 0; j < nseg; j++) {
                 double ph = 2 * M_PI * (double)j / (double)nseg;
-                bend(theta, len, sk, rad * cos(ph), rad * sin(ph), x + 3 * v++);
+                twist_bend(theta, phi, len, sk, rad / r * ry * cos(ph), rad / r * rz * sin(ph),
+                           x + 3 * v++);
             }
         }
         if (closed) bend(theta, len, len + r, 0, 0, x + 3 * v++);
         add_noise(&rng, x, nv, noise * len);
-        if ((rc = es__synth_str(ctx, &s->names[i], "%s_%03lld", closed ? "tubec" : "tube",
-                                (long long)i)) ||
-            (rc = es__synth_str(ctx, &s->labels[i], "%.6g", theta * 180 / M_PI)))
+        if ((rc = es__synth_str(ctx, &s->names[i], "%s_%03lld",
+                                closed ? "tubec" : twisted ? "tubetw" : "tube", (long long)i)) ||
+            (rc = es__synth_str(ctx, &s->labels[(twisted ? 2 : 1) * i], "%.6g",
+                                theta * 180 / M_PI)) ||
+            (twisted && (rc = es__synth_str(ctx, &s->labels[2 * i + 1], "%.6g",
+                                            phi * 180 / M_PI))))
+            return rc;
+    }
+    return ES_OK;
+}
+
+/* ---- a triangulated 3D polygon ---- */
+
+es_status es__synth_strip(es_ctx *ctx, const es_synth_opts *o, es_synth_set *s)
+{
+    /* Wuhrer et al.'s Fig. 6: the curve y = a sin x, x in [0, 2 pi], given
+     * thickness 2 along z: two rows of vertices zipped into triangles, so
+     * the dual graph is a path; a = 1 - 2 s from 1 to -1. Thicker than the
+     * curve's spread in y, so that the best rigid alignment of a = 1 to
+     * a = -1 is the identity and not the turn about x that flips z (which
+     * makes every pair of face normals antipodal, where SLERP has no path) */
+    const double h = 2.0;
+    int64_t res = o->resolution ? o->resolution : 8, n = o->n ? o->n : 2, nseg = 4 * res;
+    int64_t nv = 2 * (nseg + 1), nf = 2 * nseg;
+    es_status rc = es__synth_alloc(ctx, s, nv, nf, n, 1);
+    if (rc != ES_OK) return rc;
+    for (int64_t j = 0; j < nseg; j++) {
+        int64_t a0 = 2 * j, a1 = a0 + 1, b0 = a0 + 2, b1 = a0 + 3, *t = s->faces + 6 * j;
+        /* alternate the diagonal, as a polygon triangulation may */
+        if (j % 2 == 0) {
+            t[0] = a0; t[1] = b0; t[2] = b1;
+            t[3] = a0; t[4] = b1; t[5] = a1;
+        } else {
+            t[0] = a0; t[1] = b0; t[2] = a1;
+            t[3] = a1; t[4] = b0; t[5] = b1;
+        }
+    }
+    if ((rc = es__synth_str(ctx, &s->label_names[0], "amplitude")) != ES_OK) return rc;
+    es_rng rng;
+    es_rng_init(&rng, es_ctx_seed(ctx));
+    double noise = o->noise < 0 ? 0 : o->noise;
+    for (int64_t i = 0; i < n; i++) {
+        double frac = n > 1 ? o->span * (double)i / (double)(n - 1) : 0, amp = 1 - 2 * frac;
+        double *x = s->xyz + 3 * nv * i;
+        for (int64_t j = 0; j <= nseg; j++) {
+            double u = 2 * M_PI * (double)j / (double)nseg;
+            for (int k = 0; k < 2; k++) {
+                x[3 * (2 * j + k)] = u;
+                x[3 * (2 * j + k) + 1] = amp * sin(u);
+                x[3 * (2 * j + k) + 2] = k * h;
+            }
+        }
+        add_noise(&rng, x, nv, noise * 2 * M_PI);
+        if ((rc = es__synth_str(ctx, &s->names[i], "strip_%03lld", (long long)i)) ||
+            (rc = es__synth_str(ctx, &s->labels[i], "%.6g", amp)))
             return rc;
     }
     return ES_OK;

@@ -4,9 +4,9 @@ from the sources on every test run:
 
   1. lib/<module>/ includes only modules at or below its own place in the data
      flow (core < mesh < meshio < store < ingest < stats < procrustes < embed <
-     study < figure, synth), whether through their library-private headers or
+     morph < study < figure, synth), whether through their library-private headers or
      their public headers; siblings (figure, synth) do not include each other;
-     the numerical modules (stats, procrustes, embed) take arrays and row
+     the numerical modules (stats, procrustes, embed, morph) take arrays and row
      callbacks and do not include the store at all;
   2. a package header (<module>/<module>_pkg.h) is included only by its own
      module (and carries the #error guard that enforces it at compile time);
@@ -23,7 +23,7 @@ import re
 import sys
 
 ORDER = ["core", "mesh", "meshio", "store", "ingest", "stats", "procrustes", "embed",
-         "study", "figure", "synth"]
+         "morph", "study", "figure", "synth"]
 LEVEL = {m: i for i, m in enumerate(ORDER)}
 LEVEL["synth"] = LEVEL["figure"]          # beside figure, above study
 PUBLIC = {
@@ -32,6 +32,7 @@ PUBLIC = {
     "es_stats.h": "stats", "es_point.h": "stats", "es_model.h": "stats",
     "es_procrustes.h": "procrustes",
     "es_compare.h": "procrustes", "es_embed.h": "embed", "es_interp.h": "embed",
+    "es_morph.h": "morph",
     "es_study.h": "study", "es_plot.h": "figure", "es_render.h": "figure",
     "es_figure.h": "figure", "es_synth.h": "synth",
 }
@@ -54,7 +55,7 @@ def nlines(path):
         return sum(1 for _ in f)
 
 
-NUMERIC = {"stats", "procrustes", "embed"}
+NUMERIC = {"stats", "procrustes", "embed", "morph"}
 
 
 def may_include(own, target):

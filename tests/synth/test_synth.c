@@ -1,7 +1,8 @@
 /* tests/synth/test_synth.c — synthetic families and subdivision: members share
  * one valid face list with the expected topology, faces point outward,
  * seeded runs are identical, the barbells reproduce the paper's Fig. 7
- * finding in Procrustes space, the bent tubes bend by theta, subdivision
+ * finding in Procrustes space, the bent tubes bend by theta, the twisted
+ * tube twists by 270 degrees, the strip is a triangulated polygon, subdivision
  * gives V + E vertices and 4F faces whose sides are half their parents',
  * and the files written (and the `edgespace synth` command) are right.
  */
@@ -229,6 +230,75 @@ static void test_tubes(es_ctx *ctx)
         es_mesh_free(m);
         es_synth_set_clear(ctx, &s);
     }
+}
+
+/* The families made for the other papers' claims: the bent and twisted
+ * elliptic tube (its far ring turned by 270 degrees about the end tangent,
+ * span 2 continuing the same family) and the triangulated polygon strip
+ * (a tree as dual graph, the two members mirror images of each other). */
+static void test_twist_strip(es_ctx *ctx)
+{
+    es_synth_set s, t;
+    es_synth_opts o;
+    es_mesh *m;
+    ES_CHECK_OK(ctx, es_synth_generate(ctx, ES_SYNTH_TUBE_TWIST, NULL, &s));
+    if (s.xyz) {
+        const int64_t nseg = 16, nring = 33;
+        const double *x = s.xyz + 3 * s.nverts * 6, *v0 = x + 3 * (nring - 1) * nseg;
+        double c[3] = {0, 0, 0};
+        ES_CHECK(s.nmembers == 7 && s.nlabels == 2 && !strcmp(s.label_names[1], "twist_deg"));
+        ES_CHECK(!strcmp(s.labels[12], "180") && !strcmp(s.labels[13], "270"));
+        ES_CHECK(!strcmp(es_synth_family_name(ES_SYNTH_TUBE_TWIST), "tube-twist"));
+        m = topology(ctx, &s);
+        if (m) {
+            check_topology(m, 2, 0);
+            check_members(ctx, &s, m, 5);
+        }
+        es_mesh_free(m);
+        /* bent by pi: the end ring's centre at (0, 16/pi, 0), its tangent -x,
+         * the bend normal -y; the major axis (vertex 0 of the ring, at +y
+         * untwisted) turned by 270 degrees about the tangent lies along -z */
+        for (int64_t j = 0; j < nseg; j++)
+            for (int k = 0; k < 3; k++) c[k] += v0[3 * j + k] / (double)nseg;
+        ES_CHECK_CLOSE(c[1], 16 / M_PI, 1e-12, 0);
+        ES_CHECK_CLOSE(v0[0] - c[0], 0.0, 0, 1e-12);
+        ES_CHECK_CLOSE(v0[1] - c[1], 0.0, 0, 1e-12);
+        ES_CHECK_CLOSE(v0[2] - c[2], -1.0, 0, 1e-12);
+        es_synth_opts_init(&o);
+        o.n = 3;
+        o.span = 2;
+        ES_CHECK_OK(ctx, es_synth_generate(ctx, ES_SYNTH_TUBE_TWIST, &o, &t));
+        if (t.xyz) {
+            ES_CHECK(!strcmp(t.labels[4], "360") && !strcmp(t.labels[5], "540"));
+            ES_CHECK(memcmp(t.xyz + 3 * t.nverts, x, 3 * (size_t)s.nverts * sizeof *x) == 0);
+        }
+        es_synth_set_clear(ctx, &t);
+    }
+    es_synth_set_clear(ctx, &s);
+    es_synth_opts_init(&o);
+    o.span = 0;
+    ES_CHECK_FAILS(ctx, es_synth_generate(ctx, ES_SYNTH_TUBE, &o, &s), ES_EINVAL, "span");
+
+    ES_CHECK_OK(ctx, es_synth_generate(ctx, ES_SYNTH_STRIP, NULL, &s));
+    if (s.xyz) {
+        ES_CHECK(s.nmembers == 2 && !strcmp(s.labels[0], "1") && !strcmp(s.labels[1], "-1"));
+        m = topology(ctx, &s);
+        if (m) {
+            const int64_t *ef = es_mesh_edge_faces(m);
+            int64_t ne = es_mesh_nedges(m), interior = 0;
+            double *la = malloc((size_t)ne * sizeof *la), *lb = malloc((size_t)ne * sizeof *lb);
+            check_topology(m, 1, 0);
+            check_members(ctx, &s, m, 5);
+            for (int64_t e = 0; e < ne; e++) interior += ef[2 * e] >= 0 && ef[2 * e + 1] >= 0;
+            ES_CHECK(interior == s.nfaces - 1);   /* a connected dual graph with F - 1 arcs: a tree */
+            ES_CHECK_OK(ctx, es_edge_lengths(ctx, m, s.xyz, la));
+            ES_CHECK_OK(ctx, es_edge_lengths(ctx, m, s.xyz + 3 * s.nverts, lb));
+            for (int64_t e = 0; e < ne; e++) ES_CHECK_CLOSE(la[e], lb[e], 1e-14, 0);
+            free(la), free(lb);
+        }
+        es_mesh_free(m);
+    }
+    es_synth_set_clear(ctx, &s);
 }
 
 static void test_face(es_ctx *ctx)
@@ -565,6 +635,7 @@ int main(void)
     if (es_ctx_new(&ctx) != ES_OK) return 1;
     test_barbell(ctx);
     test_tubes(ctx);
+    test_twist_strip(ctx);
     test_face(ctx);
     test_subdivide(ctx);
     test_files(ctx);

@@ -1,5 +1,6 @@
-/* tests/tools/test_embed_cli.c — the embed and interp commands: --help, exit
- * statuses (0 ok, 1 failure, 2 usage), what they print, write and store. */
+/* tests/tools/test_embed_cli.c — the embed and interp commands (interp
+ * --method too): --help, exit statuses (0 ok, 1 failure, 2 usage), what
+ * they print, write and store. */
 #include "es_test.h"
 #include "es_test_files.h"
 #include "es_test_meshes.h"
@@ -35,6 +36,51 @@ static void check_frames_do_not_jump(const char *dir, const char *stem, int widt
     }
     if (ctx) es_meshdata_clear(ctx, &prev);
     es_ctx_free(ctx);
+}
+
+/* interp --method: the other papers' methods walk between two rows, write
+ * every frame, print reports and store them like the default (the ends
+ * reproduce the rows: RMS ratio < 1e-8, "init" names the method); an
+ * unknown method is a usage error listing the known ones, and a method
+ * that walks between rows refuses a mean. */
+static void check_methods(const char *dir, const char *store)
+{
+    static es_test_out r;
+    static const char *const methods[] = {"multiscale", "shape-space", "data-driven"};
+    char pat[4400], p[4400], name[64], buf[256];
+    for (int m = 0; m < 3; m++) {
+        snprintf(pat, sizeof pat, "%s/m%d_%%02d.obj", dir, m);
+        snprintf(name, sizeof name, "m%d", m);
+        ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-1", "--steps",
+               "3", "--method", methods[m], "-o", pat, "--name", name);
+        ES_CHECK_MSG(r.status == 0 && strstr(r.out, methods[m]) && strstr(r.out, "RMS ratio") &&
+                         strstr(r.out, "stored: /analysis/embed/"),
+                     "interp --method %s: %d %s %s", methods[m], r.status, r.out, r.err);
+        for (int i = 0; i < 3; i++) {
+            snprintf(p, sizeof p, "%s/m%d_%02d.obj", dir, m, i);
+            ES_CHECK_MSG(access(p, F_OK) == 0, "missing %s", p);
+        }
+        es_ctx *ctx = NULL;
+        es_store *s = NULL;
+        ES_CHECK(es_ctx_new(&ctx) == ES_OK);
+        if (ctx) ES_CHECK_OK(ctx, es_store_open(ctx, store, ES_STORE_READ, &s));
+        for (int i = 0; s && i < 3; i += 2) {
+            char path[96];
+            snprintf(path, sizeof path, "embed/m%d_%02d", m, i);
+            ES_CHECK_OK(ctx, es_store_get_attr(ctx, s, path, "rms_ratio", buf, sizeof buf));
+            ES_CHECK_MSG(atof(buf) < 1e-8, "%s %s: end frame RMS ratio %s", methods[m], path, buf);
+            ES_CHECK_OK(ctx, es_store_get_attr(ctx, s, path, "init", buf, sizeof buf));
+            ES_CHECK_MSG(strcmp(buf, methods[m]) == 0, "%s: init '%s'", path, buf);
+        }
+        es_store_close(s);
+        es_ctx_free(ctx);
+    }
+    ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-1", "--method",
+           "sideways", "-o", pat);
+    ES_CHECK_MSG(r.status == 2 && strstr(r.err, "known: edge-length"), "%d %s", r.status, r.err);
+    ES_RUN(&r, dir, "interp", store, "--from", "mean", "--to", "row:mesh-1", "--method",
+           "multiscale", "-o", pat, "--no-store");
+    ES_CHECK_MSG(r.status == 1 && strstr(r.err, "row:ID"), "%d %s", r.status, r.err);
 }
 
 int main(void)
@@ -210,6 +256,8 @@ int main(void)
     ES_CHECK(r.status == 1 && strstr(r.err, "nope"));
     ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-1", "-o", out);
     ES_CHECK(r.status == 2 && strstr(r.err, "pattern"));
+
+    check_methods(dir, store);
 
     /* embed a stored row from the nearest other start, and from a given row */
     snprintf(out, sizeof out, "%s/e.obj", dir);

@@ -41,6 +41,12 @@ static const char usage[] =
     "                       (default 0.0025; 0: the prior only starts and frames it)\n"
     "      --refine-iters N  refinement iterations per frame (default 12)\n"
     "      --replace         replace a stored result of that name (else refused)\n"
+    "  -m, --method M        edge-length (default: the above), or another paper's\n"
+    "                        way between two rows (--from/--to row:ID):\n"
+    "                        multiscale (Winkler et al. 2010), shape-space (Wuhrer\n"
+    "                        et al. 2010), each frame put together by the method,\n"
+    "                        in A's frame; data-driven (Gao et al. 2017): a path\n"
+    "                        through the store's rows, each frame embedded as above\n"
     "  -h, --help            show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -83,6 +89,7 @@ int cmd_interp(int argc, char **argv)
         {"no-store", no_argument, NULL, 'N'},   {"replace", no_argument, NULL, 'X'},
         {"help", no_argument, NULL, 'h'},       {"bending", required_argument, NULL, 'B'},
         {"refine-iters", required_argument, NULL, 'R'}, {"pca", required_argument, NULL, 'c'},
+        {"method", required_argument, NULL, 'm'},
         {NULL, 0, NULL, 0}};
     es_study_interp_opts o;
     es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
@@ -92,9 +99,10 @@ int cmd_interp(int argc, char **argv)
     es_store *s = NULL;
     es_status rc;
     char *cmd = NULL;
+    const char *method = NULL;
     es_study_interp_opts_init(&o);
     optind = 1;
-    while ((c = getopt_long(argc, argv, "f:t:k:w:o:n:h", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "f:t:k:w:o:n:m:h", longopts, NULL)) != -1) {
         switch (c) {
         case 'f': o.from = optarg; break;
         case 't': o.to = optarg; break;
@@ -110,6 +118,7 @@ int cmd_interp(int argc, char **argv)
             break;
         case 'w': o.weights = optarg; break;
         case 'c': o.pca_name = optarg; break;
+        case 'm': method = optarg; break;
         case 'o': o.output = optarg; break;
         case 'n': o.name = optarg; break;
         case 'N': store_it = 0; break;
@@ -146,6 +155,11 @@ int cmd_interp(int argc, char **argv)
         es_ctx_free(ctx);
         return cli_usage_error("interp", "--weights wants 'w1*row:a + w2*row:b ...' with two "
                                "or more rows");
+    }
+    if (method && es_morph_method_from_name(ctx, method, &o.method) != ES_OK) {
+        rc = cli_usage_error("interp", "%s", es_ctx_errmsg(ctx));
+        es_ctx_free(ctx);
+        return (int)rc;
     }
     o.frame = print_frame;
     if (store_it && !(cmd = cli_command_line(argc, argv))) {

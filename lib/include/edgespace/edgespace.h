@@ -20,6 +20,7 @@
 #include "es_compare.h"
 #include "es_embed.h"       /* embed */
 #include "es_interp.h"
+#include "es_morph.h"        /* morph */
 #include "es_study.h"       /* study */
 #include "es_synth.h"       /* synth */
 #if ES_HAVE_FIGURES

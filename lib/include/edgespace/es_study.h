@@ -32,6 +32,7 @@
 #include "es_procrustes.h"
 #include "es_compare.h"
 #include "es_model.h"
+#include "es_morph.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -410,6 +411,15 @@ typedef struct es_study_interp_opts {
                                base name without the conversion) */
     const char *command;    /* provenance; NULL: store nothing */
     es_embed_opts embed;
+    es_morph_method method; /* ES_MORPH_EDGE_LENGTH (the default: the above); the other
+                               papers' (es_morph.h) walk between two rows (from and to
+                               "row:ID"): multiscale and shape-space put each frame
+                               together themselves (positions in row A's frame);
+                               data-driven follows a path through the store's rows
+                               (es_data_path on their edge-length PCA scores, frames
+                               evenly along it, t0 and t1 0 and 1) and embeds each
+                               frame as the point of its row weights, like the
+                               default */
     es_study_frame_fn frame;   /* called after each frame (may be NULL) */
     void *userdata;
 } es_study_interp_opts;

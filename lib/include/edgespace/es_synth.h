@@ -15,6 +15,13 @@
  *    4 boundary loops), n subjects x {neutral, happy, angry}; subjects are
  *    random smooth bumps plus scale and rigid motion, expressions a fixed
  *    displacement field at a per-subject intensity in [0.6, 1.0].
+ *  - ES_SYNTH_TUBE_TWIST: an open tube of elliptic cross-section (half-axes
+ *    1 and 0.5) bent by s x 180 degrees and twisted about its axis by
+ *    s x 270 degrees (growing along its length), s = 0 .. 1 over n members:
+ *    a rotation past 180 degrees (Winkler et al. 2010, Figs. 1, 6, 10).
+ *  - ES_SYNTH_STRIP: a triangulated 3D polygon (a strip; its dual graph is a
+ *    path): the curve y = a sin x, x in [0, 2 pi], 2 thick along z, a
+ *    from 1 to -1 over n members (n = 2: Wuhrer et al. 2010, Fig. 6).
  * Randomness comes from the context's seed (es_ctx_set_seed): same seed,
  * same set, bit for bit.
  */
@@ -31,7 +38,9 @@ typedef enum es_synth_family {
     ES_SYNTH_BARBELL = 1,
     ES_SYNTH_TUBE,
     ES_SYNTH_TUBE_CLOSED,
-    ES_SYNTH_FACE
+    ES_SYNTH_FACE,
+    ES_SYNTH_TUBE_TWIST,
+    ES_SYNTH_STRIP
 } es_synth_family;
 
 typedef struct es_synth_opts {
@@ -40,6 +49,9 @@ typedef struct es_synth_opts {
     int64_t resolution; /* mesh density, 1 .. 64; 0 = the family's default */
     double noise;       /* per-vertex Gaussian noise, sd relative to the shape's
                            size; < 0 = family default (0, face: 1e-4) */
+    double span;        /* tubes and strip: members run s = 0 .. span, where s = 1
+                           is the family's largest deformation (1; up to 4: s = 2
+                           is a tube bent twice as far, for extrapolation) */
 } es_synth_opts;
 
 /* A generated family. All arrays are allocated through the context that
@@ -55,7 +67,8 @@ typedef struct es_synth_set {
 
 ES_API void es_synth_opts_init(es_synth_opts *opts);
 
-/* Family from its name ("barbell", "tube", "tube-closed", "face").
+/* Family from its name ("barbell", "tube", "tube-closed", "face",
+ * "tube-twist", "strip").
  * ES_ENOTFOUND for an unknown name (the message lists the known ones). */
 ES_API es_status es_synth_family_from_name(es_ctx *ctx, const char *name,
                                            es_synth_family *out);

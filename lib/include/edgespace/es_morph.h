@@ -1,0 +1,265 @@
+/* lib/include/edgespace/es_morph.h — the other papers' ways between shapes,
+ * beside the project's own (edge-length interpolation, each frame embedded:
+ * es_interp.h, es_embed.h), on the same topology and arrays:
+ *
+ *  - multi-scale geometry interpolation (Winkler, Drieseberg, Alexa and
+ *    Hormann 2010, ../shared/papers/multi-scale-geometry-interpolation):
+ *    lengths and dihedrals interpolated per wedge, the mesh put together
+ *    from a hierarchy of overlapping patches by multi-registration and
+ *    least-squares blending, one factorization per patch and topology;
+ *  - morphing in shape space (Wuhrer, Bose, Shu, O'Rourke and Brunton
+ *    2010, morphing-triangular-meshes-in-shape-space): lengths interpolated
+ *    linearly and face normals by SLERP, the mesh rebuilt by walking a
+ *    minimum spanning tree of the dual graph, averaging the candidate
+ *    positions of each vertex;
+ *  - data-driven paths (Gao, Chen, Lai and Xia 2017,
+ *    data-driven-shape-interpolation): a path through a collection of
+ *    example shapes (a K-nearest-neighbour graph, Dijkstra, then an
+ *    iterative smoothing that keeps it near the examples), each point of
+ *    it a combination of the examples;
+ *
+ * Where a paper is silent the choice made is written at the function. The
+ * quality of a mesh made by any of them is measured as the embedder's
+ * (es_morph_report fills an es_embed_report), so the methods compare on one
+ * scale.
+ */
+#ifndef EDGESPACE_ES_MORPH_H
+#define EDGESPACE_ES_MORPH_H
+
+#include "es_core.h"
+#include "es_mesh.h"
+#include "es_embed.h"
+#include "es_interp.h"
+
+/* ---- data-driven paths (Gao et al. 2017) -------------------------------------
+ * A path from example src to example dst through a collection of n
+ * examples, given by their coordinates x (dim x n, column-major, leading
+ * dimension ldx; the caller's: edgespace uses the rows' edge-length PCA
+ * scores with every component, where distances are those of the lengths):
+ *  1. the K-nearest-neighbour graph of the examples (L2), made connected
+ *     by adding the shortest arc between the part holding example 0 and
+ *     the rest, again until one part is left (Sec. 3.2.1, "similar to
+ *     Prim's algorithm");
+ *  2. Dijkstra from src to dst on it, the polyline resampled evenly by
+ *     length to `samples` points (the ends held);
+ *  3. iterations of eq. 2: each inner sample pulled toward its k~ nearest
+ *     examples with weights exp(-distance / sigma), gamma times the squared
+ *     lengths of the path's segments, lambda times its Laplacian (the
+ *     paper's weights, L(i, i-1) = -d_{i-1} / (d_{i-1} + d_i), which at a
+ *     fixed point are the uniform Laplacian, so the samples spread evenly),
+ *     delta times the distance from the previous iterate; one SPD solve
+ *     per iteration, until the mean move of a sample is below eps or
+ *     max_iter;
+ *  4. the path resampled evenly by length to nframes frames (Sec. 3.2.3).
+ * The paper's sigma, gamma, lambda, delta and eps (0.01, 0.01, 100, 1e-4,
+ * 1e-3) are in its coordinates' units, which it does not state; here the
+ * coordinates are measured in `scale`, the mean length of the graph's
+ * K-nearest-neighbour arcs, and sigma defaults to 1 of it (0.01 of it
+ * left every weight below e^-50: a straight line). */
+typedef struct es_data_path_opts {
+    int64_t knn;        /* K: neighbours of each example in the graph (6) */
+    int64_t near;       /* k~: examples pulling each sample (6) */
+    int64_t samples;    /* points of the path while it is optimized (200) */
+    double sigma;       /* weight fall-off, in units of scale (1) */
+    double gamma;       /* segment lengths (0.01) */
+    double lambda;      /* Laplacian (100) */
+    double delta;       /* distance from the previous iterate (1e-4) */
+    double eps;         /* convergence: mean move of a sample, in scale (1e-3) */
+    int max_iter;       /* (200) */
+} es_data_path_opts;
+
+ES_API void es_data_path_opts_init(es_data_path_opts *opts);
+
+typedef struct es_data_path_info {
+    double scale;           /* the unit: mean length of a K-nearest-neighbour arc */
+    int64_t arcs;           /* arcs of the connected graph (undirected) */
+    int64_t bridges;        /* of them added to connect it */
+    int64_t hops;           /* examples on the Dijkstra path, ends included */
+    double graph_length;    /* its length (coordinates' units) */
+    double length;          /* length of the optimized path */
+    int iterations, converged;
+    /* distance from a frame to its nearest example, in units of scale:
+     * along the path and along the straight line src -> dst (as many
+     * frames, evenly spaced) */
+    double mean_near, max_near, line_mean_near, line_max_near;
+} es_data_path_info;
+
+/* Frames (dim x nframes, column-major) of the path from src to dst; frame
+ * 0 is example src and frame nframes - 1 example dst, exactly. weights
+ * (n x nframes, may be NULL): each frame as an affine combination of the
+ * examples (sum 1, least norm; exact when the frame lies in their affine
+ * span, as it does in PCA scores with every component), which is how
+ * edgespace turns a frame into lengths. info may be NULL. ES_EINVAL on
+ * src == dst or out of range, n < 2, nframes < 2, non-finite coordinates or
+ * options out of range. */
+ES_API es_status es_data_path(es_ctx *ctx, int64_t dim, int64_t n, const double *x,
+                              int64_t ldx, int64_t src, int64_t dst,
+                              const es_data_path_opts *opts, int64_t nframes, double *frames,
+                              double *weights, es_data_path_info *info);
+
+/* Coordinates for es_data_path from long vectors (dim x n, leading
+ * dimension ldx, e.g. the rows' normalized edge lengths): the examples'
+ * principal component scores with every component, by classical scaling
+ * of their centred Gram matrix (n x n: cheap for a store's rows however
+ * many edges), so that distances between them are those of the vectors.
+ * coords: n x n (column j = example j; the first *ncoord rows used, the
+ * components whose eigenvalue exceeds 1e-12 of the largest). */
+ES_API es_status es_data_path_coords(es_ctx *ctx, int64_t dim, int64_t n, const double *x,
+                                     int64_t ldx, double *coords, int64_t *ncoord);
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The interpolation methods `edgespace interp --method` offers. */
+typedef enum es_morph_method {
+    ES_MORPH_EDGE_LENGTH = 0,   /* the project's: lengths interpolated, each frame embedded */
+    ES_MORPH_MULTISCALE,        /* Winkler et al. 2010 */
+    ES_MORPH_SHAPE_SPACE,       /* Wuhrer et al. 2010 */
+    ES_MORPH_DATA_DRIVEN        /* Gao et al. 2017, each frame embedded */
+} es_morph_method;
+
+/* "edge-length", "multiscale", "shape-space", "data-driven". */
+ES_API const char *es_morph_method_name(es_morph_method method);
+/* The method of a name; ES_ENOTFOUND lists the known names. */
+ES_API es_status es_morph_method_from_name(es_ctx *ctx, const char *name,
+                                           es_morph_method *out);
+
+/* ---- the quality of a mesh ----------------------------------------------------
+ * How well positions xyz (3 x V) realize target lengths (E), on the
+ * embedder's scale: rms_ratio, max_rel, p99_rel, worst_edge, n_bad_faces
+ * (target faces breaking the triangle inequality), scale (sum of the
+ * target), realized (max_rel <= realized_rtol and no bad face), and
+ * closure_after (eq. 3 at the output's dihedrals and the target's corner
+ * angles); the iteration and stage fields are 0 and t_total is left as
+ * the caller set it. vertex_closure and vertex_edge_error (V each, may be
+ * NULL) get what es_embedder_vertex_closure / _edge_error give for an
+ * embedding. */
+ES_API es_status es_morph_report(es_ctx *ctx, const es_mesh *mesh, const double *target,
+                                 const double *xyz, double realized_rtol,
+                                 es_embed_report *report, double *vertex_closure,
+                                 double *vertex_edge_error);
+
+/* ---- multi-scale geometry interpolation (Winkler et al. 2010) ----------------
+ * Preprocessing (es_multiscale_new, once per topology): the mesh is split
+ * into `patches` overlapping patches by region growing from random seed
+ * faces (the context's seed), each patch in turn, until a patch has at most
+ * leaf_faces faces (Sec. 3.3); neighbouring patches overlap by the faces
+ * along their common border (each part grown by the faces across its
+ * border edges: the paper's "strip of width one" on each side). Every
+ * inner patch's blending matrix M^T M (Sec. 3.2, eq. 2; one row per edge
+ * and occurrence in a child, one vertex per connected piece held) depends
+ * on the topology only and is factorized here.
+ * A solve (es_multiscale_solve) from target lengths l and dihedrals alpha
+ * (E each, es_geom.h's signed bending angle; boundary edges ignored):
+ *  1. leaves: the faces glued greedily along a breadth-first walk of the
+ *     patch's faces, each new face placed by its three lengths and its
+ *     dihedral with the face it is reached from (a vertex already placed
+ *     keeps its place; the blending above evens such gaps out, Sec. 3.3);
+ *  2. each inner patch, bottom up: its children registered simultaneously
+ *     (Williams and Bennamoun 2000: the translations eliminated in closed
+ *     form, one 3 x 3 polar decomposition per child and pass; the first
+ *     child fixed). The paper starts every rotation at the identity; here
+ *     each child is first placed by Kabsch onto the children placed before
+ *     it, always the one sharing most vertices with them next, because the
+ *     leaves' frames are arbitrary and 4 passes from the identity left
+ *     deep hierarchies visibly unregistered (a mesh's own lengths and
+ *     dihedrals came back 7 % of its diagonal off; placed first: 1e-12).
+ *     Then `passes` passes over all (Sec. 3.1: 4), then the children are
+ *     blended by least squares on the edges with their directions and the
+ *     target lengths (eq. 3);
+ *  3. the root patch is the mesh.
+ * Vertices in no face come out at the origin. The output's placement and
+ * orientation are arbitrary (those of the first leaf): align it. */
+typedef struct es_multiscale es_multiscale;
+
+typedef struct es_multiscale_opts {
+    int64_t patches;      /* children per patch, m (6, the paper's choice) */
+    int64_t leaf_faces;   /* a patch of at most this many faces is a leaf (0: m) */
+    int passes;           /* registration passes after the first (4, Sec. 3.1) */
+} es_multiscale_opts;
+
+ES_API void es_multiscale_opts_init(es_multiscale_opts *opts);
+
+typedef struct es_multiscale_info {
+    int64_t levels;         /* depth of the hierarchy (the root is level 0) */
+    int64_t nodes, leaves;  /* patches in all, of them leaves */
+    int64_t max_leaf;       /* faces in the largest leaf */
+    double t_split;         /* preprocessing: building the hierarchy (s) */
+    double t_factor;        /* preprocessing: factorizing the blending matrices (s) */
+    double t_leaves;        /* last solve: gluing the leaves (s) */
+    double t_register;      /* last solve: multi-registration (s) */
+    double t_blend;         /* last solve: blending (s) */
+} es_multiscale_info;
+
+/* Build the hierarchy of `mesh` (borrowed; must outlive the object). opts
+ * NULL: defaults. ES_EINVAL on a mesh without faces or options out of range
+ * (patches < 2, passes < 0). */
+ES_API es_status es_multiscale_new(es_ctx *ctx, const es_mesh *mesh,
+                                   const es_multiscale_opts *opts, es_multiscale **out);
+ES_API void es_multiscale_free(es_multiscale *ms);
+ES_API void es_multiscale_get_info(const es_multiscale *ms, es_multiscale_info *info);
+
+/* Positions xyz (3 x V) from target lengths len (E, positive) and dihedrals
+ * alpha (E). ES_EINVAL names an edge whose length is not finite and
+ * positive or whose dihedral is not finite. */
+ES_API es_status es_multiscale_solve(es_ctx *ctx, es_multiscale *ms, const double *len,
+                                     const double *alpha, double *xyz);
+
+/* Interpolate nin inputs (positions 3 x V each) with weights w as Winkler
+ * et al. do (Sec. 3, 3.4): lengths and dihedrals as es_interp_targets makes
+ * them (the weighted mean of the scale-normalized lengths at the weighted
+ * mean scale; dihedrals along the shortest arc), solved, and rigidly
+ * aligned (each connected component) to align_to (NULL: input r, the one
+ * of largest weight). Weights outside [0, 1] extrapolate (Sec. 3.5) while
+ * every length stays positive. info may be NULL. */
+ES_API es_status es_multiscale_interp(es_ctx *ctx, es_multiscale *ms, int64_t nin,
+                                      const double *const *xyz, const double *w,
+                                      const double *align_to, double *out,
+                                      es_interp_info *info);
+
+/* ---- morphing in shape space (Wuhrer et al. 2010) ----------------------------
+ * Two poses A and B (B rigidly aligned to A first, each connected component
+ * on its own, as Sec. 3 and 5 do) are points of a shape space of edge
+ * lengths and unit face normals; frame t has lengths (1 - t) l_A + t l_B
+ * (or the caller's) and normals SLERPed from A's to B's (an antipodal pair
+ * turns about the face's first edge). The mesh is rebuilt by walking a
+ * minimum spanning tree of the dual graph (arc weight: the change of the
+ * dihedral across the edge from A to B, Sec. 5) depth first from the face
+ * of each component's first vertex and first edge, whose position and
+ * direction are interpolated linearly and by SLERP. Crossing an arc from a
+ * placed face, the new face's third vertex gets candidate positions from
+ * the latest candidate of the shared edge's more recently updated end and
+ * every candidate of the other (the averaging algorithm, Sec. 6), each
+ * placed by the face's lengths in the plane of its normal (on the line of
+ * the two candidates, centred at their midpoint); a vertex ends at the mean
+ * of its candidates. On a triangulated polygon (the dual graph a tree)
+ * every vertex has one candidate and frame t realizes its lengths exactly
+ * (Theorem 1). Vertices in no face come out at the origin. */
+typedef struct es_shape_space es_shape_space;
+
+typedef struct es_shape_space_info {
+    int64_t dual_arcs;      /* interior edges: arcs of the dual graph */
+    int64_t tree_arcs;      /* arcs of the spanning forest */
+    int64_t candidates;     /* candidate positions made by the last frame */
+    int64_t max_candidates; /* most candidates of one vertex in the last frame */
+} es_shape_space_info;
+
+/* The shape-space points of poses xa and xb (3 x V each, copied; B is
+ * aligned to A) and the spanning forest. The mesh is borrowed. ES_EINVAL
+ * on a non-finite position or a degenerate face (no normal). */
+ES_API es_status es_shape_space_new(es_ctx *ctx, const es_mesh *mesh, const double *xa,
+                                    const double *xb, es_shape_space **out);
+ES_API void es_shape_space_free(es_shape_space *ss);
+ES_API void es_shape_space_get_info(const es_shape_space *ss, es_shape_space_info *info);
+
+/* Frame t (any real: outside [0, 1] extrapolates) into xyz (3 x V, in A's
+ * frame). len: the frame's lengths (E), or NULL for (1 - t) l_A + t l_B;
+ * ES_EINVAL names an edge whose length is not positive. */
+ES_API es_status es_shape_space_frame(es_ctx *ctx, es_shape_space *ss, const double *len,
+                                      double t, double *xyz);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
