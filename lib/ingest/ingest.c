@@ -1,14 +1,17 @@
 /* lib/ingest/ingest.c — meshes (and a manifest's labels) into an HDF5 store.
  *
- * All-or-nothing in two phases. Phase 1 reads every input into memory:
- * the file's bytes (hashed for duplicate detection, then parsed from the
- * buffer so the file is read once), the check that its vertex count and
- * face list equal the store's (or the first input's, for a new store), and
- * its normalized edge lengths (es_edge_lengths, es_lengths_normalize;
- * Section 4, eq. 12 of Rojas et al.). Any failure returns before the store
- * is touched. Phase 2 appends all rows in one es_store_append and commits,
- * which replaces the store by an atomic rename (lib/store/store_publish.c), so a kill during
- * phase 2 also leaves the old store intact.
+ * All-or-nothing, in bounded memory. Inputs go through in blocks of rows
+ * (about 64 MB of positions and lengths, or es_ingest_opts.block_rows).
+ * Each block is read and checked: the file's bytes (hashed for duplicate
+ * detection, then parsed from the buffer so the file is read once), its
+ * vertex count and face list against the store's (or the first input's, for
+ * a new store), and its normalized edge lengths (es_edge_lengths,
+ * es_lengths_normalize; Section 4, eq. 12 of Rojas et al.). Its rows are
+ * then appended to the store's working copy, and the block's memory serves
+ * the next block: memory does not grow with the number of inputs beyond a
+ * few dozen bytes of ids and hashes per row. Only after the last block is
+ * the copy committed, by an atomic rename (lib/store/store_publish.c); any
+ * failure, or a kill at any moment, leaves the store as it was.
  */
 #include "core/core_private.h"
 #include "core/files.h"
@@ -59,11 +62,13 @@ static es_status slurp(es_ctx *ctx, const char *path, char **buf, size_t *cap, s
     return es__read_file_reuse(ctx, path, ES__READ_REGULAR | ES__READ_NOTFOUND, buf, cap, len);
 }
 
-/* Everything phase 1 produces, one slot per input (kept or not). */
+/* What reading produces: the current block's values, one slot per input
+ * of the block (slot = input - first input of the block), and per input
+ * (all n, a few bytes each) the content hash and whether it is skipped. */
 typedef struct batch {
     int64_t cap, V, E;
     double *xyz, *len, *scale;   /* 3V x cap, E x cap, cap */
-    char (*hash)[25];            /* content hash per slot */
+    char (*hash)[25];            /* content hash per input */
     uint8_t *skip;               /* 1: already in the store, same content */
 } batch;
 
@@ -112,7 +117,20 @@ static void *alloc_uninit(es_ctx *ctx, int64_t a, int64_t b, size_t elem)
     return p;
 }
 
-static es_status batch_alloc(es_ctx *ctx, batch *b, int64_t cap, int64_t V, int64_t E)
+/* Rows per block: opts->block_rows, or about 64 MB of positions and
+ * lengths; never fewer than the threads that fill it, nor more than n. */
+static int64_t block_rows(const es_ingest_opts *o, int64_t n, int64_t nthreads, int64_t V,
+                          int64_t E)
+{
+    int64_t per = (3 * V + E) * (int64_t)sizeof(double);
+    int64_t b = o->block_rows > 0 ? o->block_rows : ((int64_t)64 << 20) / (per > 0 ? per : 1);
+    if (o->block_rows <= 0 && b < nthreads) b = nthreads;
+    if (b > n) b = n;
+    return b < 1 ? 1 : b;
+}
+
+static es_status batch_alloc(es_ctx *ctx, batch *b, int64_t cap, int64_t n, int64_t V,
+                             int64_t E)
 {
     b->cap = cap;
     b->V = V;
@@ -120,8 +138,8 @@ static es_status batch_alloc(es_ctx *ctx, batch *b, int64_t cap, int64_t V, int6
     if (!(b->xyz = alloc_uninit(ctx, 3 * V, cap, sizeof(double))) ||
         !(b->len = alloc_uninit(ctx, E, cap, sizeof(double))) ||
         !(b->scale = alloc_uninit(ctx, cap, 1, sizeof(double))) ||
-        !(b->hash = alloc_uninit(ctx, cap, 1, sizeof *b->hash)) ||
-        !(b->skip = es__alloc_array(ctx, cap, 1)))
+        !(b->hash = alloc_uninit(ctx, n, 1, sizeof *b->hash)) ||
+        !(b->skip = es__alloc_array(ctx, n, 1)))
         return ES_ENOMEM;
     return ES_OK;
 }
@@ -184,19 +202,21 @@ static int cmp_note(const void *a, const void *b)
 
 typedef struct job {
     const input *in;
-    int64_t n;
+    int64_t n;                  /* end of the current block */
+    int64_t slot0;              /* its first input: slot 0 of the batch */
     const ref *r;
     const es_store *st;
     const es_ingest_opts *o;
     batch *b;
     atomic_llong next, done;
     pthread_mutex_t mu;
-    int64_t err_index;          /* lowest failing input, n if none */
+    int64_t err_index;          /* lowest failing input, all inputs' count if none */
     es_status err_rc;
     char err_msg[1200];
     note *notes;                /* warnings (malloc'd, main ctx not touched) */
     int64_t nnotes, capnotes;
     int64_t bytes_read;
+    int64_t ntotal;             /* inputs in all (progress) */
 } job;
 
 typedef struct worker {
@@ -322,16 +342,17 @@ static es_status process_one(worker *w, int64_t i, char **buf, size_t *cap, es_m
     }
     if ((rc = es_meshdata_parse(ctx, path, *buf, len, j->o->format, md))) return rc;
     if (!(rc = check_topology(ctx, j->r, path, md))) {
-        double *li = b->len + i * b->E;
+        const int64_t slot = i - j->slot0;
+        double *li = b->len + slot * b->E;
         if ((rc = es_edge_lengths(ctx, j->r->mesh, md->xyz, li)) ||
-            (rc = es_lengths_normalize(ctx, b->E, li, li, &b->scale[i]))) {
+            (rc = es_lengths_normalize(ctx, b->E, li, li, &b->scale[slot]))) {
             char msg[900];
             snprintf(msg, sizeof msg, "%s", es_ctx_errmsg(ctx));
             rc = es__fail(ctx, rc, "'%s': %s", path, msg);
         } else {
             warn_zero_edges(ctx, path, j->r->mesh, li, b->E);
             warn_flat_faces(ctx, path, j->r->F, j->r->faces, md->xyz);
-            memcpy(b->xyz + i * 3 * b->V, md->xyz, (size_t)(3 * b->V) * sizeof(double));
+            memcpy(b->xyz + slot * 3 * b->V, md->xyz, (size_t)(3 * b->V) * sizeof(double));
         }
     }
     es_meshdata_clear(ctx, md);
@@ -358,7 +379,8 @@ static void *work(void *arg)
         if ((rc = process_one(w, i, &buf, &cap, &md)))
             record_error(j, i, rc, es_ctx_errmsg(w->ctx));
         atomic_fetch_add(&j->done, 1);
-        if (w->main) es__progress(w->main_ctx, "reading meshes", (int64_t)atomic_load(&j->done), j->n);
+        if (w->main)
+            es__progress(w->main_ctx, "reading meshes", (int64_t)atomic_load(&j->done), j->ntotal);
     }
     es__free(w->ctx, buf);
     return NULL;
@@ -373,7 +395,7 @@ static int64_t auto_threads(const es_ingest_opts *o, int64_t n)
     return t < 1 ? 1 : t;
 }
 
-/* Inputs [first, n) into their slots. */
+/* Inputs [first, j->n) into their slots. */
 static es_status run_phase1(es_ctx *ctx, job *j, int64_t first)
 {
     int64_t nt = auto_threads(j->o, j->n - first);
@@ -412,8 +434,97 @@ static es_status run_phase1(es_ctx *ctx, job *j, int64_t first)
         es_ctx_free(w[t].ctx);
     }
     es_ctx_set_log(ctx, user_log, user_ud);
-    if (j->err_index < j->n) rc = es__fail(ctx, j->err_rc, "%s", j->err_msg);
+    if (j->err_index < j->ntotal) rc = es__fail(ctx, j->err_rc, "%s", j->err_msg);
     return rc;
+}
+
+/* The rows kept so far, in input order (pointer arrays for all n inputs:
+ * the ids and labels are the inputs', the hashes the batch's, the real
+ * source paths made here), and the content hashes seen: the store's rows
+ * (as it was opened) and the inputs kept (keys borrowed from the store and
+ * the batch; a map, not a scan of every earlier row for each input). */
+typedef struct kept {
+    int64_t n;
+    const char **ids, **hashes, **labels;   /* labels: ncols per row */
+    char **sources;
+    es__strmap seen_store, seen_new;
+} kept;
+
+static es_status kept_init(es_ctx *ctx, kept *k, const es_store *st, int64_t n, int64_t ncols)
+{
+    es_status rc;
+    if (!(k->ids = es__alloc_array(ctx, n, sizeof *k->ids)) ||
+        !(k->sources = es__alloc_array(ctx, n, sizeof *k->sources)) ||
+        !(k->hashes = es__alloc_array(ctx, n, sizeof *k->hashes)) ||
+        !(k->labels = es__alloc_array(ctx, ncols > 0 ? n * ncols : 1, sizeof *k->labels)))
+        return ES_ENOMEM;
+    if ((rc = es__strmap_init(ctx, &k->seen_store, st ? es_store_nrows(st) : 0)) ||
+        (rc = es__strmap_init(ctx, &k->seen_new, n)))
+        return rc;
+    for (int64_t r = 0; st && r < es_store_nrows(st); r++)
+        if ((rc = es__strmap_put(ctx, &k->seen_store, es_store_content_hash(st, r), r, NULL)))
+            return rc;
+    return ES_OK;
+}
+
+static void kept_clear(es_ctx *ctx, kept *k)
+{
+    es__strmap_clear(ctx, &k->seen_store);
+    es__strmap_clear(ctx, &k->seen_new);
+    for (int64_t i = 0; k->sources && i < k->n; i++) es__free(ctx, k->sources[i]);
+    es__free(ctx, k->sources);
+    es__free(ctx, k->ids);
+    es__free(ctx, k->hashes);
+    es__free(ctx, k->labels);
+}
+
+/* Inputs [b0, b1), read into the batch: duplicate warnings, the kept rows
+ * moved to the front of the batch and appended to the store's working copy
+ * (made now, for a new store). */
+static es_status keep_block(es_ctx *ctx, const char *store_path, es_store **st, const ref *r,
+                            const input *in, int64_t b0, int64_t b1, int64_t ncols,
+                            const char *const *colnames, batch *b, kept *k,
+                            es_ingest_report *rep)
+{
+    const int64_t k0 = k->n;
+    int64_t m = 0;
+    es_status rc;
+    for (int64_t i = b0; i < b1; i++) {
+        char real[PATH_MAX];
+        const int64_t slot = i - b0;
+        int64_t prev;
+        if (b->skip[i]) {
+            rep->rows_skipped++;
+            continue;
+        }
+        if ((prev = es__strmap_get(&k->seen_store, b->hash[i])) >= 0)
+            es__warn(ctx, "'%s' has the same content as row '%s' of the store",
+                     in[i].path, es_store_row_id(*st, prev));
+        if ((rc = es__strmap_put(ctx, &k->seen_new, b->hash[i], k->n, &prev))) return rc;
+        if (prev >= 0)
+            es__warn(ctx, "'%s' has the same content as '%s'", in[i].path, k->sources[prev]);
+        if (m != slot) {
+            memmove(b->len + m * b->E, b->len + slot * b->E, (size_t)b->E * sizeof(double));
+            memmove(b->xyz + m * 3 * b->V, b->xyz + slot * 3 * b->V,
+                    (size_t)(3 * b->V) * sizeof(double));
+            b->scale[m] = b->scale[slot];
+        }
+        k->ids[k->n] = in[i].id;
+        k->hashes[k->n] = b->hash[i];
+        for (int64_t c = 0; c < ncols; c++) k->labels[k->n * ncols + c] = in[i].labels[c];
+        if (!(k->sources[k->n] = es__strdup(ctx, realpath(in[i].path, real) ? real : in[i].path)))
+            return ES_ENOMEM;
+        k->n++;
+        m++;
+    }
+    if (m == 0) return ES_OK;
+    if (!*st && (rc = es_store_create(ctx, store_path, r->mesh, st))) return rc;
+    {
+        es_store_rows rows = {m, k->ids + k0, (const char *const *)(k->sources + k0),
+                              k->hashes + k0, b->len, b->scale, b->xyz, ncols, colnames,
+                              k->labels + k0 * ncols};
+        return es_store_append(ctx, *st, &rows);
+    }
 }
 
 static es_status ingest(es_ctx *ctx, const char *store_path, int64_t n, const input *in,
@@ -421,29 +532,28 @@ static es_status ingest(es_ctx *ctx, const char *store_path, int64_t n, const in
                         es_ingest_report *rep)
 {
     es_store *st = NULL;
-    int64_t *store_faces = NULL, *ref_faces = NULL, first = 0, nkeep = 0;
-    const char **ids = NULL, **labels = NULL;
-    char **sources = NULL;
-    const char **hashes = NULL;
+    int64_t *store_faces = NULL, *ref_faces = NULL, first = 0;
     es_meshdata md;
     batch b;
     ref r;
     job j;
-    es__strmap seen_store = {0}, seen_new = {0};
+    kept k;
     es_status rc = ES_OK;
-    bool exists, mu_init = false;
+    bool exists, mu_init = false, created;
     memset(&md, 0, sizeof md);
     memset(&b, 0, sizeof b);
     memset(&r, 0, sizeof r);
     memset(&j, 0, sizeof j);
+    memset(&k, 0, sizeof k);
     memset(rep, 0, sizeof *rep);
     if (!store_path || !*store_path) ES_FAIL(ctx, ES_EINVAL, "ingest: no store path");
     if (n < 1) ES_FAIL(ctx, ES_EINVAL, "ingest: no meshes to ingest");
     exists = access(store_path, F_OK) == 0;
+    created = !exists;
     if (!exists && !o->create)
         ES_FAIL(ctx, ES_ENOTFOUND, "ingest: store '%s' does not exist", store_path);
     if (exists) {
-        int64_t nf3;
+        int64_t nf3, E;
         if ((rc = es_store_open(ctx, store_path, ES_STORE_WRITE, &st))) return rc;
         if (es_store_topology_kind(st) != ES_TOPOLOGY_MESH) {
             rc = es__fail(ctx, ES_EMISMATCH, "ingest: store '%s' holds landmarks without faces "
@@ -464,7 +574,10 @@ static es_status ingest(es_ctx *ctx, const char *store_path, int64_t n, const in
             goto done;
         r.faces = store_faces;
         snprintf(r.what, sizeof r.what, "the store '%s'", store_path);
-        if ((rc = batch_alloc(ctx, &b, n, r.V, es_mesh_nedges(r.mesh)))) goto done;
+        E = es_mesh_nedges(r.mesh);
+        if ((rc = batch_alloc(ctx, &b, block_rows(o, n, auto_threads(o, n), r.V, E), n, r.V,
+                              E)))
+            goto done;
     }
     if (pthread_mutex_init(&j.mu, NULL) != 0) {
         rc = es__fail(ctx, ES_ENOMEM, "ingest: cannot make a mutex");
@@ -472,19 +585,19 @@ static es_status ingest(es_ctx *ctx, const char *store_path, int64_t n, const in
     }
     mu_init = true;
     j.in = in;
-    j.n = n;
+    j.ntotal = n;
     j.r = &r;
     j.st = st;
     j.o = o;
     j.b = &b;
     j.err_index = n;
+    if ((rc = kept_init(ctx, &k, st, n, ncols))) goto done;
 
-    /* ---- phase 1: read and validate everything ---- */
     if (!st) {
         /* New store: the first input defines the topology. */
         char *buf = NULL;
         size_t cap = 0, len = 0;
-        int64_t nf3;
+        int64_t nf3, E;
         es__progress(ctx, "reading meshes", 0, n);
         if ((rc = slurp(ctx, in[0].path, &buf, &cap, &len)) ||
             (rc = es_meshdata_parse(ctx, in[0].path, buf, len, o->format, &md))) {
@@ -518,7 +631,9 @@ static es_status ingest(es_ctx *ctx, const char *store_path, int64_t n, const in
                          "positions; they have no edges)", in[0].path,
                          (long long)sum.n_unreferenced, (long long)r.V);
         }
-        if ((rc = batch_alloc(ctx, &b, n, r.V, es_mesh_nedges(r.mesh)))) {
+        E = es_mesh_nedges(r.mesh);
+        if ((rc = batch_alloc(ctx, &b, block_rows(o, n, auto_threads(o, n), r.V, E), n, r.V,
+                              E))) {
             es__free(ctx, buf);
             goto done;
         }
@@ -537,84 +652,43 @@ static es_status ingest(es_ctx *ctx, const char *store_path, int64_t n, const in
         es_meshdata_clear(ctx, &md);
         first = 1;
     }
-    if (first < n) rc = run_phase1(ctx, &j, first);
-    /* warnings, in input order (sorted: 10^5 inputs with a warning each
-     * took minutes with the exchange sort this replaced) */
-    if (j.nnotes > 1) qsort(j.notes, (size_t)j.nnotes, sizeof *j.notes, cmp_note);
-    for (int64_t k = 0; k < j.nnotes; k++) es__warn(ctx, "%s", j.notes[k].msg);
-    rep->bytes_read = j.bytes_read;
-    if (rc) goto done;
+
+    /* ---- block by block: read and check, then write to the working copy ---- */
+    for (int64_t b0 = 0; b0 < n; b0 += b.cap) {
+        const int64_t b1 = n - b0 > b.cap ? b0 + b.cap : n;
+        j.n = b1;
+        j.slot0 = b0;
+        if (b0 < first && first < b1) rc = run_phase1(ctx, &j, first);
+        else if (b0 >= first) rc = run_phase1(ctx, &j, b0);
+        /* the block's warnings, in input order (sorted: 10^5 inputs with a
+         * warning each took minutes with the exchange sort this replaced) */
+        if (j.nnotes > 1) qsort(j.notes, (size_t)j.nnotes, sizeof *j.notes, cmp_note);
+        for (int64_t q = 0; q < j.nnotes; q++) {
+            es__warn(ctx, "%s", j.notes[q].msg);
+            free(j.notes[q].msg);
+        }
+        j.nnotes = 0;
+        rep->bytes_read = j.bytes_read;
+        if (rc || (rc = keep_block(ctx, store_path, &st, &r, in, b0, b1, ncols, colnames, &b,
+                                   &k, rep)))
+            goto done;
+    }
     es__progress(ctx, "reading meshes", n, n);
 
-    /* ---- gather the kept rows, in input order ---- */
-    if (!(ids = es__alloc_array(ctx, n, sizeof *ids)) ||
-        !(sources = es__alloc_array(ctx, n, sizeof *sources)) ||
-        !(hashes = es__alloc_array(ctx, n, sizeof *hashes)) ||
-        !(labels = es__alloc_array(ctx, ncols > 0 ? n * ncols : 1, sizeof *labels))) {
-        rc = ES_ENOMEM;
-        goto done;
-    }
-    /* content hashes seen: the store's rows and the inputs kept so far
-     * (keys borrowed from the store and the batch; a map, not a scan of
-     * every earlier row for each input) */
-    if ((rc = es__strmap_init(ctx, &seen_store, st ? es_store_nrows(st) : 0)) ||
-        (rc = es__strmap_init(ctx, &seen_new, n)))
-        goto done;
-    for (int64_t k = 0; st && k < es_store_nrows(st); k++)
-        if ((rc = es__strmap_put(ctx, &seen_store, es_store_content_hash(st, k), k, NULL)))
-            goto done;
-    for (int64_t i = 0; i < n; i++) {
-        char real[PATH_MAX];
-        int64_t k;
-        if (b.skip[i]) {
-            rep->rows_skipped++;
-            continue;
-        }
-        if ((k = es__strmap_get(&seen_store, b.hash[i])) >= 0)
-            es__warn(ctx, "'%s' has the same content as row '%s' of the store",
-                     in[i].path, es_store_row_id(st, k));
-        if ((rc = es__strmap_put(ctx, &seen_new, b.hash[i], nkeep, &k))) goto done;
-        if (k >= 0)
-            es__warn(ctx, "'%s' has the same content as '%s'", in[i].path, sources[k]);
-        if (nkeep != i) {
-            memmove(b.len + nkeep * b.E, b.len + i * b.E, (size_t)b.E * sizeof(double));
-            memmove(b.xyz + nkeep * 3 * b.V, b.xyz + i * 3 * b.V,
-                    (size_t)(3 * b.V) * sizeof(double));
-            b.scale[nkeep] = b.scale[i];
-        }
-        ids[nkeep] = in[i].id;
-        hashes[nkeep] = b.hash[i];
-        for (int64_t c = 0; c < ncols; c++) labels[nkeep * ncols + c] = in[i].labels[c];
-        if (!(sources[nkeep] = es__strdup(ctx, realpath(in[i].path, real) ? real : in[i].path))) {
-            rc = ES_ENOMEM;
-            goto done;
-        }
-        nkeep++;
-    }
-
-    /* ---- phase 2: write (to a working copy), then commit atomically ---- */
-    if (nkeep > 0) {
-        es_store_rows rows = {nkeep, ids, (const char *const *)sources, hashes, b.len,
-                              b.scale, b.xyz, ncols, colnames, labels};
+    /* ---- publish the working copy, atomically ---- */
+    if (k.n > 0) {
         es__progress(ctx, "writing store", 0, 1);
-        if (!st) {
-            if ((rc = es_store_create(ctx, store_path, r.mesh, &st))) goto done;
-            rep->created = 1;
-        }
-        if ((rc = es_store_append(ctx, st, &rows)) || (rc = es_store_commit(ctx, st))) {
-            rep->created = 0;
-            goto done;
-        }
+        if ((rc = es_store_commit(ctx, st))) goto done;
         es__progress(ctx, "writing store", 1, 1);
     }
-    rep->rows_added = nkeep;
+    rep->created = created;
+    rep->rows_added = k.n;
     rep->rows_total = es_store_nrows(st);
 done:
     if (rc != ES_OK) rep->rows_added = 0;
-    es__strmap_clear(ctx, &seen_store);
-    es__strmap_clear(ctx, &seen_new);
+    kept_clear(ctx, &k);
     if (mu_init) pthread_mutex_destroy(&j.mu);
-    for (int64_t k = 0; k < j.nnotes; k++) free(j.notes[k].msg);
+    for (int64_t q = 0; q < j.nnotes; q++) free(j.notes[q].msg);
     free(j.notes);
     es_meshdata_clear(ctx, &md);
     if (rc != ES_OK) es_store_abort(st);
@@ -622,11 +696,6 @@ done:
     es_mesh_free(r.mesh);
     es__free(ctx, store_faces);
     es__free(ctx, ref_faces);
-    for (int64_t k = 0; sources && k < nkeep; k++) es__free(ctx, sources[k]);
-    es__free(ctx, sources);
-    es__free(ctx, ids);
-    es__free(ctx, hashes);
-    es__free(ctx, labels);
     batch_free(ctx, &b);
     return rc;
 }

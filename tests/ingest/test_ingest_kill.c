@@ -3,7 +3,9 @@
  * A store with 2 rows gets a large ingest (38 generated meshes of 10,000
  * vertices, ~40 MB of OBJ) that is killed with SIGKILL at moments spread over
  * a full run's duration: while reading, while writing the working copy, around
- * the commit. After every kill the store must open, and be either
+ * the commit. Rows go to the working copy 4 at a time (--block-rows 4), so
+ * most kills land between blocks already written to the copy and blocks
+ * still being read. After every kill the store must open, and be either
  * byte-for-byte the old store or (if the kill came after the atomic rename)
  * the complete new one with all 40 rows, never anything between. A later
  * successful ingest removes the working copies the killed processes left. */
@@ -67,7 +69,8 @@ int main(void)
     /* a full run, on a copy, to time it */
     {
         char copy[4300];
-        const char *argv[] = {es_test_edgespace(), "ingest", copy, "--manifest", m1, NULL};
+        const char *argv[] = {es_test_edgespace(), "ingest", copy, "--manifest", m1,
+                              "--block-rows", "4", NULL};
         snprintf(copy, sizeof copy, "%s/copy.h5", dir);
         f = fopen(copy, "wb");
         fwrite(base, 1, nbase, f);
@@ -81,7 +84,8 @@ int main(void)
 
     static const double at[] = {0.0, 0.05, 0.2, 0.4, 0.6, 0.75, 0.85, 0.9, 0.95, 0.98, 1.0, 1.05};
     for (size_t k = 0; k < sizeof at / sizeof at[0]; k++) {
-        const char *argv[] = {es_test_edgespace(), "ingest", store, "--manifest", m1, NULL};
+        const char *argv[] = {es_test_edgespace(), "ingest", store, "--manifest", m1,
+                              "--block-rows", "4", NULL};
         pid_t pid = es_test_spawn(argv, o, e);
         int status;
         int64_t n;

@@ -1,14 +1,22 @@
 /* tools/bench/bench_pca.c — PCA of a synthetic shape set at the paper's FRGC
- * scale (600 shapes x 175,000 edges, Section 4 of Fisher et al.), streamed
- * in blocks from a generator so that the data never sit in memory whole.
+ * scale (600 shapes x 175,000 edges, Section 4 of Fisher et al.), against
+ * numpy on the same matrix, algorithm for algorithm.
  *
  * Row i = (1 + basis * c_i + noise_i) / E: a rank-R variation with decaying
- * weights plus uniform noise, drawn from the seeded RNG per row so that
- * every pass sees the same matrix. Prints the time and peak RSS of the exact
- * fit (all components, Gram route) and of a randomized top-K fit, and the
- * randomized eigenvalues' relative error. If python3 with numpy is on the
- * PATH it also times numpy.linalg.svd on the same matrix (written to a
- * temporary .npy) and prints the ratio; otherwise it says it skipped that.
+ * weights plus uniform noise, drawn from the seeded RNG. The matrix is made
+ * once in memory and written to a temporary .npy; then, on that one matrix:
+ *   exact, all components: es_pca_fit (Gram route) against numpy centring,
+ *     G = A^T A, numpy.linalg.eigh(G), components A V / sqrt(w);
+ *   exact, top 20: the same with 20 components;
+ *   randomized top K: es_pca_fit (Halko et al. subspace iteration, p, q)
+ *     against the same algorithm in numpy (Gaussian test matrix, q power
+ *     iterations re-orthonormalized by QR, SVD of A^T Q).
+ * Wall and CPU time of each, the ratio numpy / ours, and the largest relative
+ * difference of the top eigenvalues (numpy is the oracle). numpy runs under
+ * /usr/bin/python3 (Debian's, with python3-numpy; the python3 first on PATH
+ * may lack it); when it cannot run, the bench says so and why. Both sides
+ * use the same OpenBLAS with the same thread count (OPENBLAS_NUM_THREADS, or
+ * OpenBLAS's default: one per core); it is printed.
  *
  *   bench_pca [--rows N] [--edges E] [--rank R] [--components K] [--no-numpy]
  */
@@ -102,9 +110,101 @@ static void print_stages(const stages *st)
     printf("\n");
 }
 
-static int have_numpy(void)
+#define PYTHON "/usr/bin/python3"
+
+/* numpy's side, reading the matrix from argv[1]: the three timings and the
+ * top eigenvalues of each, one line per method. */
+static const char numpy_script[] =
+    "import sys, time\n"
+    "import numpy as np\n"
+    "X = np.load(sys.argv[1]); K, p, q, seed = (int(a) for a in sys.argv[2:6])\n"
+    "E, N = X.shape\n"
+    "def timed(name, f):\n"
+    "    t, c = time.perf_counter(), time.process_time()\n"
+    "    w = f()\n"
+    "    print(name, time.perf_counter() - t, time.process_time() - c,\n"
+    "          ' '.join(repr(float(v)) for v in w[:10]), flush=True)\n"
+    "def gram(k):\n"
+    "    A = X - X.mean(axis=1, keepdims=True)\n"
+    "    w, V = np.linalg.eigh(A.T @ A)\n"
+    "    w, V = w[::-1], V[:, ::-1]\n"
+    "    r = min(int((w > max(E, N) * np.finfo(float).eps * w[0]).sum()), N - 1)\n"
+    "    r = min(r, k) if k else r\n"
+    "    U = A @ (V[:, :r] / np.sqrt(w[:r]))\n"
+    "    return w[:r] / (N - 1)\n"
+    "def randomized():\n"
+    "    A = X - X.mean(axis=1, keepdims=True)\n"
+    "    Y = A @ np.random.default_rng(seed).standard_normal((N, K + p))\n"
+    "    for _ in range(q):\n"
+    "        Q, _ = np.linalg.qr(Y)\n"
+    "        Y = A @ (A.T @ Q)\n"
+    "    Q, _ = np.linalg.qr(Y)\n"
+    "    W, s, VT = np.linalg.svd(A.T @ Q, full_matrices=False)\n"
+    "    U = Q @ VT[:K].T\n"
+    "    return s[:K] ** 2 / (N - 1)\n"
+    "timed('gram', lambda: gram(0))\n"
+    "timed('top20', lambda: gram(20))\n"
+    "timed('randomized', randomized)\n";
+
+/* Why numpy cannot run, or NULL when it can. */
+static const char *numpy_missing(void)
 {
-    return system("python3 -c 'import numpy' >/dev/null 2>&1") == 0;
+    if (access(PYTHON, X_OK) != 0) return PYTHON " is not installed";
+    if (system(PYTHON " -c 'import numpy' >/dev/null 2>&1") != 0)
+        return PYTHON " cannot import numpy (Debian package python3-numpy)";
+    return NULL;
+}
+
+static int write_npy(const char *path, const double *X, int64_t E, int64_t N)
+{
+    FILE *f = fopen(path, "wb");
+    char hdr[128];
+    int hl = snprintf(hdr, sizeof hdr, "{'descr': '<f8', 'fortran_order': True, "
+                      "'shape': (%lld, %lld), }", (long long)E, (long long)N);
+    int pad = (64 - (10 + hl + 1) % 64) % 64, ok;
+    unsigned short len = (unsigned short)(hl + pad + 1);
+    if (!f) return -1;
+    fwrite("\x93NUMPY\x01\x00", 1, 8, f);
+    fputc(len & 0xff, f);
+    fputc(len >> 8, f);
+    fwrite(hdr, 1, (size_t)hl, f);
+    for (int i = 0; i < pad; i++) fputc(' ', f);
+    fputc('\n', f);
+    ok = fwrite(X, sizeof(double), (size_t)(E * N), f) == (size_t)(E * N);
+    return fclose(f) == 0 && ok ? 0 : -1;
+}
+
+typedef struct timing {
+    double wall, cpu, eig[10];
+    int neig;
+} timing;
+
+static es_pca *fit(es_ctx *ctx, const es_source *src, const es_pca_opts *o, timing *t)
+{
+    es_pca *p = NULL;
+    double w0 = bench_wall_s(), c0 = bench_process_cpu_s();
+    if (es_pca_fit(ctx, src, o, &p) != ES_OK) {
+        fprintf(stderr, "bench_pca: %s\n", es_ctx_errmsg(ctx));
+        exit(1);
+    }
+    t->wall = bench_wall_s() - w0;
+    t->cpu = bench_process_cpu_s() - c0;
+    t->neig = p->ncomp < 10 ? (int)p->ncomp : 10;
+    for (int k = 0; k < t->neig; k++) t->eig[k] = p->eigenvalues[k];
+    return p;
+}
+
+static void compare(const char *what, const timing *ours, const timing *np)
+{
+    double maxrel = 0;
+    for (int k = 0; k < ours->neig && k < np->neig; k++) {
+        double rel = fabs(ours->eig[k] - np->eig[k]) / fabs(np->eig[k]);
+        if (rel > maxrel) maxrel = rel;
+    }
+    printf("  %-26s ours %7.2f s wall %7.2f s CPU | numpy %7.2f s wall %7.2f s CPU | "
+           "numpy/ours wall %.2f, CPU %.2f | top eigenvalues differ by %.1e\n", what,
+           ours->wall, ours->cpu, np->wall, np->cpu, np->wall / ours->wall, np->cpu / ours->cpu,
+           maxrel);
 }
 
 int main(int argc, char **argv)
@@ -148,126 +248,96 @@ int main(int argc, char **argv)
 
     printf("bench_pca: %lld shapes x %lld edges (%.0f MiB as doubles), rank %lld + noise\n",
            (long long)N, (long long)E, (double)N * (double)E * 8 / 1048576.0, (long long)R);
-    /* time to generate the data once (part of every pass below) */
-    double *blk = malloc((size_t)E * 64 * sizeof(double));
-    double t0 = bench_wall_s(), cg0 = bench_process_cpu_s();
-    for (int64_t r0 = 0; r0 < N; r0 += 64) {
-        int64_t n = N - r0 < 64 ? N - r0 : 64;
-        gen_read(ctx, &src, r0, n, (es_mat){blk, E, n, E});
+    double *X = malloc((size_t)(E * N) * sizeof *X);
+    if (!X) {
+        fprintf(stderr, "bench_pca: cannot hold the %lld x %lld matrix\n", (long long)E,
+                (long long)N);
+        return 1;
     }
-    double tgen = bench_wall_s() - t0, cgen = bench_process_cpu_s() - cg0;
-    printf("  load average at start: %s\n", loadavg());
-    free(blk);
-    printf("  generating one pass of the data:   %7.2f s wall, %.2f s CPU\n", tgen, cgen);
+    gen_read(ctx, &src, 0, N, (es_mat){X, E, N, E});
+    es_source mat = es_source_matrix((es_mat){X, E, N, E}, NULL, N);
+    const char *threads = getenv("OPENBLAS_NUM_THREADS");
+    printf("  load average at start: %s; OpenBLAS threads: %s (%ld cores online)\n", loadavg(),
+           threads ? threads : "default", sysconf(_SC_NPROCESSORS_ONLN));
 
     es_pca_opts o;
     es_pca_opts_init(&o);
-    es_pca *exact = NULL, *rnd = NULL;
+    timing t_exact, t_top, t_rnd, n_exact = {0}, n_top = {0}, n_rnd = {0};
     stages stg;
     memset(&stg, 0, sizeof stg);
     es_ctx_set_progress(ctx, on_progress, &stg);
-    g.rows_read = 0;
-    t0 = bench_wall_s();
-    stg.t0 = t0;
-    double c0 = bench_process_cpu_s();
-    if (es_pca_fit(ctx, &src, &o, &exact) != ES_OK) {
-        fprintf(stderr, "bench_pca: %s\n", es_ctx_errmsg(ctx));
-        return 1;
-    }
-    double texact = bench_wall_s() - t0, cexact = bench_process_cpu_s() - c0;
-    double rss_exact = bench_peak_rss_mib();
-    printf("  exact PCA (Gram route, %lld components): %7.2f s wall, %.2f s CPU  (%.2f passes over "
-           "the data, ~%.2f s CPU of them generating), peak RSS %.0f MiB\n",
-           (long long)exact->ncomp, texact, cexact, (double)g.rows_read / (double)N,
-           cgen * (double)g.rows_read / (double)N, rss_exact);
+    stg.t0 = bench_wall_s();
+    es_pca *exact = fit(ctx, &mat, &o, &t_exact);
+    es_ctx_set_progress(ctx, NULL, NULL);
+    printf("  ours, exact (Gram route, %lld components): %.2f s wall, %.2f s CPU, peak RSS %.0f "
+           "MiB\n", (long long)exact->ncomp, t_exact.wall, t_exact.cpu, bench_peak_rss_mib());
     print_stages(&stg);
     double cum = 0;
     for (int64_t k = 0; k < 3 && k < exact->ncomp; k++) cum += exact->explained[k];
     printf("    eigenvalues 1..3: %.6g %.6g %.6g; top 3 explain %.1f%% of the variance\n",
            exact->eigenvalues[0], exact->eigenvalues[1], exact->eigenvalues[2], 100 * cum);
-
-    {
-        es_pca *top = NULL;
-        es_pca_opts ot = o;
-        ot.ncomp = 20;
-        g.rows_read = 0;
-        t0 = bench_wall_s();
-        c0 = bench_process_cpu_s();
-        if (es_pca_fit(ctx, &src, &ot, &top) != ES_OK) {
-            fprintf(stderr, "bench_pca: %s\n", es_ctx_errmsg(ctx));
-            return 1;
-        }
-        printf("  exact PCA (Gram route, top 20):     %7.2f s wall, %.2f s CPU  (%.2f passes)\n",
-               bench_wall_s() - t0, bench_process_cpu_s() - c0, (double)g.rows_read / (double)N);
-        es_pca_free(top);
-    }
+    es_pca_opts ot = o;
+    ot.ncomp = 20;
+    es_pca_free(fit(ctx, &mat, &ot, &t_top));
     o.method = ES_PCA_RANDOMIZED;
     o.ncomp = K;
-    g.rows_read = 0;
-    t0 = bench_wall_s();
-    c0 = bench_process_cpu_s();
-    if (es_pca_fit(ctx, &src, &o, &rnd) != ES_OK) {
-        fprintf(stderr, "bench_pca: %s\n", es_ctx_errmsg(ctx));
-        return 1;
-    }
-    double trnd = bench_wall_s() - t0, crnd = bench_process_cpu_s() - c0;
+    es_pca *rnd = fit(ctx, &mat, &o, &t_rnd);
     double maxrel = 0;
     for (int64_t k = 0; k < K; k++) {
         double rel = fabs(rnd->eigenvalues[k] - exact->eigenvalues[k]) / exact->eigenvalues[k];
         if (rel > maxrel) maxrel = rel;
     }
-    printf("  randomized PCA (top %lld, p=%lld, q=%lld): %7.2f s wall, %.2f s CPU  (%.2f passes), "
-           "max relative eigenvalue error %.2e\n", (long long)K, (long long)o.oversample,
-           (long long)o.power_iters, trnd, crnd, (double)g.rows_read / (double)N, maxrel);
+    printf("  ours, randomized (top %lld, p=%lld, q=%lld): %.2f s wall, %.2f s CPU, max relative "
+           "eigenvalue error against our exact fit %.2e\n", (long long)K, (long long)o.oversample,
+           (long long)o.power_iters, t_rnd.wall, t_rnd.cpu, maxrel);
 
-    if (numpy && have_numpy()) {
-        char path[] = "/tmp/bench_pca_XXXXXX";
-        int fd = mkstemp(path);
-        if (fd >= 0) {
-            close(fd);
-            char npy[64];
-            snprintf(npy, sizeof npy, "%s.npy", path);
-            FILE *f = fopen(npy, "wb");
-            char hdr[128];
-            int hl = snprintf(hdr, sizeof hdr, "{'descr': '<f8', 'fortran_order': True, "
-                              "'shape': (%lld, %lld), }", (long long)E, (long long)N);
-            int total = 10 + hl + 1;
-            int pad = (64 - total % 64) % 64;
-            fwrite("\x93NUMPY\x01\x00", 1, 8, f);
-            unsigned short len = (unsigned short)(hl + pad + 1);
-            fputc(len & 0xff, f);
-            fputc(len >> 8, f);
-            fwrite(hdr, 1, (size_t)hl, f);
-            for (int i = 0; i < pad; i++) fputc(' ', f);
-            fputc('\n', f);
-            double *b = malloc((size_t)E * 64 * sizeof(double));
-            for (int64_t r0 = 0; r0 < N; r0 += 64) {
-                int64_t n = N - r0 < 64 ? N - r0 : 64;
-                gen_read(ctx, &src, r0, n, (es_mat){b, E, n, E});
-                fwrite(b, sizeof(double), (size_t)(E * n), f);
+    const char *why = numpy ? numpy_missing() : "--no-numpy";
+    char dir[] = "/tmp/bench_pca_XXXXXX", npy[64], py[64], cmd[512];
+    if (!why && !mkdtemp(dir)) why = "cannot make a temporary folder";
+    if (!why) {
+        FILE *f;
+        snprintf(npy, sizeof npy, "%s/X.npy", dir);
+        snprintf(py, sizeof py, "%s/pca.py", dir);
+        if (write_npy(npy, X, E, N) != 0 || !(f = fopen(py, "w")) ||
+            fputs(numpy_script, f) < 0 || fclose(f) != 0)
+            why = "cannot write the matrix and script to /tmp";
+    }
+    if (!why) {
+        snprintf(cmd, sizeof cmd, PYTHON " %s %s %lld %lld %lld %llu", py, npy, (long long)K,
+                 (long long)o.oversample, (long long)o.power_iters,
+                 (unsigned long long)es_ctx_seed(ctx));
+        FILE *pp = popen(cmd, "r");
+        char line[2048], name[32];
+        int got = 0;
+        while (pp && fgets(line, sizeof line, pp)) {
+            timing t = {0};
+            int off = 0;
+            if (sscanf(line, "%31s %lf %lf%n", name, &t.wall, &t.cpu, &off) != 3) continue;
+            for (char *q = line + off, *end; t.neig < 10; q = end) {
+                t.eig[t.neig] = strtod(q, &end);
+                if (end == q) break;
+                t.neig++;
             }
-            free(b);
-            fclose(f);
-            char cmd[512];
-            snprintf(cmd, sizeof cmd, "python3 -c \"import numpy as np, time; X = np.load('%s'); "
-                     "t = time.time(); Xc = X - X.mean(axis=1, keepdims=True); "
-                     "np.linalg.svd(Xc, full_matrices=False); print(time.time() - t)\"", npy);
-            FILE *pp = popen(cmd, "r");
-            double tnp = -1;
-            if (pp && fscanf(pp, "%lf", &tnp) == 1)
-                printf("  numpy.linalg.svd (centred, thin):   %7.2f s  -> ratio numpy / exact "
-                       "%.2f\n", tnp, tnp / texact);
-            else
-                printf("  numpy.linalg.svd: failed to run\n");
-            if (pp) pclose(pp);
-            remove(npy);
-            remove(path);
+            if (!strcmp(name, "gram")) n_exact = t, got++;
+            else if (!strcmp(name, "top20")) n_top = t, got++;
+            else if (!strcmp(name, "randomized")) n_rnd = t, got++;
         }
+        if (!pp || pclose(pp) != 0 || got != 3) why = "the numpy script failed";
+        remove(npy);
+        remove(py);
+        rmdir(dir);
+    }
+    if (why) {
+        printf("  numpy comparison NOT run: %s\n", why);
     } else {
-        printf("  numpy.linalg.svd: skipped (python3 with numpy not available)\n");
+        printf("  on the same matrix, numpy under " PYTHON ":\n");
+        compare("exact, all components:", &t_exact, &n_exact);
+        compare("exact, top 20:", &t_top, &n_top);
+        compare("randomized, top K:", &t_rnd, &n_rnd);
     }
     es_pca_free(exact);
     es_pca_free(rnd);
+    free(X);
     free(g.basis);
     free(g.coef);
     es_ctx_free(ctx);

@@ -12,14 +12,17 @@ static const char usage[] =
     "\n"
     "Read meshes that share one connectivity into the HDF5 store STORE (created\n"
     "if absent): edge lengths normalized to sum 1, their scale, positions, ids\n"
-    "and labels. Every input is read and checked before anything is written; on\n"
-    "any error (or if killed) the store is left exactly as it was. Inputs whose\n"
-    "id and content are in the store already are skipped.\n"
+    "and labels. Inputs are read and checked a block at a time, and each block\n"
+    "is written to a working copy that replaces STORE only when every input is\n"
+    "in: on any error (or if killed) the store is left exactly as it was.\n"
+    "Inputs whose id and content are in the store already are skipped.\n"
     "\n"
     "  -m, --manifest CSV  CSV with a 'file' column (paths relative to the CSV),\n"
     "                      an optional 'id' column and any label columns\n"
     "  -f, --format FMT    obj, ply or off (default: from each file's extension)\n"
     "      --no-create     fail if STORE does not exist\n"
+    "      --block-rows N  inputs held in memory at once (default: about 64 MB\n"
+    "                      of positions and lengths)\n"
     "  -q, --quiet         print nothing on success\n"
     "  -h, --help          show this help\n"
     "\n"
@@ -31,7 +34,8 @@ int cmd_ingest(int argc, char **argv)
     static const struct option longopts[] = {
         {"manifest", required_argument, NULL, 'm'}, {"format", required_argument, NULL, 'f'},
         {"no-create", no_argument, NULL, 'N'},      {"quiet", no_argument, NULL, 'q'},
-        {"help", no_argument, NULL, 'h'},           {NULL, 0, NULL, 0}};
+        {"help", no_argument, NULL, 'h'},           {"block-rows", required_argument, NULL, 'B'},
+        {NULL, 0, NULL, 0}};
     const char *manifest = NULL, *store;
     es_ingest_opts opts;
     es_ingest_report rep;
@@ -50,6 +54,11 @@ int cmd_ingest(int argc, char **argv)
             else return cli_usage_error("ingest", "unknown format '%s' (obj, ply, off)", optarg);
             break;
         case 'N': opts.create = 0; break;
+        case 'B':
+            if (cli_parse_i64(optarg, &opts.block_rows) != 0 || opts.block_rows < 1)
+                return cli_usage_error("ingest", "--block-rows wants a positive integer, not "
+                                       "'%s'", optarg);
+            break;
         case 'q': quiet = 1; break;
         case 'h': fputs(usage, stdout); return CLI_OK;
         default: return cli_usage_error("ingest", "bad option");

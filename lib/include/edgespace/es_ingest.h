@@ -8,12 +8,14 @@
  * a leading byte-order mark are accepted; every error names the manifest and
  * the line.
  *
- * Ingest is all-or-nothing: every input is read and validated in memory
- * (readable mesh, same vertex count and face list as the store or as the
- * first input, a valid oriented 2-manifold, finite positive scale, unique
- * ids) before anything is written, and the store is then replaced
+ * Ingest is all-or-nothing, in bounded memory: inputs are read and
+ * validated a block at a time (readable mesh, same vertex count and face
+ * list as the store or as the first input, a valid oriented 2-manifold,
+ * finite positive scale, unique ids), each block's rows are appended to the
+ * store's working copy, and only after the last block is the store replaced
  * atomically (see es_store.h). A failure or a kill at any moment leaves the
- * store exactly as it was.
+ * store exactly as it was. Memory holds one block (es_ingest_opts.block_rows)
+ * plus a few dozen bytes per input, whatever the number of inputs.
  *
  * Duplicates: an input whose id is in the store already and whose content
  * hash equals the stored row's is skipped (re-ingesting a manifest is a
@@ -74,6 +76,11 @@ typedef struct es_ingest_opts {
                                 buffers come from malloc, not ctx's allocator;
                                 1 keeps every allocation on ctx. Results do not
                                 depend on it. */
+    int64_t block_rows;      /* inputs read and checked before their rows are
+                                written to the store's working copy (the memory
+                                ingest holds); 0 (default): about 64 MB of
+                                positions and lengths, and at least one per
+                                thread. Results do not depend on it. */
 } es_ingest_opts;
 
 ES_API void es_ingest_opts_init(es_ingest_opts *opts);
