@@ -309,6 +309,17 @@ typedef struct attr_value {
     int64_t i;
 } attr_value;
 
+/* The attribute messages of obj checked (store_groups.c) before HDF5
+ * decodes any of them. */
+static es_status check_attrs_of(es_ctx *ctx, es_store *s, hid_t obj, const char *full)
+{
+    es__h5_raw *raw = NULL;
+    es_status rc = es__h5_raw_open(ctx, obj, s->path, &raw);
+    if (rc == ES_OK) rc = es__h5_check_attrs(raw, obj, full);
+    es__h5_raw_close(raw);
+    return rc;
+}
+
 static es_status put_attr_impl(es_ctx *ctx, es_store *s, const char *path, const char *key,
                                const attr_value *v)
 {
@@ -326,12 +337,7 @@ static es_status put_attr_impl(es_ctx *ctx, es_store *s, const char *path, const
     if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
     if ((obj = H5Oopen(s->file, full, H5P_DEFAULT)) < 0)
         return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
-    {
-        es__h5_raw *raw = NULL;
-        if ((rc = es__h5_raw_open(ctx, obj, s->path, &raw)) == ES_OK)
-            rc = es__h5_check_attrs(raw, obj, full);
-        es__h5_raw_close(raw);
-    }
+    rc = check_attrs_of(ctx, s, obj, full);
     if (rc == ES_OK)
         rc = v->type == 1 ? es__h5_write_attr_f64(ctx, obj, key, v->d)
              : v->type == 2 ? es__h5_write_attr_i64(ctx, obj, key, v->i)
@@ -555,15 +561,9 @@ static es_status get_attr_impl(es_ctx *ctx, es_store *s, const char *path, const
     if ((obj = H5Oopen(s->file, full, H5P_DEFAULT)) < 0)
         return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
     /* HDF5 decodes every attribute of the object to find one: checked first */
-    {
-        es__h5_raw *raw = NULL;
-        if ((rc = es__h5_raw_open(ctx, obj, s->path, &raw)) == ES_OK)
-            rc = es__h5_check_attrs(raw, obj, full);
-        es__h5_raw_close(raw);
-        if (rc) {
-            H5Oclose(obj);
-            return rc;
-        }
+    if ((rc = check_attrs_of(ctx, s, obj, full))) {
+        H5Oclose(obj);
+        return rc;
     }
     if (H5Aexists(obj, key) <= 0) {
         H5Oclose(obj);
@@ -692,15 +692,10 @@ static es_status attrs_impl(es_ctx *ctx, es_store *s, const char *path, char ***
     if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
     hid_t obj = H5Oopen(s->file, full, H5P_DEFAULT);
     if (obj < 0) return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
-    {   /* the attribute messages checked before HDF5 decodes them */
-        es__h5_raw *raw = NULL;
-        if ((rc = es__h5_raw_open(ctx, obj, s->path, &raw)) == ES_OK)
-            rc = es__h5_check_attrs(raw, obj, full);
-        es__h5_raw_close(raw);
-        if (rc) {
-            H5Oclose(obj);
-            return rc;
-        }
+    /* the attribute messages checked before HDF5 decodes them */
+    if ((rc = check_attrs_of(ctx, s, obj, full))) {
+        H5Oclose(obj);
+        return rc;
     }
     if (H5Aiterate2(obj, H5_INDEX_NAME, H5_ITER_INC, NULL, attr_cb, &l) < 0) {
         rc = l.rc ? l.rc : es__h5_fail(ctx, ES_EIO, "store: cannot list the attributes of %s",
