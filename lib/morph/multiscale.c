@@ -60,9 +60,10 @@ es_status es_multiscale_new(es_ctx *ctx, const es_mesh *mesh, const es_multiscal
     else es_multiscale_opts_init(&ms->opts);
     if (ms->opts.patches < 2 || ms->opts.patches > 64 || ms->opts.passes < 0 ||
         ms->opts.leaf_faces < 0) {
+        int64_t patches = ms->opts.patches;
         es__free(ctx, ms);
         ES_FAIL(ctx, ES_EINVAL, "multiscale: patches must be 2 .. 64 (got %lld), passes and "
-                "leaf_faces >= 0", (long long)ms->opts.patches);
+                "leaf_faces >= 0", (long long)patches);
     }
     /* a leaf has at least m faces, so that every split has m seeds */
     if (ms->opts.leaf_faces < ms->opts.patches) ms->opts.leaf_faces = ms->opts.patches;
