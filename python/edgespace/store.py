@@ -120,6 +120,14 @@ class CompareResult(Result):
     """Distances in the two spaces and their agreement (es_compare_result)."""
 
 
+class ModelResult(Result):
+    """A linear model with permutation tests (es_study_model): terms (T,),
+    df, ss, ms, r2, f, p (T,) the ANOVA table (p NaN where untestable),
+    df_resid, rss, tss, coef_names (q,), coef (q, P), coef_weights (q, N),
+    mean (P,), rows (N,) store rows, and with edges= edge_f/edge_p/edge_q
+    (E,), with log(size) a term cac (P,) and cac_scores (N,)."""
+
+
 def ingest(store_path, manifest=None, files=None, create=True, threads=0, ctx=None):
     """Ingest meshes into a store (es_ingest_manifest / es_ingest_files):
     all-or-nothing; returns the report as a dict."""
@@ -672,6 +680,48 @@ class Store:
             res.mean_proc = A.view(r.mean_proc, (G, G), r).T
             res.p_len = A.view(r.p_len, (G, G), r).T
             res.p_proc = A.view(r.p_proc, (G, G), r).T
+        return res
+
+    def model(self, formula, gpa=None, where=None, block=None, ss_type=1, permute="rrpp",
+              permutations=999, contrasts="treatment", pairwise=None, edges=None,
+              edge_permutations=-1, name=None):
+        """A linear model of the shapes on label columns with permutation
+        tests (es_study_model): in edge-length space, or on GPA result
+        `gpa`'s aligned coordinates; stored as model/<name> (None: not
+        stored) and committed."""
+        schemes = {"rrpp": lib.ES_PERM_RRPP, "raw": lib.ES_PERM_RAW}
+        codings = {"treatment": lib.ES_CONTRASTS_TREATMENT, "sum": lib.ES_CONTRASTS_SUM}
+        if permute not in schemes or contrasts not in codings or ss_type not in (1, 2, 3):
+            raise ValueError(f"model: permute in {sorted(schemes)}, contrasts in "
+                             f"{sorted(codings)}, ss_type in 1, 2, 3")
+        keep = [_c(formula), _c(gpa), _c(where), _c(block), _c(pairwise), _c(edges), _c(name),
+                self._command("model")]
+        o = ffi.new("es_study_model_opts *")
+        lib.es_study_model_opts_init(o)
+        (o.formula, o.gpa, o.where, o.block, o.pairwise, o.edge_term, o.name,
+         o.command) = keep
+        o.ss_type, o.scheme, o.contrasts = ss_type, schemes[permute], codings[contrasts]
+        o.permutations, o.edge_permutations = int(permutations), int(edge_permutations)
+        out = ffi.new("es_study_model_result **")
+        self.ctx.call(lib.es_study_model, self.ptr, o, out)
+        r = A.owned(self.ctx, out[0], lib.es_study_model_free)
+        if name:
+            self.commit()
+        m, d = r.model, r.design
+        T, q, P, N = int(m.nterms), int(m.ncoef), int(m.p), int(r.nrows)
+        res = ModelResult(
+            terms=[A.string(d.terms[j]) for j in range(T)],
+            df=A.view(m.df, (T,), r, "i8"), ss=A.view(m.ss, (T,), r), ms=A.view(m.ms, (T,), r),
+            r2=A.view(m.r2, (T,), r), f=A.view(m.f, (T,), r), p=A.view(m.pval, (T,), r),
+            df_resid=int(m.df_resid), rss=m.rss, tss=m.tss,
+            coef_names=[A.string(d.colnames[c]) for c in range(q)],
+            coef=A.view(m.coef, (P, q), r).T, coef_weights=A.view(m.coef_weights, (q, N), r),
+            mean=A.view(m.mean, (P,), r), rows=A.view(r.rows, (N,), r, "i8"))
+        if r.edge_f != ffi.NULL:
+            res.edge_f, res.edge_p, res.edge_q = (A.view(v, (P,), r)
+                                                  for v in (r.edge_f, r.edge_p, r.edge_q))
+        if r.cac != ffi.NULL:
+            res.cac, res.cac_scores = A.view(r.cac, (P,), r), A.view(r.cac_scores, (N,), r)
         return res
 
     # -- files --------------------------------------------------------------

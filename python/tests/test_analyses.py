@@ -166,3 +166,37 @@ def test_gpa_and_compare(store_path, cli_copy, tmp_path, cli, ctx):
     ref = np.sqrt(((L[:, None, :] - L[None, :, :]) ** 2).sum(-1))
     assert np.allclose(c.d_len, ref, rtol=1e-7, atol=1e-12)
     assert c.group_names == ["neutral", "happy", "angry"] and c.mean_len.shape == (3, 3)
+
+
+def test_model(store_path, cli_copy, tmp_path, cli, ctx):
+    """Store.model against `edgespace model`'s ANOVA CSV bit for bit, and
+    numpy: the balanced expression SS, SS + RSS = TSS, and coefficients
+    rebuilt from their row weights."""
+    cli("model", cli_copy, "~ expression + subject", "--block", "subject", "--permutations", "99",
+        "--name", "m", "--csv", tmp_path / "anova.csv")
+    head, body = table(tmp_path / "anova.csv")
+    with es.Store(store_path, write=True, ctx=ctx) as s:
+        m = s.model("~ expression + subject", block="subject", permutations=99, name="m")
+        assert m.terms == [r[0] for r in body[:len(m.terms)]] == ["expression", "subject"]
+        for j in range(len(m.terms)):
+            row = body[j]
+            assert int(row[1]) == m.df[j]
+            for col, v in zip(row[2:6], (m.ss[j], m.ms[j], m.r2[j], m.f[j])):
+                assert float(col) == v                              # bit for bit
+        assert float(body[0][6]) == m.p[0] and np.isnan(m.p[1])    # the block: untestable
+        L, expr = s.lengths(), s.label("expression")
+        grand = L.mean(axis=0)
+        ss = sum((expr == g).sum() * ((L[expr == g].mean(axis=0) - grand) ** 2).sum()
+                 for g in np.unique(expr))
+        assert np.isclose(m.ss[0], ss, rtol=1e-10, atol=0)          # numpy oracle
+        assert np.isclose(m.ss.sum() + m.rss, m.tss, rtol=1e-12)
+        assert np.isclose(m.tss, ((L - grand) ** 2).sum(), rtol=1e-12)
+        ok = ~np.isnan(m.coef[:, 0])
+        assert np.allclose(m.coef_weights[ok] @ L[m.rows], m.coef[ok], rtol=0,
+                           atol=1e-10 * np.abs(L).max())
+        assert m.coef_names[0] == "intercept" and "expression=neutral" in m.coef_names
+        assert s.results("model") == ["m"]
+        with pytest.raises(es.Error, match="no label column 'mood'"):
+            s.model("~ mood", permutations=0)
+        with pytest.raises(ValueError):
+            s.model("~ expression", permute="shuffle")
