@@ -155,9 +155,12 @@ static es_status columns(es_ctx *ctx, es_store *s, const es_study_model_result *
             cols[v].values = rp->size;
             continue;
         }
-        if (col < 0)
-            ES_FAIL(ctx, ES_ENOTFOUND, "model: no label column '%s' in '%s'", name,
-                    es_store_path(s));
+        if (col < 0) {
+            char hint[400];
+            es_store_column_hint(s, name, hint, sizeof hint);
+            ES_FAIL(ctx, ES_ENOTFOUND, "model: no label column '%s' in '%s'%s", name,
+                    es_store_path(s), hint);
+        }
         if (!(lab[v] = es__alloc_array(ctx, n, sizeof **lab))) return ES_ENOMEM;
         for (int64_t i = 0; i < n; i++) lab[v][i] = es_store_label(s, res->rows[i], col);
         cols[v].labels = lab[v];
@@ -170,7 +173,11 @@ static es_status blocks_of(es_ctx *ctx, es_store *s, const es_study_model_result
 {
     int64_t col = es_store_find_column(s, block), ng = 0;
     const char **lab = NULL, **names = NULL;
-    if (col < 0) ES_FAIL(ctx, ES_ENOTFOUND, "model: no label column '%s' for the blocks", block);
+    if (col < 0) {
+        char hint[400];
+        es_store_column_hint(s, block, hint, sizeof hint);
+        ES_FAIL(ctx, ES_ENOTFOUND, "model: no label column '%s' for the blocks%s", block, hint);
+    }
     if (!(lab = es__alloc_array(ctx, res->nrows, sizeof *lab))) return ES_ENOMEM;
     for (int64_t i = 0; i < res->nrows; i++) lab[i] = es_store_label(s, res->rows[i], col);
     es_status rc = es_groups_from_labels(ctx, lab, res->nrows, out, &names, &ng);

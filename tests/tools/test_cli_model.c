@@ -136,9 +136,12 @@ int main(void)
     ES_RUN(&r, dir, "export", store, "--lengths", lengths);
     ES_CHECK(r.status == 0);
     ES_RUN(&r, dir, "model", store, "~ expresion");
-    ES_CHECK_MSG(r.status == 1 && strstr(r.err, "no label column 'expresion'"), "%s", r.err);
+    /* a misspelt column names the closest */
+    ES_CHECK_MSG(r.status == 1 && strstr(r.err, "no label column 'expresion'") &&
+                 strstr(r.err, "did you mean") && strstr(r.err, "expression"), "%s", r.err);
     ES_RUN(&r, dir, "model", store, "~ expression", "--block", "subjct");
-    ES_CHECK_MSG(r.status == 1 && strstr(r.err, "'subjct'"), "%s", r.err);
+    ES_CHECK_MSG(r.status == 1 && strstr(r.err, "'subjct'") && strstr(r.err, "did you mean") &&
+                 strstr(r.err, "subject"), "%s", r.err);
     ES_RUN(&r, dir, "export", store, "--result", "model/m", "--csv", "-");
     ES_CHECK(r.status == 1 && strstr(r.err, "the store has no result model/m"));
 
