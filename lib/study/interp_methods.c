@@ -52,13 +52,7 @@ static es_status emit(mwalk *w, int64_t i, const char *heading, const double *ta
     char fname[4096], rname[300], init[96];
     int64_t rows[2] = {w->ra, w->rb};
     es_status rc;
-    if (o->steps > 1) {
-        es_study_frame_path(o->output, i, fname, sizeof fname);
-        snprintf(rname, sizeof rname, "%s_%02lld", w->name, (long long)i);
-    } else {
-        snprintf(fname, sizeof fname, "%s", o->output);
-        snprintf(rname, sizeof rname, "%s", w->name);
-    }
+    es__study_frame_names(o, w->name, i, fname, sizeof fname, rname, sizeof rname);
     if ((rc = es_mesh_write(w->ctx, fname, ES_FORMAT_AUTO, w->mesh, xyz, NULL)) != ES_OK)
         return rc;
     if (o->frame) o->frame(o->userdata, i, o->steps, fname, heading, rep);

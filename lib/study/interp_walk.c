@@ -101,13 +101,7 @@ static es_status emit_frame(walk *wk, int64_t i, const char *heading, const doub
     const es_study_interp_opts *o = wk->o;
     char fname[4096], rname[300];
     es_status rc;
-    if (o->steps > 1) {
-        es_study_frame_path(o->output, i, fname, sizeof fname);
-        snprintf(rname, sizeof rname, "%s_%02lld", wk->name, (long long)i);
-    } else {
-        snprintf(fname, sizeof fname, "%s", o->output);
-        snprintf(rname, sizeof rname, "%s", wk->name);
-    }
+    es__study_frame_names(o, wk->name, i, fname, sizeof fname, rname, sizeof rname);
     if ((rc = es_mesh_write(wk->ctx, fname, ES_FORMAT_AUTO, wk->mesh, xyz, NULL)) != ES_OK)
         return rc;
     if (o->frame) o->frame(o->userdata, i, o->steps, fname, heading, rep);
@@ -123,6 +117,18 @@ const char *es_study_interp_name(const es_study_interp_opts *o, char *buf, size_
     else default_name(o->output, name, sizeof name);
     snprintf(buf, n, "%s%s", name, !o->weights && o->steps > 1 ? "_NN" : "");
     return buf;
+}
+
+void es__study_frame_names(const es_study_interp_opts *o, const char *name, int64_t i,
+                           char *fname, size_t nf, char *rname, size_t nr)
+{
+    if (o->steps > 1) {
+        es_study_frame_path(o->output, i, fname, nf);
+        snprintf(rname, nr, "%s_%02lld", name, (long long)i);
+    } else {
+        snprintf(fname, nf, "%s", o->output);
+        snprintf(rname, nr, "%s", name);
+    }
 }
 
 /* ---- the walk ------------------------------------------------------------------ */

@@ -81,6 +81,12 @@ es_status es__study_store_mesh_result(es_ctx *ctx, es_store *store, const char *
                                       const double *xyz, const es_embed_report *r,
                                       const char *init);
 
+/* Frame i's file (the output pattern's, or the output itself for one
+ * frame) and its result name (NAME_<i> in a sequence, else NAME), for
+ * every interpolation method (interp_walk.c). */
+void es__study_frame_names(const es_study_interp_opts *o, const char *name, int64_t i,
+                           char *fname, size_t nf, char *rname, size_t nr);
+
 /* es_study_interp for opts->method other than edge-length, between two rows
  * (interp_methods.c); name: the result name (without the frame suffix). */
 es_status es__study_interp_method(es_ctx *ctx, es_store *store, const es_study_interp_opts *o,
