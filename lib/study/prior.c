@@ -78,34 +78,60 @@ done:
     return rc;
 }
 
+es_status es__study_rows_new(es_ctx *ctx, int64_t n, int64_t nv, int64_t ne, es_study_rows **out,
+                             double **aligned, double **alpha)
+{
+    es_study_rows *r;
+    *out = NULL;
+    if (!(r = es__calloc(ctx, 1, sizeof *r))) return ES_ENOMEM;
+    r->ctx = ctx;
+    r->n = n;
+    r->nv = nv;
+    r->ne = ne;
+    r->aligned = es__alloc_array(ctx, 3 * nv * n, sizeof *r->aligned);
+    r->alpha = es__alloc_array(ctx, ne * n, sizeof *r->alpha);
+    r->pa = es__alloc_array(ctx, n, sizeof *r->pa);
+    r->pd = es__alloc_array(ctx, n, sizeof *r->pd);
+    if (!r->aligned || !r->alpha || !r->pa || !r->pd) {
+        es_study_rows_free(r);
+        return ES_ENOMEM;
+    }
+    for (int64_t j = 0; j < n; j++) {
+        r->pa[j] = r->aligned + 3 * nv * j;
+        r->pd[j] = r->alpha + ne * j;
+    }
+    *aligned = r->aligned;
+    *alpha = r->alpha;
+    *out = r;
+    return ES_OK;
+}
+
+void es__study_rows_arrays(const es_study_rows *r, const double **aligned, const double **alpha)
+{
+    *aligned = r->aligned;
+    *alpha = r->alpha;
+}
+
 es_status es_study_rows_load(es_ctx *ctx, es_store *store, const es_mesh *mesh,
                              es_study_rows **out)
 {
-    es_study_rows *r;
-    es_status rc = ES_OK;
+    es_study_rows *r = NULL;
+    double *aligned, *alpha, *orig0 = NULL;
+    es_status rc;
     *out = NULL;
     if (!mesh) ES_FAIL(ctx, ES_EINVAL, "prior: the store has no faces");
     if (es_store_nrows(store) < 1) ES_FAIL(ctx, ES_EINVAL, "prior: the store has no rows");
-    if (!(r = es__calloc(ctx, 1, sizeof *r))) return ES_ENOMEM;
-    r->ctx = ctx;
-    r->n = es_store_nrows(store);
-    r->nv = es_mesh_nverts(mesh);
-    r->ne = es_mesh_nedges(mesh);
-    r->aligned = es__alloc_array(ctx, 3 * r->nv * r->n, sizeof *r->aligned);
-    r->alpha = es__alloc_array(ctx, r->ne * r->n, sizeof *r->alpha);
-    r->pa = es__alloc_array(ctx, r->n, sizeof *r->pa);
-    r->pd = es__alloc_array(ctx, r->n, sizeof *r->pd);
-    double *orig0 = es__alloc_array(ctx, 3 * r->nv, sizeof *orig0);
-    if (!r->aligned || !r->alpha || !r->pa || !r->pd || !orig0) {
+    if ((rc = es__study_rows_new(ctx, es_store_nrows(store), es_mesh_nverts(mesh),
+                                 es_mesh_nedges(mesh), &r, &aligned, &alpha)) != ES_OK)
+        return rc;
+    if (!(orig0 = es__alloc_array(ctx, 3 * r->nv, sizeof *orig0))) {
         rc = ES_ENOMEM;
         goto done;
     }
     for (int64_t j = 0; j < r->n && rc == ES_OK; j++) {
-        double *x = r->aligned + 3 * r->nv * j;
-        r->pa[j] = x;
-        r->pd[j] = r->alpha + r->ne * j;
+        double *x = aligned + 3 * r->nv * j;
         if ((rc = es_store_read_positions(ctx, store, j, x)) == ES_OK)
-            rc = es_dihedral_angles(ctx, mesh, x, r->alpha + r->ne * j);
+            rc = es_dihedral_angles(ctx, mesh, x, alpha + r->ne * j);
         es__progress(ctx, "prior: rows", j + 1, r->n);
     }
     if (rc == ES_OK) memcpy(orig0, r->aligned, (size_t)(3 * r->nv) * sizeof *orig0);

@@ -568,12 +568,14 @@ class Store:
         return Embedding(xyz, self.mesh.faces, rep)
 
     def interp(self, from_=None, to=None, steps=9, t0=0.0, t1=1.0, weights=None, pca=None,
-               name=None, output=None, **opts):
+               name=None, output=None, cold=False, **opts):
         """A walk from `from_` (t = t0) to `to` (t = t1) in `steps` frames, or one
         weighted combination of rows (weights="0.3*row:a + 0.7*row:b"), each
-        frame embedded as es_study_interp embeds it. Returns a list of
-        Embedding (report["t_heading"] says which t). output: a mesh file
-        pattern ("walk_%02d.obj") to keep the frames; name stores them."""
+        frame embedded as es_study_interp embeds it: from the last frame's
+        correction of its prior (a warm start), or with cold=True from its own
+        prior, as embed() does. Returns a list of Embedding (report["t_heading"]
+        says which t). output: a mesh file pattern ("walk_%02d.obj") to keep the
+        frames; name stores them."""
         o = ffi.new("es_study_interp_opts *")
         lib.es_study_interp_opts_init(o)
         frames = []
@@ -589,6 +591,7 @@ class Store:
             setattr(o, "from", keep[0])   # a Python keyword
             o.to, o.weights, o.pca_name, o.output, o.name, o.command = keep[1:]
             o.t0, o.t1, o.steps = float(t0), float(t1), int(steps)
+            o.cold = 1 if cold else 0
             o.frame = cb
             set_embed_opts(o.embed, opts)
             self.ctx.call(lib.es_study_interp, self.ptr, o)
