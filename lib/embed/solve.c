@@ -283,7 +283,10 @@ static es_status shape_from_start(es_embedder *emb, const es_embed_opts *o, es__
         Lr = emb->len;
     }
     if (o->prior_exact) lo.rms_tol /= 3, lo.max_tol /= 3;
-    if ((rc = es__lg_solve(emb, Lr, xyz, &lo, &res)) != ES_OK) return rc;
+    double t0 = now_s();
+    rc = es__lg_solve(emb, Lr, xyz, &lo, &res);
+    rep->t_local_global = now_s() - t0;
+    if (rc != ES_OK) return rc;
     rep->lg_iters = res.iters;
     if (!res.met && o->lg_polish && o->refine_max_iter > 0) {
         es__refine_opts ro = es__refine_opts_from(o);

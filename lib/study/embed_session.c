@@ -13,7 +13,11 @@
  * so it depends little on which point came before (starting from the last
  * output as it is, a walk's middle frame came 0.5 % of the diagonal from the
  * same point embedded alone on facecap, and mean +- c sd of a statismo
- * export lost their symmetry). */
+ * export lost their symmetry). A last output that bends more than 1.1 x its
+ * prior (the folds of an extrapolated point) is no start: carried along a
+ * walk of the synthetic faces from mean - 2 sd on PC 1 (bending 1.48), it
+ * kept every later frame folded (1.45-1.49, where each frame alone bends
+ * 1.00-1.21); that frame starts from its prior instead. */
 #include "study/study_pkg.h"
 
 #include <math.h>
@@ -28,6 +32,7 @@ struct es_study_embedder {
     int64_t nv, ne, n;
     double *target, *w, *prior, *last;   /* E, N, 3V + 2E, 3V */
     double *correction, *start;          /* 3V each: x_last - prior_last, the warm start */
+    int last_ok;                         /* the last output bent <= 1.1 x its prior */
     int have_last;
 };
 
@@ -120,15 +125,17 @@ es_status es_study_embedder_solve(es_study_embedder *se, const double *lengths, 
     res->scale = scale;
     int64_t n3 = 3 * se->nv;
     if ((rc = es_study_prior(ctx, se->rows, w, se->prior, alpha, sd)) != ES_OK) return rc;
-    if (warm && se->have_last)   /* (the solve scales the start to the target's sum) */
+    warm = warm && se->have_last && se->last_ok;
+    if (warm)   /* (the solve scales the start to the target's sum) */
         for (int64_t i = 0; i < n3; i++) se->start[i] = se->prior[i] + se->correction[i];
-    es_embed_prior pr = {se->prior, alpha, sd, warm && se->have_last ? se->start : NULL};
+    es_embed_prior pr = {se->prior, alpha, sd, warm ? se->start : NULL};
     if ((rc = es_embed_prior_solve(ctx, se->emb, lengths, scale, &pr, &o, xyz, &res->report)) !=
         ES_OK)
         return rc;
     memcpy(se->last, xyz, (size_t)n3 * sizeof *xyz);
     for (int64_t i = 0; i < n3; i++) se->correction[i] = xyz[i] - se->prior[i];
     se->have_last = 1;
+    se->last_ok = !(res->report.bend_ratio > 1.1);
     for (int64_t i = 0; i < se->n; i++) {
         used += w[i] != 0;
         if (fabs(w[i]) > fabs(w[top])) top = i;

@@ -20,7 +20,9 @@ struct es_study_rows {
     int64_t n, nv, ne;
     double *aligned;        /* 3V x n: row i's positions in the frame */
     double *alpha;          /* E x n: row i's dihedrals */
-    const double **pa, **pd;   /* column pointers for es_embed_prior_from_rows */
+    double *trig;           /* 2 E x n: their cosines, then their sines (made on first
+                               use by es_study_prior) */
+    const double **pa, **pd, **pc, **ps;   /* column pointers for es_embed_prior_from_rows */
 };
 
 void es_study_rows_free(es_study_rows *r)
@@ -28,8 +30,11 @@ void es_study_rows_free(es_study_rows *r)
     if (!r) return;
     es__free(r->ctx, r->aligned);
     es__free(r->ctx, r->alpha);
+    es__free(r->ctx, r->trig);
     es__free(r->ctx, (void *)r->pa);
     es__free(r->ctx, (void *)r->pd);
+    es__free(r->ctx, (void *)r->pc);
+    es__free(r->ctx, (void *)r->ps);
     es__free(r->ctx, r);
 }
 
@@ -146,9 +151,36 @@ done:
     return ES_OK;
 }
 
+/* Every row's cosines and sines of its dihedrals, once: the prior's
+ * circular mean then needs no trigonometry per row (es_embed_prior_from_rows_sc). */
+static es_status make_trig(es_ctx *ctx, es_study_rows *r)
+{
+    int64_t ne = r->ne, n = r->n;
+    r->trig = es__alloc_array(ctx, 2 * ne * n, sizeof *r->trig);
+    r->pc = es__alloc_array(ctx, n, sizeof *r->pc);
+    r->ps = es__alloc_array(ctx, n, sizeof *r->ps);
+    if (!r->trig || !r->pc || !r->ps) return ES_ENOMEM;
+    for (int64_t j = 0; j < n; j++) {
+        double *c = r->trig + 2 * ne * j, *s = c + ne;
+        const double *a = r->alpha + ne * j;
+        for (int64_t e = 0; e < ne; e++) {
+            c[e] = cos(a[e]);
+            s[e] = sin(a[e]);
+        }
+        r->pc[j] = c;
+        r->ps[j] = s;
+    }
+    return ES_OK;
+}
+
 es_status es_study_prior(es_ctx *ctx, const es_study_rows *r, const double *w, double *xyz,
                          double *alpha, double *sd)
 {
     if (!r || !w) ES_FAIL(ctx, ES_EINVAL, "prior: no rows or weights");
-    return es_embed_prior_from_rows(ctx, r->nv, r->ne, r->n, r->pa, r->pd, w, xyz, alpha, sd);
+    if (!r->trig && (alpha || sd)) {
+        es_status rc = make_trig(ctx, (es_study_rows *)r);   /* a cache inside the rows */
+        if (rc != ES_OK) return rc;
+    }
+    return es_embed_prior_from_rows_sc(ctx, r->nv, r->ne, r->n, r->pa, r->pd, r->pc, r->ps, w,
+                                       xyz, alpha, sd);
 }

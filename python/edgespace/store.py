@@ -162,6 +162,7 @@ class Store:
         self._ptr = A.owned(self.ctx, _ptr, lib.es_store_close)
         self.writable = bool(write)
         self._mesh = None
+        self._sessions = []   # StudyEmbedder sessions, closed before the store
 
     open = classmethod(lambda cls, path, write=False, ctx=None: cls(path, write, ctx))
 
@@ -193,6 +194,7 @@ class Store:
         """Commit (raising its error) and close. Idempotent."""
         if self._ptr is None:
             return
+        self._close_sessions()
         try:
             if self.writable:
                 self.commit()
@@ -203,6 +205,7 @@ class Store:
     def abort(self):
         """Close, discarding uncommitted writes."""
         if self._ptr is not None:
+            self._close_sessions()
             ffi.gc(self._ptr, None)   # no es_store_close at collection
             lib.es_store_abort(self._ptr)
             self._ptr = None
@@ -541,6 +544,21 @@ class Store:
         self.ctx.call(lib.es_study_nearest_row, self.ptr, A.dptr(L), A.iptr(r),
                       0 if r is None else len(r), row, dist)
         return int(row[0]), float(dist[0])
+
+    def _close_sessions(self):
+        for s in self._sessions:
+            s.close()
+        self._sessions = []
+
+    def embedder(self, cache=True):
+        """An embedding session (StudyEmbedder): embed(point, warm=True, fast=...)
+        costs only the solve; the mesh, embedder and rows for priors are made
+        once (from STORE.es-cache when it is current; cache=False neither
+        reads nor writes it). Closed with the store."""
+        from .session import StudyEmbedder
+        s = StudyEmbedder(self, cache)
+        self._sessions.append(s)
+        return s
 
     def embed(self, point, pca=None, init=None, scale=0.0, name=None, output=None,
               residuals=None, **opts):
