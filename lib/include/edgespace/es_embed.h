@@ -20,6 +20,12 @@
  * Optionally (continuation_steps > 0 with initial positions) stage 4 runs
  * along the path from the initial mesh's own lengths (which it realizes
  * exactly) to the target, warm-started step by step.
+ * From positions (es_embed_prior_solve on open meshes: the prior's
+ * realization, or a warm start) the solve is instead local-global
+ * iterations on the triangles the target lengths make, with L-BFGS on a
+ * factored V x V Laplacian (lib/embed/local_global.c), and stage 4 only
+ * finishes where they did not meet the accuracy asked for (es_embed_opts:
+ * solver, lg_*).
  *
  * Conventions are those of ../shared/oracle/embed (es_geom.h signs): the
  * angle alpha_e is the signed bending angle, alpha = 0 flat, < 0 convex;
