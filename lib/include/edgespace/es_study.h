@@ -271,7 +271,23 @@ typedef struct es_study_model_opts {
     int64_t permutations;      /* 999 */
     es_contrasts contrasts;    /* treatment */
     const char *pairwise;      /* a categorical variable: its LS means compared, or NULL */
-    const char *edge_term;     /* a term: per-edge tests with FDR (edge-length space) */
+    const char *slopes;        /* with pairwise: compare the levels' slopes on this numeric
+                                  variable ("log(size)") instead of LS means */
+    const char *at;            /* LS means at "NAME=VALUE,...": NAME a variable label
+                                  ("log(size)") or the column a log() reads ("size", VALUE
+                                  then on the column's scale); VALUE a number or "mean" (of
+                                  what NAME names). Default: every numeric variable at its
+                                  mean as the formula uses it (mean of log(size)) */
+    const char *reference;     /* baseline levels "LEVEL" or "FACTOR=LEVEL", comma-separated
+                                  (LEVEL alone: the one factor of the formula that has it) */
+    const char *const *errors; /* nerrors "TERM=ERROR": TERM's F over ERROR's mean square
+                                  (nested designs: "population=population:colony") */
+    int64_t nerrors;
+    const char *null_formula;  /* compare the model with this nested one (RRPP's anova(null,
+                                  full)), or NULL */
+    const char *edge_term;     /* a term: per-variable tests with FDR: every edge in
+                                  edge-length space, every landmark's displacement (its d
+                                  coordinates together) in Procrustes space */
     int64_t edge_permutations; /* -1: permutations */
     const char *name;          /* store as model/<name> (NULL: store nothing) */
     const char *command;       /* provenance */
@@ -285,7 +301,12 @@ typedef struct es_study_model_result {
     es_design *design;
     es_model *model;
     es_model_pairwise *pairwise;   /* with opts->pairwise, else NULL */
-    double *edge_f, *edge_p, *edge_q;   /* E each with opts->edge_term, else NULL */
+    es_formula *null_formula;      /* with opts->null_formula, else NULL: */
+    es_design *null_design;
+    es_model *null_model;
+    es_model_comparison *comparison;
+    int64_t ntests;                /* with opts->edge_term: E edges or k landmarks */
+    double *edge_f, *edge_p, *edge_q;   /* ntests each with opts->edge_term, else NULL */
     double *cac, *cac_scores;      /* p and N when log(size) is a term, else NULL */
     int64_t nrows;
     int64_t *rows;                 /* N store rows, in model order */
@@ -301,10 +322,25 @@ ES_API void es_study_model_free(es_study_model_result *r);
 ES_API es_status es_study_model(es_ctx *ctx, es_store *store, const es_study_model_opts *opts,
                                 es_study_model_result **out);
 
-/* The analysis-of-variance table as CSV: term, df, ss, ms, r2, f, p, then
- * the rows Residual (df, ss, ms) and Total (df, ss). */
+/* The analysis-of-variance table as CSV: term, df, ss, ms, r2, f, z, p,
+ * error (the term whose MS divides, "Residual" by default), then the rows
+ * Residual (df, ss, ms) and Total (df, ss); with a null model, a row "null
+ * model: FORMULA" (df, ss, ms, r2, f, z, p of the comparison). */
 ES_API es_status es_study_write_model_table(es_ctx *ctx, const es_study_model_result *r,
                                             const char *path);
+/* The pairwise table as CSV, a row per pair of levels: level_a, level_b,
+ * d, ucl, z, p (distances of LS means or of slopes), and for slopes r
+ * (vector correlation), angle (degrees), angle_ucl, angle_z, angle_p,
+ * dlength, dlength_ucl, dlength_z, dlength_p. ES_EINVAL without pairwise. */
+ES_API es_status es_study_write_pairwise_table(es_ctx *ctx, const es_study_model_result *r,
+                                               const char *path);
+/* The fit as `edgespace model` shows it: the ANOVA table with Z (and each
+ * term's error term), the terms left out and why, the comparison with the
+ * null model, the pairwise table with the values its LS means are taken at,
+ * the count of edges or landmarks with q < 0.05. *out: text, caller frees
+ * with es_free. */
+ES_API es_status es_study_model_summary(es_ctx *ctx, const es_study_model_result *r,
+                                        char **out);
 
 /* Coefficient `coef` (a design column name, e.g. "age" or "expression=happy")
  * of stored model `model` in edge-length space: its E values (vec) and its row
