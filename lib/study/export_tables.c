@@ -276,19 +276,48 @@ es_status es__t_model_weights(es_ctx *ctx, es_store *s, const char *kind, const 
     return rc;
 }
 
+/* Per-landmark tests (Procrustes space): landmark, f, p, q. */
+static es_status landmark_table(es_ctx *ctx, es_store *s, const char *kind, const char *name,
+                                const char *path)
+{
+    static const char *const ds[3] = {"landmark_f", "landmark_p", "landmark_q"};
+    double *v[3] = {NULL};
+    int64_t n[3] = {0};
+    es__table_out t;
+    es_status rc = ES_OK;
+    for (int k = 0; k < 3 && rc == ES_OK; k++)
+        if ((rc = es__result_vector(ctx, s, kind, name, ds[k], &v[k], &n[k])) == ES_OK &&
+            n[k] != n[0])
+            rc = es__fail(ctx, ES_EFORMAT, "export: model/%s/%s is inconsistent", name, ds[k]);
+    if (rc == ES_OK && (rc = es__table_begin(ctx, path, &t)) == ES_OK) {
+        fputs("landmark,f,p,q\n", t.f);
+        for (int64_t i = 0; i < n[0]; i++) {
+            fprintf(t.f, "%lld", (long long)(i + 1));
+            for (int k = 0; k < 3; k++) es__table_number(t.f, v[k][i]);
+            fputc('\n', t.f);
+        }
+        rc = es__table_end(ctx, &t, ES_OK);
+    }
+    for (int k = 0; k < 3; k++) es_free(ctx, v[k]);
+    return rc;
+}
+
 es_status es__t_model_edges(es_ctx *ctx, es_store *s, const char *kind, const char *name,
                             const char *path)
 {
     static const char *const ds[3] = {"edge_f", "edge_p", "edge_q"}, *const cols[3] = {"f", "p",
                                                                                           "q"};
     const int64_t E = es_store_nedges(s);
-    double *all = es__alloc_array(ctx, 3 * E > 0 ? 3 * E : 1, sizeof *all), *v = NULL;
+    double *all = NULL, *v = NULL;
     int64_t n = 0;
     char p[700];
-    es_status rc = all ? es__result_path(ctx, p, sizeof p, kind, name, "edge_f") : ES_ENOMEM;
+    es_status rc = es__result_path(ctx, p, sizeof p, kind, name, "landmark_f");
+    if (rc == ES_OK && es_store_has(s, p)) return landmark_table(ctx, s, kind, name, path);
+    all = es__alloc_array(ctx, 3 * E > 0 ? 3 * E : 1, sizeof *all);
+    rc = all ? es__result_path(ctx, p, sizeof p, kind, name, "edge_f") : ES_ENOMEM;
     if (rc == ES_OK && !es_store_has(s, p))
-        rc = es__fail(ctx, ES_ENOTFOUND, "export: model/%s has no per-edge tests (fit it with "
-                      "--edges TERM)", name);
+        rc = es__fail(ctx, ES_ENOTFOUND, "export: model/%s has no per-edge or per-landmark "
+                      "tests (fit it with --edges TERM)", name);
     for (int k = 0; k < 3 && rc == ES_OK; k++) {
         if ((rc = es__result_vector(ctx, s, kind, name, ds[k], &v, &n)) != ES_OK) break;
         if (n != E) rc = es__fail(ctx, ES_EFORMAT, "export: model/%s/%s is not per edge", name,

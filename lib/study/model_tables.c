@@ -301,8 +301,10 @@ es_status es_study_model_summary(es_ctx *ctx, const es_study_model_result *r, ch
     add(&t, "%-24s %5s %14s %14s %8s %10s %7s %8s\n", "term", "df", "SS", "MS", "R2", "F", "Z",
         "p");
     for (int64_t j = 0; j < m->nterms; j++) {
-        add(&t, "%-24s %5lld %14.6g %14.6g %8.4f %10.4g %7.3f ", d->terms[j], (long long)m->df[j],
-            m->ss[j], m->ms[j], m->r2[j], m->f[j], m->z[j]);
+        add(&t, "%-24s %5lld %14.6g %14.6g %8.4f %10.4g ", d->terms[j], (long long)m->df[j],
+            m->ss[j], m->ms[j], m->r2[j], m->f[j]);
+        if (isnan(m->z[j])) add(&t, "%7s ", "-");
+        else add(&t, "%7.3f ", m->z[j]);
         /* untestable: constant within the blocks (the block itself) */
         if (isnan(m->pval[j])) add(&t, "%8s", m->testable[j] ? "-" : "(block)");
         else add(&t, "%8.4g", m->pval[j]);
