@@ -36,6 +36,8 @@ packages=(
   # R, for the tests that run datasets-spec/store-format.md's R snippets
   r-cran-hdf5r r-bioc-rhdf5
   r-cran-vegan               # the oracle of edgespace model (tools/oracle/adonis2.R)
+  r-cran-ape r-cran-ggplot2  # RRPP's imports (with r-cran-matrix), for the optional RRPP
+                             # oracle built from source by tools/oracle/install_rrpp.sh
 )
 
 install_missing() {

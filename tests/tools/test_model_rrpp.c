@@ -31,6 +31,7 @@
 #include "core/core_private.h"
 #include "core/csv_table.h"
 #include "es_test.h"
+#include "es_test_perms.h"
 #include "es_test_run.h"
 #include "edgespace/edgespace.h"
 
@@ -139,31 +140,10 @@ static void compare(const char *set, const char *oracle, const char *ours, const
     es__csv_table_clear(ctx, &b);
 }
 
-/* The permutations of a fit with seed SEED (and blocks: the labels of
- * column `block` in the rows of table `spec`), 1-based, as CSV. */
 static void write_perms(const char *spec, const char *block, const char *path)
 {
-    es__csv_table t = {0};
-    ES_CHECK_OK(ctx, es__csv_read(ctx, "spec", spec, 0, &t));
-    const int64_t n = t.nrecords - 1;
-    int64_t *perm = calloc((size_t)(n * B), sizeof *perm), *blocks = NULL, ng = 0;
-    const char **lab = calloc((size_t)n, sizeof *lab), **names = NULL;
-    if (block) {
-        const int64_t c = column(&t, block);
-        for (int64_t i = 0; i < n; i++) lab[i] = es__csv_field(&t, i + 1, c);
-        ES_CHECK_OK(ctx, es_groups_from_labels(ctx, lab, n, &blocks, &names, &ng));
-    }
-    ES_CHECK_OK(ctx, es_model_permutations(ctx, n, blocks, strtoull(SEED, NULL, 10), B, perm));
-    FILE *f = fopen(path, "w");
-    for (int64_t b = 0; f && b < B; b++)
-        for (int64_t i = 0; i < n; i++)
-            fprintf(f, "%lld%c", (long long)(perm[i + b * n] + 1), i + 1 < n ? ',' : '\n');
-    if (f) fclose(f);
-    es_free(ctx, blocks);
-    es_free(ctx, (void *)names);
-    free(perm);
-    free(lab);
-    es__csv_table_clear(ctx, &t);
+    ES_CHECK_MSG(es_test_write_permutations(ctx, spec, block, strtoull(SEED, NULL, 10), B, path),
+                 "permutations of %s: %s", spec, es_ctx_errmsg(ctx));
 }
 
 /* Run an oracle script into DIR/<what>.<oracle>/; args end with NULL. */

@@ -13,6 +13,10 @@
 # column centroid_size or scale when the design has no `size`. BY: terms
 # (sequential, type I) or margin (each term after all others). STRATA: a
 # column whose values hold the permutations (blocks), or "-" for none.
+# NPERM: a count (adonis2 draws them, seeded with SEED), or a CSV file of
+# permutations, one per line, 1-based (es_model_permutations': row i of the
+# permuted data is row perm[i]), which adonis2 takes as its permutation
+# matrix: then its p-values must equal edgespace's exactly.
 suppressMessages(library(vegan))
 a <- commandArgs(trailingOnly = TRUE)
 if (length(a) != 9) stop("usage: adonis2.R RESPONSE SKIP DESIGN FORMULA BY STRATA NPERM SEED OUT")
@@ -36,7 +40,8 @@ if (!("size" %in% names(des))) {
 }
 f <- as.formula(paste("dist(Y)", a[4]))
 set.seed(as.integer(a[8]))
-perm <- if (a[6] == "-") as.integer(a[7]) else
+perm <- if (file.exists(a[7])) as.matrix(read.csv(a[7], header = FALSE)) else
+  if (a[6] == "-") as.integer(a[7]) else
   permute::how(nperm = as.integer(a[7]), blocks = des[[a[6]]])
 res <- adonis2(f, data = des, by = a[5], permutations = perm)
 g <- function(x) ifelse(is.na(x), "NA", sprintf("%.17g", x))   # round trip
