@@ -8,8 +8,8 @@ that array), positions as (V, 3), labels as arrays of str. Results the
 library allocates (a PCA, a comparison) are read-only views that keep their
 owner alive.
 
-Models (issue 15, linear models on the store) are not bound yet: they will
-be Store methods beside mean/pca/diff calling their es_study_* functions.
+Linear models (Store.model) come back as a ModelResult whose tables view the
+library's arrays, with the summary text the command prints.
 """
 import os
 import tempfile

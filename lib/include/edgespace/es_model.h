@@ -1,10 +1,12 @@
 /* lib/include/edgespace/es_model.h — linear models on shape with permutation
- * tests: formulas over label columns, design matrices, sums of squares of
- * type I, II and III, R^2 and F with permutation p-values by residual
- * randomization (RRPP), blocks for repeated measures, coefficients as
- * combinations of rows, pairwise comparisons of least-squares means,
- * per-variable (per-edge) tests with Benjamini-Hochberg FDR, and the common
- * allometric component.
+ * tests: formulas over label columns, design matrices (aliased terms left
+ * out by name), sums of squares of type I, II and III, R^2 and F with
+ * permutation p-values by residual randomization (RRPP) and RRPP's effect
+ * sizes Z, blocks for repeated measures, error terms of nested designs,
+ * coefficients as combinations of rows, pairwise comparisons of
+ * least-squares means or of slopes with confidence limits, two models
+ * compared, per-variable (per-edge, per-landmark) tests with
+ * Benjamini-Hochberg FDR, and the common allometric component.
  *
  * datasets-spec/analysis-results.md ("model/<name>") describes the formula
  * syntax and the statistics as the command offers them. The method is
