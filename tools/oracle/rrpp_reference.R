@@ -47,6 +47,11 @@ if (!is.null(opt$reference)) {
   f <- sub("=.*", "", opt$reference)
   des[[f]] <- relevel(des[[f]], sub("^[^=]*=", "", opt$reference))
 }
+# A wide response (a face study's 27,871 lengths for 90 rows) is rotated into
+# n columns, Y Q with Q from R's Householder QR of t(Y): every statistic here
+# but the per-landmark ones depends on Y only through Y Y^T, which the
+# rotation keeps (Gower 1966), and the permutations then cost n, not p.
+if (ncol(Y) > nrow(Y) && is.null(opt$edges)) Y <- Y %*% qr.Q(qr(t(Y)))
 perms <- as.matrix(read.csv(a[5], header = FALSE))
 B <- nrow(perms)
 n <- nrow(Y)

@@ -316,9 +316,13 @@ ES_API void es_study_model_free(es_study_model_result *r);
 
 /* Fit and test the model (es_model_fit), then what opts asks for after it,
  * and store it when opts->name is given (the store open for writing; the
- * caller commits). Errors: ES_ENOTFOUND (a label column, the GPA result),
- * ES_EINVAL (no rows, per-edge tests in Procrustes space, a store without
- * edges in edge-length space), those of es_model.h. */
+ * caller commits). Terms the design leaves out as aliased are warned about
+ * (the context's log) and listed in design->dropped. Errors: ES_ENOTFOUND
+ * (a label column, the GPA result, an error term), ES_EINVAL (no rows, a
+ * store without edges in edge-length space, pairwise or per-variable tests
+ * of a dropped term, slopes or at without pairwise, a reference that is no
+ * factor's level, a null model not nested in the model), those of
+ * es_model.h. */
 ES_API es_status es_study_model(es_ctx *ctx, es_store *store, const es_study_model_opts *opts,
                                 es_study_model_result **out);
 
