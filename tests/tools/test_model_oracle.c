@@ -18,7 +18,7 @@
 #include "core/core_private.h"
 #include "core/csv_table.h"
 #include "es_test.h"
-#include "es_test_perms.h"
+#include "es_test_models.h"
 #include "es_test_run.h"
 #include "edgespace/edgespace.h"
 
@@ -110,25 +110,9 @@ static void run_case(const char *what, const char *store, const char *formula, c
     compare(what, ours, theirs, B);
 }
 
-/* A landmark set of landmarks_rshapes ingested, GPA'd and exported. */
 static int landmarks(const char *set, char *store, char *aligned, char *spec, size_t n)
 {
-    static es_test_out r;
-    char lm[600], sp[600];
-    snprintf(lm, sizeof lm, "%s/data/landmarks_rshapes/%s_landmarks.csv", ES_SHARED_DIR, set);
-    snprintf(sp, sizeof sp, "%s/data/landmarks_rshapes/%s_specimens.csv", ES_SHARED_DIR, set);
-    snprintf(store, n, "%s/%s.h5", dir, set);
-    snprintf(aligned, n, "%s/%s.aligned.csv", dir, set);
-    snprintf(spec, n, "%s/%s.specimens.csv", dir, set);
-    unlink(store);
-    ES_RUN(&r, dir, "ingest-landmarks", store, "--csv", lm, "--specimens", sp, "-q");
-    if (r.status) return 0;
-    ES_RUN(&r, dir, "gpa", store, "--name", "g");
-    if (r.status) return 0;
-    ES_RUN(&r, dir, "export", store, "--result", "gpa/g", "--table", "aligned", "--csv", aligned);
-    if (r.status) return 0;
-    ES_RUN(&r, dir, "export", store, "--result", "gpa/g", "--csv", spec);
-    return r.status == 0;
+    return es_test_landmark_gpa(dir, set, NULL, store, aligned, spec, n);
 }
 
 int main(int argc, char **argv)

@@ -31,7 +31,7 @@
 #include "core/core_private.h"
 #include "core/csv_table.h"
 #include "es_test.h"
-#include "es_test_perms.h"
+#include "es_test_models.h"
 #include "es_test_run.h"
 #include "edgespace/edgespace.h"
 
@@ -214,43 +214,30 @@ static void cac_scores(const char *store, const char *name, char *path, size_t l
     ES_CHECK_MSG(r.status == 0, "%s", r.err);
 }
 
-/* A landmark set ingested (with extra columns: apes' species and sex),
- * aligned and exported. */
+/* A landmark set ingested, aligned and exported; the apes with species and
+ * sex read from the group and sexcopy, sex under other labels. */
 static int landmarks(const char *set, char *store, char *aligned, char *spec, size_t n)
 {
-    static es_test_out r;
-    char lm[600], sp[600], sp2[700];
-    snprintf(lm, sizeof lm, "%s/data/landmarks_rshapes/%s_landmarks.csv", ES_SHARED_DIR, set);
+    char sp[600], derived[700];
     snprintf(sp, sizeof sp, "%s/data/landmarks_rshapes/%s_specimens.csv", ES_SHARED_DIR, set);
-    snprintf(store, n, "%s/%s.h5", dir, set);
-    snprintf(aligned, n, "%s/%s.aligned.csv", dir, set);
-    snprintf(spec, n, "%s/%s.specimens.csv", dir, set);
+    snprintf(derived, sizeof derived, "%s/%s.derived.csv", dir, set);
     if (!strcmp(set, "apes")) {
         /* gorf -> species gor, sex f, sexcopy female */
         es__csv_table t = {0};
         ES_CHECK_OK(ctx, es__csv_read(ctx, "apes", sp, 0, &t));
-        snprintf(sp2, sizeof sp2, "%s/apes.derived.csv", dir);
-        FILE *f = fopen(sp2, "w");
-        fputs("specimen,group,species,sex,sexcopy\n", f);
-        for (int64_t i = 1; i < t.nrecords; i++) {
+        FILE *f = fopen(derived, "w");
+        if (f) fputs("specimen,group,species,sex,sexcopy\n", f);
+        for (int64_t i = 1; f && i < t.nrecords; i++) {
             const char *g = es__csv_field(&t, i, 1);
             const size_t L = strlen(g);
             fprintf(f, "%s,%s,%.*s,%c,%s\n", es__csv_field(&t, i, 0), g, (int)(L - 1), g,
                     g[L - 1], g[L - 1] == 'f' ? "female" : "male");
         }
-        fclose(f);
+        if (f) fclose(f);
         es__csv_table_clear(ctx, &t);
-        memcpy(sp, sp2, sizeof sp);
     }
-    unlink(store);
-    ES_RUN(&r, dir, "ingest-landmarks", store, "--csv", lm, "--specimens", sp, "-q");
-    if (r.status) return 0;
-    ES_RUN(&r, dir, "gpa", store, "--name", "g");
-    if (r.status) return 0;
-    ES_RUN(&r, dir, "export", store, "--result", "gpa/g", "--table", "aligned", "--csv", aligned);
-    if (r.status) return 0;
-    ES_RUN(&r, dir, "export", store, "--result", "gpa/g", "--csv", spec);
-    return r.status == 0;
+    return es_test_landmark_gpa(dir, set, strcmp(set, "apes") ? NULL : derived, store, aligned,
+                                spec, n);
 }
 
 static void apes(void)

@@ -11,25 +11,12 @@ lib <- Sys.getenv("ES_RRPP_LIB")
 if (nzchar(lib)) .libPaths(c(lib, .libPaths()))
 suppressMessages(library(RRPP))
 a <- commandArgs(trailingOnly = TRUE)
-opt <- list(type = "I")
-for (kv in a[-(1:6)]) opt[[sub("=.*", "", kv)]] <- sub("^[^=]*=", "", kv)
-skip <- as.integer(a[2])
-ncol <- length(scan(a[1], what = "", sep = ",", nlines = 1, quiet = TRUE))
-resp <- read.csv(a[1], check.names = FALSE,
-                 colClasses = c(rep("character", 1 + skip), rep("numeric", ncol - 1 - skip)))
-des <- read.csv(a[3], check.names = FALSE, colClasses = "character")
-names(des)[1] <- "id"
-des <- des[match(resp[[1]], des$id), , drop = FALSE]
-Y <- as.matrix(resp[, -(1:(1 + skip)), drop = FALSE])
-for (c in names(des)[-1]) {
-  v <- suppressWarnings(as.numeric(des[[c]]))
-  des[[c]] <- if (!anyNA(v)) v else factor(des[[c]])
-}
-if (!("size" %in% names(des))) des$size <- des$centroid_size
-if (!is.null(opt$reference)) {
-  f <- sub("=.*", "", opt$reference)
-  des[[f]] <- relevel(des[[f]], sub("^[^=]*=", "", opt$reference))
-}
+source(file.path(dirname(normalizePath(sub("^--file=", "", grep("^--file=", commandArgs(FALSE),
+                                                            value = TRUE)))), "model_data.R"))
+opt <- read_options(a[-(1:6)], list(type = "I"))
+md <- read_model_data(a[1], a[2], a[3], opt$reference)
+Y <- md$Y
+des <- md$des
 perms <- as.matrix(read.csv(a[5], header = FALSE))
 B <- nrow(perms)
 n <- nrow(Y)

@@ -10,8 +10,8 @@
 #
 #   Rscript rrpp_reference.R RESPONSE.csv SKIP DESIGN.csv FORMULA PERMS.csv OUTDIR [KEY=VALUE...]
 #
-# RESPONSE, SKIP, DESIGN as for adonis2.R (rows matched by id; `size` from
-# centroid_size or scale). PERMS: B rows of N 1-based indices, row i of a
+# RESPONSE, SKIP, DESIGN as model_data.R reads them (rows matched by id;
+# `size` from centroid_size or scale). PERMS: B rows of N 1-based indices, row i of a
 # permuted response takes the residual of row perms[b, i] (what
 # es_model_permutations writes). Keys: type=I|II|III, reference=FACTOR=LEVEL,
 # pairwise=FACTOR, slopes=VAR, at=data (LS means at the columns' means, so
@@ -21,32 +21,12 @@
 # pairwise.csv, comparison.csv, cac.csv (id, score), landmarks.csv (f, p).
 a <- commandArgs(trailingOnly = TRUE)
 if (length(a) < 6) stop("usage: rrpp_reference.R RESPONSE SKIP DESIGN FORMULA PERMS OUTDIR [K=V...]")
-opt <- list(type = "I")
-for (kv in a[-(1:6)]) {
-  k <- sub("=.*", "", kv)
-  opt[[k]] <- sub("^[^=]*=", "", kv)
-}
-skip <- as.integer(a[2])
-ncol <- length(scan(a[1], what = "", sep = ",", nlines = 1, quiet = TRUE))
-resp <- read.csv(a[1], check.names = FALSE,
-                 colClasses = c(rep("character", 1 + skip), rep("numeric", ncol - 1 - skip)))
-des <- read.csv(a[3], check.names = FALSE, colClasses = "character")
-names(des)[1] <- "id"
-des <- des[match(resp[[1]], des$id), , drop = FALSE]
-if (anyNA(des$id)) stop("design lacks some response ids")
-Y <- as.matrix(resp[, -(1:(1 + skip)), drop = FALSE])
-for (c in names(des)[-1]) {
-  v <- suppressWarnings(as.numeric(des[[c]]))
-  des[[c]] <- if (!anyNA(v)) v else factor(des[[c]])
-}
-if (!("size" %in% names(des))) {
-  if ("centroid_size" %in% names(des)) des$size <- des$centroid_size
-  else if ("scale" %in% names(des)) des$size <- des$scale
-}
-if (!is.null(opt$reference)) {
-  f <- sub("=.*", "", opt$reference)
-  des[[f]] <- relevel(des[[f]], sub("^[^=]*=", "", opt$reference))
-}
+source(file.path(dirname(normalizePath(sub("^--file=", "", grep("^--file=", commandArgs(FALSE),
+                                                            value = TRUE)))), "model_data.R"))
+opt <- read_options(a[-(1:6)], list(type = "I"))
+md <- read_model_data(a[1], a[2], a[3], opt$reference)
+Y <- md$Y
+des <- md$des
 # A wide response (a face study's 27,871 lengths for 90 rows) is rotated into
 # n columns, Y Q with Q from R's Householder QR of t(Y): every statistic here
 # but the per-landmark ones depends on Y only through Y Y^T, which the
@@ -217,7 +197,7 @@ if (!is.null(opt$cac)) {
   Yc <- scale(Y, scale = FALSE)
   b <- crossprod(Yc, r)
   cac <- b / sqrt(sum(b^2))
-  write.csv(data.frame(id = resp[[1]], score = g17(Yc %*% cac)), file.path(out, "cac.csv"),
+  write.csv(data.frame(id = md$ids, score = g17(Yc %*% cac)), file.path(out, "cac.csv"),
             row.names = FALSE, quote = FALSE)
 }
 

@@ -1,11 +1,13 @@
-/* tests/common/test_perms.c — es_test_perms.h. */
-#include "es_test_perms.h"
+/* tests/common/test_models.c — es_test_models.h. */
+#include "es_test_models.h"
+#include "es_test_run.h"
 #include "core/core_private.h"
 #include "core/csv_table.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 int es_test_write_permutations(es_ctx *ctx, const char *rows_csv, const char *block,
                                uint64_t seed, int64_t count, const char *path)
@@ -35,4 +37,26 @@ int es_test_write_permutations(es_ctx *ctx, const char *rows_csv, const char *bl
     free(lab);
     es__csv_table_clear(ctx, &t);
     return ok;
+}
+
+int es_test_landmark_gpa(const char *dir, const char *set, const char *specimens, char *store,
+                         char *aligned, char *spec, size_t n)
+{
+    static es_test_out r;
+    char lm[600], sp[600];
+    snprintf(lm, sizeof lm, "%s/data/landmarks_rshapes/%s_landmarks.csv", ES_SHARED_DIR, set);
+    snprintf(sp, sizeof sp, "%s/data/landmarks_rshapes/%s_specimens.csv", ES_SHARED_DIR, set);
+    snprintf(store, n, "%s/%s.h5", dir, set);
+    snprintf(aligned, n, "%s/%s.aligned.csv", dir, set);
+    snprintf(spec, n, "%s/%s.specimens.csv", dir, set);
+    unlink(store);
+    ES_RUN(&r, dir, "ingest-landmarks", store, "--csv", lm, "--specimens", specimens ? specimens : sp,
+           "-q");
+    if (r.status) return 0;
+    ES_RUN(&r, dir, "gpa", store, "--name", "g");
+    if (r.status) return 0;
+    ES_RUN(&r, dir, "export", store, "--result", "gpa/g", "--table", "aligned", "--csv", aligned);
+    if (r.status) return 0;
+    ES_RUN(&r, dir, "export", store, "--result", "gpa/g", "--csv", spec);
+    return r.status == 0;
 }
