@@ -47,7 +47,7 @@ static int have_rrpp;
 
 /* The largest difference seen per data set, oracle and quantity. */
 typedef struct seen {
-    char set[24], oracle[12], quantity[24];
+    char set[24], oracle[12], quantity[24];   /* set: the case (data set_model) */
     double diff, ours, theirs;
 } seen;
 static seen table[128];
@@ -173,7 +173,7 @@ static const double pair_tol[] = {1e-10, 1e-10, 1e-8, 1e-12, 1e-10, 1e-10, 1e-10
                                   1e-8, 1e-12, 1e-9, 1e-9, 1e-7, 1e-12};
 
 /* One case: ours (CLI args after the formula), the reference, and RRPP. */
-static void run_case(const char *set, const char *what, const char *store, const char *formula,
+static void run_case(const char *what, const char *store, const char *formula,
                      const char *response, int skip, const char *spec, const char *perms,
                      const char *const *ours_args, const char *const *kv, int pairwise, int slopes)
 {
@@ -194,11 +194,11 @@ static void run_case(const char *set, const char *what, const char *store, const
         const char *o = s ? "RRPP" : "reference";
         if (!oracle(scripts[s], what, response, skip, spec, formula, perms, kv)) continue;
         snprintf(path, sizeof path, "%s/%s.%s/anova.csv", dir, what, s ? "rrpp" : "ref");
-        compare(set, o, anova, path, "term", NULL, anova_cols, s ? anova_rrpp_tol : anova_ref_tol,
+        compare(what, o, anova, path, "term", NULL, anova_cols, s ? anova_rrpp_tol : anova_ref_tol,
                 7);
         if (pairwise) {
             snprintf(path, sizeof path, "%s/%s.%s/pairwise.csv", dir, what, s ? "rrpp" : "ref");
-            compare(set, o, pw, path, "level_a", "level_b", pair_cols, pair_tol, slopes ? 13 : 4);
+            compare(what, o, pw, path, "level_a", "level_b", pair_cols, pair_tol, slopes ? 13 : 4);
         }
     }
 }
@@ -253,7 +253,7 @@ static void apes(void)
     /* allometry by species: slopes compared, the CAC */
     const char *a1[] = {"--gpa", "g", "--pairwise", "species", "--slopes", "log(size)", NULL};
     const char *k1[] = {"pairwise=species", "slopes=log(size)", "cac=log(size)", NULL};
-    run_case("apes", "apes_slopes", store, "~ log(size) * species", aligned, 4, spec, perms, a1,
+    run_case("apes_slopes", store, "~ log(size) * species", aligned, 4, spec, perms, a1,
              k1, 1, 1);
     static const char *const sc[] = {"cac_score"};
     static const double sct[] = {1e-10};
@@ -265,14 +265,14 @@ static void apes(void)
         snprintf(fixed, sizeof fixed, "sed -i '1s/score/cac_score/' '%s'", path);
         ES_CHECK(system(fixed) == 0);
     }
-    compare("apes", "reference", s1, path, "id", NULL, sc, sct, 1);
+    compare("apes_slopes", "reference", s1, path, "id", NULL, sc, sct, 1);
     /* ~ log(size) + species: the same CAC to 1e-12; LS means at log of mean
      * size (RRPP's), compared with ~ log(size) */
     const char *a2[] = {"--gpa", "g", "--pairwise", "species", "--at", "size=mean", "--null",
                         "~ log(size)", "--edges", "species", NULL};
     const char *k2[] = {"pairwise=species", "at=data", "null=~ log(size)", "edges=species",
                         "dim=2", NULL};
-    run_case("apes", "apes_additive", store, "~ log(size) + species", aligned, 4, spec, perms, a2,
+    run_case("apes_additive", store, "~ log(size) + species", aligned, 4, spec, perms, a2,
              k2, 1, 0);
     cac_scores(store, "apes_additive", s2, sizeof s2);
     {
@@ -286,7 +286,7 @@ static void apes(void)
             worst = fmax(worst, fabs(num(&x, i, cx) - num(&y, i, cy)));
             scale = fmax(scale, fabs(num(&x, i, cx)));
         }
-        note("apes", "+ vs *", "cac_score", scale, scale, worst);
+        note("apes_cac", "+ vs *", "cac_score", scale, scale, worst);
         ES_CHECK_MSG(worst <= 1e-12 * scale, "apes: CAC under + and * differ by %g (scale %g)",
                      worst, scale);
         es__csv_table_clear(ctx, &x);
@@ -306,7 +306,7 @@ static void apes(void)
         snprintf(path, sizeof path, "%s/apes_additive.%s/comparison.csv", dir, s ? "rrpp" : "ref");
         snprintf(cmd, sizeof cmd, "sed -i '1s/^/term,/; 2,$s/^/x,/' '%s'", path);
         ES_CHECK(system(cmd) == 0);
-        compare("apes", s ? "RRPP" : "reference", ours, path, "term", NULL, cmp_cols,
+        compare("apes_null", s ? "RRPP" : "reference", ours, path, "term", NULL, cmp_cols,
                 s ? cmp_rrpp : cmp_tol, 6);
     }
     static const char *const lm_cols[] = {"f", "p"};
@@ -315,12 +315,12 @@ static void apes(void)
            "--csv", s1);
     ES_CHECK_MSG(r.status == 0, "%s", r.err);
     snprintf(path, sizeof path, "%s/apes_additive.ref/landmarks.csv", dir);
-    compare("apes", "reference", s1, path, "landmark", NULL, lm_cols, lm_tol, 2);
+    compare("apes_landmark", "reference", s1, path, "landmark", NULL, lm_cols, lm_tol, 2);
 
     /* sex nested in species: species tested over species:sex */
     const char *a3[] = {"--gpa", "g", "--error", "species=species:sex", NULL};
     const char *k3[] = {"error=species=species:sex", NULL};
-    run_case("apes", "apes_nested", store, "~ species + species:sex", aligned, 4, spec, perms, a3,
+    run_case("apes_nested", store, "~ species + species:sex", aligned, 4, spec, perms, a3,
              k3, 0, 0);
 
     /* a copy of sex: left out by name; type III keeps sex; requests refused */
@@ -358,7 +358,7 @@ static void rats(void)
     write_perms(spec, "rat_no", perms);
     const char *a[] = {"--gpa", "g", "--block", "rat_no", "--type", "II", NULL};
     const char *k[] = {"type=II", NULL};
-    run_case("rats", "rats", store, "~ time + factor(rat_no)", aligned, 2, spec, perms, a, k, 0,
+    run_case("rats", store, "~ time + factor(rat_no)", aligned, 2, spec, perms, a, k, 0,
              0);
 }
 
@@ -389,13 +389,13 @@ static void faces(void)
     const char *a1[] = {"--block", "subject", "--reference", "neutral", "--pairwise",
                         "expression", NULL};
     const char *k1[] = {"reference=expression=neutral", "pairwise=expression", NULL};
-    run_case("face-study", "face", store, "~ expression + subject", lengths, 1, spec, perms, a1,
+    run_case("face", store, "~ expression + subject", lengths, 1, spec, perms, a1,
              k1, 1, 0);
     /* the CAC under + and * */
     const char *a2[] = {NULL};
     const char *k2[] = {"cac=log(size)", NULL};
     write_perms(spec, NULL, perms);
-    run_case("face-study", "face_cac_star", store, "~ log(size) * expression", lengths, 1, spec,
+    run_case("face_cac_star", store, "~ log(size) * expression", lengths, 1, spec,
              perms, a2, k2, 0, 0);
     cac_scores(store, "face_cac_star", s1, sizeof s1);
     es__csv_table x = {0}, y = {0};
@@ -407,7 +407,7 @@ static void faces(void)
         worst = fmax(worst, fabs(num(&x, i, cx) - num(&y, i, cy)));
         scale = fmax(scale, fabs(num(&x, i, cx)));
     }
-    note("face-study", "+ vs *", "cac_score", scale, scale, worst);
+    note("face_cac", "+ vs *", "cac_score", scale, scale, worst);
     ES_CHECK_MSG(x.nrecords == 91 && worst <= 1e-12 * scale, "face: CAC differs by %g", worst);
     es__csv_table_clear(ctx, &x);
     es__csv_table_clear(ctx, &y);
@@ -416,7 +416,7 @@ static void faces(void)
     static const char *const sc[] = {"cac_score"};
     static const double sct[] = {1e-9};
     snprintf(path, sizeof path, "%s/face_cac_star.ref/cac.csv", dir);
-    compare("face-study", "reference", s1, path, "id", NULL, sc, sct, 1);
+    compare("face_cac_star", "reference", s1, path, "id", NULL, sc, sct, 1);
 }
 
 int main(int argc, char **argv)
@@ -442,10 +442,10 @@ int main(int argc, char **argv)
         apes();
         rats();
     }
-    fprintf(stderr, "%-11s %-10s %-12s %22s %22s %10s\n", "data set", "oracle", "quantity",
+    fprintf(stderr, "%-15s %-10s %-12s %22s %22s %10s\n", "case", "oracle", "quantity",
             "ours", "oracle", "max diff");
     for (int k = 0; k < nseen; k++)
-        fprintf(stderr, "%-11s %-10s %-12s %22.15g %22.15g %10.2g\n", table[k].set,
+        fprintf(stderr, "%-15s %-10s %-12s %22.15g %22.15g %10.2g\n", table[k].set,
                 table[k].oracle, table[k].quantity, table[k].ours, table[k].theirs,
                 table[k].diff);
     es_ctx_free(ctx);
