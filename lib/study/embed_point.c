@@ -15,6 +15,7 @@ void es_study_embed_opts_init(es_study_embed_opts *o)
 {
     memset(o, 0, sizeof *o);
     o->init = "prior";
+    o->cache = 1;
     es_embed_opts_init(&o->embed);
 }
 
@@ -84,49 +85,12 @@ static es_status write_residuals(es_ctx *ctx, const char *path, const es_embedde
     return es__table_end(ctx, &t, ES_OK);
 }
 
-/* 1 if the point is one mesh's lengths (a row or a file, coefficient 1):
- * exactly realizable. */
-static int one_mesh(es_ctx *ctx, const char *spec)
-{
-    es_point_expr *x = NULL;
-    double coef = 0;
-    es_point_leaf kind = ES_POINT_MEAN;
-    int one = 0;
-    if (!strncmp(spec, "row:", 4) || !strncmp(spec, "file:", 5)) {
-        if (es_point_parse(ctx, spec, &x) == ES_OK && es_point_expr_nterms(x) == 1) {
-            es_point_expr_term(x, 0, &coef, &kind, NULL, NULL);
-            one = coef == 1 && (kind == ES_POINT_ROW || kind == ES_POINT_FILE);
-        }
-        es_point_expr_free(x);
-        es_ctx_clear_error(ctx);
-    }
-    return one;
-}
-
-/* The prior of the point's row weights: its realization, dihedrals and
- * spread, and what the report says it started from. */
-static es_status point_prior(es_ctx *ctx, es_store *s, const es_mesh *mesh, const double *w,
-                             double *xyz, double *alpha, double *sd, char *desc, size_t ndesc)
-{
-    es_study_rows *rows = NULL;
-    int64_t n = es_store_nrows(s), used = 0, top = 0;
-    es_status rc = es_study_rows_load(ctx, s, mesh, &rows);
-    if (rc == ES_OK) rc = es_study_prior(ctx, rows, w, xyz, alpha, sd);
-    es_study_rows_free(rows);
-    for (int64_t i = 0; i < n; i++) {
-        used += w[i] != 0;
-        if (fabs(w[i]) > fabs(w[top])) top = i;
-    }
-    snprintf(desc, ndesc, "prior of %lld row%s (weight %.3g on %s), store frame", (long long)used,
-             used == 1 ? "" : "s", w[top], es_store_row_id(s, top));
-    return rc;
-}
-
 es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o, double *xyz_out,
                          es_study_embed_result *res)
 {
     es_mesh *mesh = NULL;
     es_embedder *emb = NULL;
+    es_study_embedder *se = NULL;
     double *target = NULL, *xyz = NULL, *init_xyz = NULL, *alpha = NULL, *sd = NULL, *w = NULL;
     double own;
     int64_t init_row = -1, *sel = NULL, nsel = 0, ne, nv, n = es_store_nrows(s);
@@ -155,15 +119,15 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
         goto done;
     res->scale = o->scale > 0 ? o->scale : own;
     if (prior) {
-        es_embed_prior pr = {init_xyz, alpha, sd, NULL};
-        es_embed_opts eo = o->embed;
-        eo.prior_exact = one_mesh(ctx, o->point);
-        if ((rc = point_prior(ctx, s, mesh, w, init_xyz, alpha, sd, res->init,
-                              sizeof res->init)) != ES_OK ||
-            (rc = es_embedder_new(ctx, mesh, &emb)) != ES_OK ||
-            (rc = es_embed_prior_solve(ctx, emb, target, res->scale, &pr, &eo, xyz,
-                                       &res->report)) != ES_OK)
+        /* the session: the embedder and the rows for priors, from the cache
+         * beside the store when it is current (a fresh process skips their
+         * making) */
+        if ((rc = es_study_embedder_open(ctx, s, o->cache, &se)) != ES_OK ||
+            (rc = es_study_embedder_solve(se, target, res->scale, w, &o->embed, 0,
+                                          es__study_point_is_one_mesh(ctx, o->point), xyz,
+                                          res)) != ES_OK)
             goto done;
+        emb = es_study_embedder_embedder(se);
         /* provenance: the rows the prior drew on */
         for (int64_t i = 0; i < n; i++) nsel += w[i] != 0;
         if (nsel && !(sel = es__alloc_array(ctx, nsel, sizeof *sel))) {
@@ -218,7 +182,9 @@ done:
         if (o->output) remove(stage_out);
         if (o->residuals) remove(stage_res);
     }
+    if (se) emb = NULL;   /* the session's */
     es_embedder_free(emb);
+    es_study_embedder_free(se);
     es_mesh_free(mesh);
     es__free(ctx, sel);
     es__free(ctx, target);

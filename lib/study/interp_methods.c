@@ -155,14 +155,12 @@ static es_status data_driven(mwalk *w)
     const es_study_interp_opts *o = w->o;
     int64_t n = es_store_nrows(w->store), ne = es_mesh_nedges(w->mesh);
     int64_t nv = es_mesh_nverts(w->mesh), nc = 0, m = o->steps;
-    double *l = es__alloc_array(ctx, ne * n + n + n * n + n * m * 2 + ne + 3 * nv * 2 + 2 * ne,
-                                sizeof *l);
+    double *l = es__alloc_array(ctx, ne * n + n + n * n + n * m * 2 + ne + 3 * nv, sizeof *l);
     double *sc = l + ne * n, *coords = sc + n, *frames = coords + n * n, *wts = frames + n * m;
-    double *v = wts + n * m, *xyz = v + ne, *prior = xyz + 3 * nv, *alpha = prior + 3 * nv;
-    double *sd = alpha + ne, scale;
+    double *v = wts + n * m, *xyz = v + ne, scale;
     es_data_path_info info;
-    es_study_rows *rows = NULL;
-    es_embedder *emb = NULL;
+    es_study_embedder *se = NULL;
+    es_study_embed_result er;
     es_status rc = l ? ES_OK : ES_ENOMEM;
     if (rc == ES_OK && (o->t0 != 0 || o->t1 != 1))
         rc = es__fail(ctx, ES_EINVAL, "interp --method data-driven: the path runs from A to B "
@@ -178,16 +176,14 @@ static es_status data_driven(mwalk *w)
         rc = es_data_path(ctx, nc, n, coords, n, w->ra, w->rb, NULL, m, frames, wts, &info);
     for (int64_t i = 0; rc == ES_OK && i < m; i++)
         rc = dd_frame(w, n, l, sc, wts + i * n, i, v, &scale);
-    if (rc == ES_OK) rc = es_study_rows_load(ctx, w->store, w->mesh, &rows);
-    if (rc == ES_OK) rc = es_embedder_new(ctx, w->mesh, &emb);
+    if (rc == ES_OK) rc = es_study_embedder_open(ctx, w->store, 1, &se);
     for (int64_t i = 0; rc == ES_OK && i < m; i++) {
         const double *wi = wts + i * n;
-        es_embed_prior pr = {prior, alpha, sd, NULL};
-        es_embed_report rep;
         char heading[160], params[1024];
         dd_frame(w, n, l, sc, wi, i, v, &scale);
-        if ((rc = es_study_prior(ctx, rows, wi, prior, alpha, sd)) != ES_OK ||
-            (rc = es_embed_prior_solve(ctx, emb, v, scale, &pr, &o->embed, xyz, &rep)) != ES_OK)
+        /* each frame from the last one's output (a warm start) */
+        if ((rc = es_study_embedder_solve(se, v, scale, wi, &o->embed, i > 0 && !o->cold, 0, xyz,
+                                          &er)) != ES_OK)
             break;
         snprintf(heading, sizeof heading, "s = %.4g along a path by %lld rows (data-driven; "
                  "nearest row at most %.3g neighbour arcs away, the straight line %.3g)",
@@ -195,10 +191,10 @@ static es_status data_driven(mwalk *w)
                  info.line_max_near);
         snprintf(params, sizeof params, "method=data-driven; from=%s; to=%s; s=%.17g", o->from,
                  o->to, (double)i / (double)(m - 1));
-        rc = emit(w, i, heading, v, xyz, &rep, emb, NULL, NULL, params);
+        rc = emit(w, i, heading, v, xyz, &er.report, es_study_embedder_embedder(se), NULL, NULL,
+                  params);
     }
-    es_embedder_free(emb);
-    es_study_rows_free(rows);
+    es_study_embedder_free(se);
     es__free(ctx, l);
     return rc;
 }

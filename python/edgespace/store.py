@@ -207,6 +207,7 @@ class Store:
         self._ptr = A.owned(self.ctx, _ptr, lib.es_store_close)
         self.writable = bool(write)
         self._mesh = None
+        self._sessions = []   # StudyEmbedder sessions, closed before the store
 
     open = classmethod(lambda cls, path, write=False, ctx=None: cls(path, write, ctx))
 
@@ -238,6 +239,7 @@ class Store:
         """Commit (raising its error) and close. Idempotent."""
         if self._ptr is None:
             return
+        self._close_sessions()
         try:
             if self.writable:
                 self.commit()
@@ -248,6 +250,7 @@ class Store:
     def abort(self):
         """Close, discarding uncommitted writes."""
         if self._ptr is not None:
+            self._close_sessions()
             ffi.gc(self._ptr, None)   # no es_store_close at collection
             lib.es_store_abort(self._ptr)
             self._ptr = None
@@ -587,6 +590,21 @@ class Store:
                       0 if r is None else len(r), row, dist)
         return int(row[0]), float(dist[0])
 
+    def _close_sessions(self):
+        for s in self._sessions:
+            s.close()
+        self._sessions = []
+
+    def embedder(self, cache=True):
+        """An embedding session (StudyEmbedder): embed(point, warm=True, fast=...)
+        costs only the solve; the mesh, embedder and rows for priors are made
+        once (from STORE.es-cache when it is current; cache=False neither
+        reads nor writes it). Closed with the store."""
+        from .session import StudyEmbedder
+        s = StudyEmbedder(self, cache)
+        self._sessions.append(s)
+        return s
+
     def embed(self, point, pca=None, init=None, scale=0.0, name=None, output=None,
               residuals=None, **opts):
         """Embed a point of the store's space (es_study_embed: near the prior
@@ -613,12 +631,14 @@ class Store:
         return Embedding(xyz, self.mesh.faces, rep)
 
     def interp(self, from_=None, to=None, steps=9, t0=0.0, t1=1.0, weights=None, pca=None,
-               name=None, output=None, **opts):
+               name=None, output=None, cold=False, **opts):
         """A walk from `from_` (t = t0) to `to` (t = t1) in `steps` frames, or one
         weighted combination of rows (weights="0.3*row:a + 0.7*row:b"), each
-        frame embedded as es_study_interp embeds it. Returns a list of
-        Embedding (report["t_heading"] says which t). output: a mesh file
-        pattern ("walk_%02d.obj") to keep the frames; name stores them."""
+        frame embedded as es_study_interp embeds it: from the last frame's
+        correction of its prior (a warm start), or with cold=True from its own
+        prior, as embed() does. Returns a list of Embedding (report["t_heading"]
+        says which t). output: a mesh file pattern ("walk_%02d.obj") to keep the
+        frames; name stores them."""
         o = ffi.new("es_study_interp_opts *")
         lib.es_study_interp_opts_init(o)
         frames = []
@@ -634,6 +654,7 @@ class Store:
             setattr(o, "from", keep[0])   # a Python keyword
             o.to, o.weights, o.pca_name, o.output, o.name, o.command = keep[1:]
             o.t0, o.t1, o.steps = float(t0), float(t1), int(steps)
+            o.cold = 1 if cold else 0
             o.frame = cb
             set_embed_opts(o.embed, opts)
             self.ctx.call(lib.es_study_interp, self.ptr, o)

@@ -37,16 +37,16 @@ static const char usage[] =
     "                       scale, else the mean scale of the store)\n"
     "  -n, --name NAME      result name in the store (default: the output's base name)\n"
     "      --no-store       do not write the report into the store\n"
-    "      --bending W      weight of the prior's bending term against the lengths\n"
-    "                       (default 0.0025; 0: the prior only starts and frames it)\n"
-    "      --refine-iters N refinement iterations (default 12; more for accuracy,\n"
-    "                       0 for the linear stages only)\n"
+CLI_EMBED_HELP
     "      --residuals CSV  per vertex of the output: closure energy, mean relative\n"
     "                       edge error and, with the prior, distance from the prior's\n"
     "                       realization / bbox diagonal (header closure,edge_error\n"
     "                       [,deviation]; render MESH --scalars CSV draws the first)\n"
     "      --paper          the published method's stages only (stage 1 always, no\n"
     "                       refinement), for comparison\n"
+    "      --no-cache       neither read nor write STORE.es-cache (the embedder's\n"
+    "                       vertex order and the rows made ready for priors, kept\n"
+    "                       beside the store so the next command skips them)\n"
     "      --replace        replace a stored result of that name (else refused)\n"
     "  -h, --help           show this help\n"
     "\n"
@@ -59,14 +59,13 @@ int cmd_embed(int argc, char **argv)
         {"init", required_argument, NULL, 'i'},  {"scale", required_argument, NULL, 's'},
         {"name", required_argument, NULL, 'n'},  {"no-store", no_argument, NULL, 'N'},
         {"paper", no_argument, NULL, 'P'},       {"replace", no_argument, NULL, 'X'},
-        {"help", no_argument, NULL, 'h'},        {"bending", required_argument, NULL, 'B'},
-        {"refine-iters", required_argument, NULL, 'R'},
+        {"help", no_argument, NULL, 'h'},        CLI_EMBED_LONGOPTS,
         {"residuals", required_argument, NULL, 'r'}, {"pca", required_argument, NULL, 'c'},
+        {"no-cache", no_argument, NULL, 'C'},
         {NULL, 0, NULL, 0}};
     char namebuf[256], text[1024], *cmd = NULL;
     es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
-    int c, store_it = 1;
-    int64_t iters;
+    int c, e, store_it = 1;
     es_ctx *ctx;
     es_store *s = NULL;
     es_study_embed_opts o;
@@ -91,21 +90,15 @@ int cmd_embed(int argc, char **argv)
             o.embed.dihedral_mode = ES_EMBED_DIHEDRAL_ON;
             o.embed.refine_max_iter = 0;
             break;
-        case 'B': {
-            double mu;
-            if (cli_parse_double(optarg, &mu) || !(mu >= 0))
-                return cli_usage_error("embed", "--bending wants a weight >= 0");
-            o.embed.prior_mu = mu;
-            break;
-        }
-        case 'R':
-            if (cli_parse_i64(optarg, &iters) || iters < 0 || iters > 100000)
-                return cli_usage_error("embed", "--refine-iters wants a count >= 0");
-            o.embed.refine_max_iter = (int)iters;
-            break;
+        case 'C': o.cache = 0; break;
         case 'X': wmode = ES_STORE_REPLACE; break;
         case 'h': fputs(usage, stdout); return CLI_OK;
-        default: return cli_usage_error("embed", "bad option");
+        default:
+            if ((e = cli_embed_option("embed", c, optarg, &o.embed)) >= 0) {
+                if (e) return e;
+                break;
+            }
+            return cli_usage_error("embed", "bad option");
         }
     }
     if (optind != argc - 1) return cli_usage_error("embed", "give exactly one STORE");

@@ -19,10 +19,9 @@ static const char usage[] =
     "start) and embed each result as a mesh. Weights or t outside [0, 1]\n"
     "extrapolate; a walk that leaves edge-length space (a length reaches 0 or\n"
     "below) is refused, naming t and the edge, before any frame is written.\n"
-    "Between two points that are not both rows (a stored point, a mean, an\n"
-    "expression) each frame starts from the previous frame's dihedrals (the\n"
-    "first from the nearest stored row; a frame at a row end from that row's).\n"
-    "Sequences are aligned frame to frame. Reports are printed\n"
+    "Each frame is embedded near the prior of its row weights, in the store's\n"
+    "frame (as embed does), starting from the last frame's correction of its\n"
+    "prior (--cold: from its own prior). Reports are printed\n"
     "and stored under /analysis/embed/NAME_<i> (per-vertex residuals included).\n"
     "\n"
     "  -f, --from A          first shape (t = 0): row:ID, a stored point's name, or\n"
@@ -37,9 +36,10 @@ static const char usage[] =
     "                        one integer conversion, e.g. 'cat_%02d.obj' (%% for %)\n"
     "  -n, --name NAME       result name in the store (default: output base name)\n"
     "      --no-store        do not write reports into the store\n"
-    "      --bending W      weight of the prior's bending term against the lengths\n"
-    "                       (default 0.0025; 0: the prior only starts and frames it)\n"
-    "      --refine-iters N  refinement iterations per frame (default 12)\n"
+CLI_EMBED_HELP
+    "      --cold            every frame from its own prior, as embed starts the same\n"
+    "                        point (default: from the last frame's correction of its\n"
+    "                        prior, a warm start)\n"
     "      --replace         replace a stored result of that name (else refused)\n"
     "  -m, --method M        edge-length (default: the above), or another paper's\n"
     "                        way between two rows (--from/--to row:ID):\n"
@@ -87,14 +87,13 @@ int cmd_interp(int argc, char **argv)
         {"t1", required_argument, NULL, '1'},   {"weights", required_argument, NULL, 'w'},
         {"output", required_argument, NULL, 'o'}, {"name", required_argument, NULL, 'n'},
         {"no-store", no_argument, NULL, 'N'},   {"replace", no_argument, NULL, 'X'},
-        {"help", no_argument, NULL, 'h'},       {"bending", required_argument, NULL, 'B'},
-        {"refine-iters", required_argument, NULL, 'R'}, {"pca", required_argument, NULL, 'c'},
+        {"help", no_argument, NULL, 'h'},       CLI_EMBED_LONGOPTS,
+        {"pca", required_argument, NULL, 'c'},  {"cold", no_argument, NULL, 'C'},
         {"method", required_argument, NULL, 'm'},
         {NULL, 0, NULL, 0}};
     es_study_interp_opts o;
     es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
-    int c, store_it = 1;
-    int64_t iters;
+    int c, e, store_it = 1;
     es_ctx *ctx;
     es_store *s = NULL;
     es_status rc;
@@ -122,21 +121,15 @@ int cmd_interp(int argc, char **argv)
         case 'o': o.output = optarg; break;
         case 'n': o.name = optarg; break;
         case 'N': store_it = 0; break;
-        case 'B': {
-            double mu;
-            if (cli_parse_double(optarg, &mu) || !(mu >= 0))
-                return cli_usage_error("interp", "--bending wants a weight >= 0");
-            o.embed.prior_mu = mu;
-            break;
-        }
-        case 'R':
-            if (cli_parse_i64(optarg, &iters) || iters < 0 || iters > 100000)
-                return cli_usage_error("interp", "--refine-iters wants a count >= 0");
-            o.embed.refine_max_iter = (int)iters;
-            break;
+        case 'C': o.cold = 1; break;
         case 'X': wmode = ES_STORE_REPLACE; break;
         case 'h': fputs(usage, stdout); return CLI_OK;
-        default: return cli_usage_error("interp", "bad option");
+        default:
+            if ((e = cli_embed_option("interp", c, optarg, &o.embed)) >= 0) {
+                if (e) return e;
+                break;
+            }
+            return cli_usage_error("interp", "bad option");
         }
     }
     if (optind != argc - 1) return cli_usage_error("interp", "give exactly one STORE");

@@ -395,6 +395,51 @@ ES_API void es_study_rows_free(es_study_rows *rows);
 ES_API es_status es_study_prior(es_ctx *ctx, const es_study_rows *rows, const double *w,
                                 double *xyz, double *alpha, double *sd);
 
+typedef struct es_study_embed_result {
+    es_embed_report report;
+    double scale;           /* the sum of lengths embedded at */
+    char init[512];         /* what the embedding started from, in words */
+} es_study_embed_result;
+
+/* ---- an embedding session -----------------------------------------------------
+ * What every embedding of a store's points shares, made once: the mesh, the
+ * embedder and the rows made ready for priors. With use_cache, the
+ * embedder's vertex order and the rows are kept in a file beside the store
+ * (STORE.es-cache, datasets-spec/cache-format.md) and read back by the next
+ * session while the store's rows are the same: a command in a fresh process
+ * then skips the GPA of every row and the ordering (on face-study 0.6 s of
+ * CPU). A stale or damaged cache is made again; one that cannot be written
+ * (a read-only folder) only costs the time, and the log says so. The
+ * session borrows the store (it must outlive the session) and remembers its
+ * last output: a warm embedding starts from it instead of the prior's
+ * realization (a walk's next frame, a slider's next position). One thread
+ * at a time. */
+typedef struct es_study_embedder es_study_embedder;
+ES_API es_status es_study_embedder_open(es_ctx *ctx, es_store *store, int use_cache,
+                                        es_study_embedder **out);
+ES_API void es_study_embedder_free(es_study_embedder *se);
+ES_API const es_mesh *es_study_embedder_mesh(const es_study_embedder *se);
+ES_API es_embedder *es_study_embedder_embedder(es_study_embedder *se);
+ES_API const es_study_rows *es_study_embedder_rows(const es_study_embedder *se);
+/* Forget the last output: the next warm embedding starts from its prior. */
+ES_API void es_study_embedder_forget(es_study_embedder *se);
+/* Embed lengths (E, any scale; embedded at `scale`, > 0) with row weights w
+ * (N) near their prior, as es_study_embed does by default; warm: from the
+ * last output when there is one; exact: the lengths are one real mesh's
+ * (es_embed_opts.prior_exact). xyz: 3 x V, in the store's frame. res->init
+ * says what the solve started from. */
+ES_API es_status es_study_embedder_solve(es_study_embedder *se, const double *lengths,
+                                         double scale, const double *w, const es_embed_opts *eo,
+                                         int warm, int exact, double *xyz,
+                                         es_study_embed_result *res);
+/* The same for a point expression (datasets-spec/point-syntax.md) at its own
+ * scale (scale 0) or the one given; a point that is one row or one mesh file
+ * is solved as exact. */
+ES_API es_status es_study_embedder_point(es_study_embedder *se, const char *point,
+                                         const char *pca_name, double scale,
+                                         const es_embed_opts *eo, int warm, double *xyz,
+                                         es_study_embed_result *res);
+
 /* What es_study_embed does: embed one point of the store's space. */
 typedef struct es_study_embed_opts {
     const char *point;      /* as es_study_point_lengths reads it (required) */
@@ -412,15 +457,12 @@ typedef struct es_study_embed_opts {
     const char *residuals;  /* CSV of per-vertex closure and edge error, or NULL */
     const char *name;       /* store as /analysis/embed/<name> and commit (NULL: no) */
     const char *command;    /* provenance of the stored result */
+    int cache;              /* 1 (the default): the session's cache beside the store
+                               (es_study_embedder_open) */
     es_embed_opts embed;    /* solver options (es_embed_opts_init) */
 } es_study_embed_opts;
 ES_API void es_study_embed_opts_init(es_study_embed_opts *opts);
 
-typedef struct es_study_embed_result {
-    es_embed_report report;
-    double scale;           /* the sum of lengths embedded at */
-    char init[512];         /* what the embedding started from, in words */
-} es_study_embed_result;
 
 /* Embed a point: resolve it, initialize, solve, write the mesh and the
  * residuals, store the result with its provenance. The store must be open
@@ -451,6 +493,9 @@ typedef struct es_study_interp_opts {
                                base name without the conversion) */
     const char *command;    /* provenance; NULL: store nothing */
     es_embed_opts embed;
+    int cold;               /* 1: every frame from its own prior (as es_study_embed of
+                               the same point); 0 (default): each frame from the last
+                               one's output, which is nearer (a warm start) */
     es_morph_method method; /* ES_MORPH_EDGE_LENGTH (the default: the above); the other
                                papers' (es_morph.h) walk between two rows (from and to
                                "row:ID"): multiscale and shape-space put each frame
