@@ -160,6 +160,11 @@ typedef struct es_embed_opts {
     int lg_polish;            /* 1: the Levenberg-Marquardt finish where the local-global
                                  iterations did not meet the tolerances (default); 0:
                                  local-global alone (interactive use: es_embed_opts_fast) */
+    double realize_bend;      /* for such a target (no mesh has its lengths) the
+                                 Levenberg-Marquardt finish always runs, with the prior's
+                                 bending term held at realize_bend x prior_mu, so that the
+                                 data's bending decides where the lengths cannot be met
+                                 (default 3; 0: as for any target) */
     double realize_margin;    /* target lengths that break the triangle inequality on a
                                  face are replaced by the nearest lengths (relative least
                                  squares) whose every face has its longest edge at most
