@@ -122,6 +122,21 @@ static es_status point_prior(es_ctx *ctx, es_store *s, const es_mesh *mesh, cons
     return rc;
 }
 
+/* The published pipeline from dihedrals alpha (NULL: those of init_xyz),
+ * aligned to init_xyz; the start's description says so. */
+static es_status solve_paper(es_ctx *ctx, es_embedder *emb, const es_study_embed_opts *o,
+                             const double *target, double scale, const double *alpha,
+                             const double *init_xyz, double *xyz, es_study_embed_result *res)
+{
+    es_embed_paper_opts po;
+    size_t n = strlen(res->init);
+    es_embed_paper_opts_init(&po);
+    po.embed = o->embed;
+    snprintf(res->init + n, sizeof res->init - n, "; published pipeline (L-BFGS, stages 2-3)");
+    return es_embed_paper_solve(ctx, emb, target, scale, alpha, init_xyz, &po, xyz,
+                                &res->report);
+}
+
 es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o, double *xyz_out,
                          es_study_embed_result *res)
 {
@@ -161,8 +176,10 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
         if ((rc = point_prior(ctx, s, mesh, w, init_xyz, alpha, sd, res->init,
                               sizeof res->init)) != ES_OK ||
             (rc = es_embedder_new(ctx, mesh, &emb)) != ES_OK ||
-            (rc = es_embed_prior_solve(ctx, emb, target, res->scale, &pr, &eo, xyz,
-                                       &res->report)) != ES_OK)
+            (rc = o->paper ? solve_paper(ctx, emb, o, target, res->scale, alpha, init_xyz, xyz,
+                                         res)
+                           : es_embed_prior_solve(ctx, emb, target, res->scale, &pr, &eo, xyz,
+                                                  &res->report)) != ES_OK)
             goto done;
         /* provenance: the rows the prior drew on */
         for (int64_t i = 0; i < n; i++) nsel += w[i] != 0;
@@ -175,8 +192,10 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
     } else if ((rc = choose_start(ctx, s, mesh, o->init, target, init_xyz, alpha, &init_row,
                                   &sel, &nsel, res->init, sizeof res->init)) != ES_OK ||
                (rc = es_embedder_new(ctx, mesh, &emb)) != ES_OK ||
-               (rc = es_embed_solve(ctx, emb, target, res->scale, sel ? alpha : NULL, init_xyz,
-                                    &o->embed, xyz, &res->report)) != ES_OK) {
+               (rc = o->paper ? solve_paper(ctx, emb, o, target, res->scale, sel ? alpha : NULL,
+                                            init_xyz, xyz, res)
+                              : es_embed_solve(ctx, emb, target, res->scale, sel ? alpha : NULL,
+                                               init_xyz, &o->embed, xyz, &res->report)) != ES_OK) {
         goto done;
     }
     /* with a stored result the files are staged beside their targets and

@@ -6,6 +6,9 @@
  *    frame together themselves from the rows' positions as ingested; the
  *    report is es_morph_report's (the embedder's scale), the stored result
  *    has no prior deviation;
+ *  - paper (edge-length-interpolation as published) embeds each frame of
+ *    the rows' interpolated lengths from their averaged dihedrals by
+ *    es_embed_paper_solve, aligned frame to frame;
  *  - data-driven (Gao et al.) finds a path through all rows (es_data_path
  *    on their edge-length PCA scores with every component) and embeds each
  *    frame as the point of its row weights, as interp_walk.c embeds lerp:
@@ -129,6 +132,48 @@ static es_status geometric(mwalk *w, const double *xa, const double *xb)
     return rc;
 }
 
+/* The published pipeline (es_embed_paper_solve) along t: each frame from
+ * the lengths and shortest-arc averaged dihedrals of es_interp_targets,
+ * aligned to the previous frame (the first to A). */
+static es_status paper(mwalk *w, const double *xa, const double *xb)
+{
+    es_ctx *ctx = w->ctx;
+    const es_study_interp_opts *o = w->o;
+    int64_t nv = es_mesh_nverts(w->mesh), ne = es_mesh_nedges(w->mesh);
+    const double *in[2] = {xa, xb};
+    double *buf = es__alloc_array(ctx, 2 * ne + 6 * nv, sizeof *buf);
+    double *len = buf, *alpha = len + ne, *xyz = alpha + ne, *prev = xyz + 3 * nv;
+    es_embedder *emb = NULL;
+    es_embed_paper_opts po;
+    es_status rc = buf ? ES_OK : ES_ENOMEM;
+    es_embed_paper_opts_init(&po);
+    po.embed = o->embed;
+    for (int64_t i = 0; rc == ES_OK && i < o->steps; i++) {   /* all frames checked first */
+        double t = step_t(o, i), wt[2] = {1 - t, t};
+        rc = es_interp_targets(ctx, w->mesh, 2, in, wt, len, NULL, NULL);
+    }
+    if (rc == ES_OK) rc = es_embedder_new(ctx, w->mesh, &emb);
+    if (rc == ES_OK) memcpy(prev, xa, 3 * (size_t)nv * sizeof *prev);
+    for (int64_t i = 0; rc == ES_OK && i < o->steps; i++) {
+        double t = step_t(o, i), wt[2] = {1 - t, t};
+        char heading[96], params[1024];
+        es_embed_report rep;
+        if ((rc = es_interp_targets(ctx, w->mesh, 2, in, wt, len, alpha, NULL)) != ES_OK ||
+            (rc = es_embed_paper_solve(ctx, emb, len, 0, alpha, prev, &po, xyz, &rep)) != ES_OK)
+            break;
+        snprintf(heading, sizeof heading, "t = %.4g (paper: %lld L-BFGS iterations, E %.3g)", t,
+                 (long long)rep.dihedral_iters, rep.closure_stage1);
+        snprintf(params, sizeof params, "method=paper; from=%s; to=%s; t=%.17g", o->from, o->to,
+                 t);
+        rc = emit(w, i, heading, len, xyz, &rep, emb, NULL, NULL, params);
+        memcpy(prev, xyz, 3 * (size_t)nv * sizeof *prev);
+        es__progress(ctx, "interp", i + 1, o->steps);
+    }
+    es_embedder_free(emb);
+    es__free(ctx, buf);
+    return rc;
+}
+
 /* Frame i of the path: lengths (normalized) and scale of weights w. */
 static es_status dd_frame(mwalk *w, int64_t n, const double *l, const double *sc,
                           const double *wt, int64_t i, double *v, double *scale)
@@ -236,7 +281,7 @@ es_status es__study_interp_method(es_ctx *ctx, es_store *store, const es_study_i
         xb = xa + 3 * nv;
         if ((rc = es_store_read_positions(ctx, store, w.ra, xa)) == ES_OK &&
             (rc = es_store_read_positions(ctx, store, w.rb, xb)) == ES_OK)
-            rc = geometric(&w, xa, xb);
+            rc = o->method == ES_MORPH_PAPER ? paper(&w, xa, xb) : geometric(&w, xa, xb);
         es__free(ctx, xa);
     }
     if (rc == ES_OK && o->command) rc = es_store_commit(ctx, store);

@@ -46,9 +46,9 @@ static void check_frames_do_not_jump(const char *dir, const char *stem, int widt
 static void check_methods(const char *dir, const char *store)
 {
     static es_test_out r;
-    static const char *const methods[] = {"multiscale", "shape-space", "data-driven"};
+    static const char *const methods[] = {"multiscale", "shape-space", "data-driven", "paper"};
     char pat[4400], p[4400], name[64], buf[256];
-    for (int m = 0; m < 3; m++) {
+    for (int m = 0; m < 4; m++) {
         snprintf(pat, sizeof pat, "%s/m%d_%%02d.obj", dir, m);
         snprintf(name, sizeof name, "m%d", m);
         ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-1", "--steps",
@@ -81,6 +81,47 @@ static void check_methods(const char *dir, const char *store)
     ES_RUN(&r, dir, "interp", store, "--from", "mean", "--to", "row:mesh-1", "--method",
            "multiscale", "-o", pat, "--no-store");
     ES_CHECK_MSG(r.status == 1 && strstr(r.err, "row:ID"), "%d %s", r.status, r.err);
+}
+
+/* embed --paper / --method paper: the published pipeline runs its stage 1
+ * (L-BFGS) on an open mesh (two boundary loops) as on a closed one (the old
+ * --paper started from the prior's positions and ran 0 dihedral iterations
+ * there), says so, and is stored like any embedding. */
+static void check_paper(const char *dir)
+{
+    static es_test_out r;
+    char tubes[4200], store[4400], man[4400], out[4400];
+    es_ctx *ctx = NULL;
+    es_synth_opts so;
+    es_synth_set set;
+    snprintf(tubes, sizeof tubes, "%s/tubes", dir);
+    snprintf(store, sizeof store, "%s/tubes.h5", dir);
+    snprintf(man, sizeof man, "%s/manifest.csv", tubes);
+    snprintf(out, sizeof out, "%s/paper.obj", dir);
+    ES_CHECK(es_ctx_new(&ctx) == ES_OK);
+    es_synth_opts_init(&so);
+    so.n = 3;
+    ES_CHECK_OK(ctx, es_synth_generate(ctx, ES_SYNTH_TUBE, &so, &set));
+    ES_CHECK_OK(ctx, es_synth_write(ctx, &set, tubes));
+    ES_RUN(&r, dir, "ingest", "-q", store, "--manifest", man);
+    ES_CHECK_MSG(r.status == 0, "ingest tubes: %s", r.err);
+    for (int k = 0; k < 2; k++) {
+        char point[512], *it;
+        snprintf(point, sizeof point, "0.5*row:%s + 0.5*row:%s", set.names[0], set.names[2]);
+        if (k)
+            ES_RUN(&r, dir, "embed", store, "--point", point, "-o", out, "--method", "paper",
+                   "--name", "p1");
+        else
+            ES_RUN(&r, dir, "embed", store, "--point", point, "-o", out, "--paper");
+        it = strstr(r.out, "stage 1 ");
+        ES_CHECK_MSG(r.status == 0 && strstr(r.out, "published pipeline") && it &&
+                         atol(it + 8) > 0 && strstr(r.out, "refinement 0"),
+                     "embed --paper on an open mesh: %d %s %s", r.status, r.out, r.err);
+    }
+    ES_RUN(&r, dir, "embed", store, "--point", "mean", "-o", out, "--method", "fast");
+    ES_CHECK_MSG(r.status == 2 && strstr(r.err, "default or paper"), "%d %s", r.status, r.err);
+    es_synth_set_clear(ctx, &set);
+    es_ctx_free(ctx);
 }
 
 int main(void)
@@ -258,6 +299,7 @@ int main(void)
     ES_CHECK(r.status == 2 && strstr(r.err, "pattern"));
 
     check_methods(dir, store);
+    check_paper(dir);
 
     /* embed a stored row from the nearest other start, and from a given row */
     snprintf(out, sizeof out, "%s/e.obj", dir);

@@ -46,7 +46,9 @@ static const char usage[] =
     "                        multiscale (Winkler et al. 2010), shape-space (Wuhrer\n"
     "                        et al. 2010), each frame put together by the method,\n"
     "                        in A's frame; data-driven (Gao et al. 2017): a path\n"
-    "                        through the store's rows, each frame embedded as above\n"
+    "                        through the store's rows, each frame embedded as above;\n"
+    "                        paper: the published pipeline (embed --paper) on each\n"
+    "                        frame from the rows' averaged dihedrals\n"
     "  -h, --help            show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";

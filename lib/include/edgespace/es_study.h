@@ -373,6 +373,11 @@ typedef struct es_study_embed_opts {
     const char *name;       /* store as /analysis/embed/<name> and commit (NULL: no) */
     const char *command;    /* provenance of the stored result */
     es_embed_opts embed;    /* solver options (es_embed_opts_init) */
+    int paper;              /* 1: the published pipeline (es_embed_paper_solve, default
+                               L-BFGS settings; embed's alignment and report settings)
+                               from the same start's dihedrals: the prior's weighted
+                               circular mean of the rows' (the paper: their average), or
+                               the explicit start's (0) */
 } es_study_embed_opts;
 ES_API void es_study_embed_opts_init(es_study_embed_opts *opts);
 
@@ -419,7 +424,9 @@ typedef struct es_study_interp_opts {
                                (es_data_path on their edge-length PCA scores, frames
                                evenly along it, t0 and t1 0 and 1) and embeds each
                                frame as the point of its row weights, like the
-                               default */
+                               default; paper: the published pipeline
+                               (es_embed_paper_solve) from the rows' averaged
+                               dihedrals, aligned frame to frame */
     es_study_frame_fn frame;   /* called after each frame (may be NULL) */
     void *userdata;
 } es_study_interp_opts;
