@@ -17,6 +17,9 @@
  *    example shapes (a K-nearest-neighbour graph, Dijkstra, then an
  *    iterative smoothing that keeps it near the examples), each point of
  *    it a combination of the examples;
+ *  - the conformal morph of edge-length-interpolation Sec. 5: a closed
+ *    genus-0 mesh taken to the sphere by discrete conformal factors u,
+ *    frame k of lengths e^(k (u_a + u_b) / 2) l_ab embedded;
  *
  * Where a paper is silent the choice made is written at the function. The
  * quality of a mesh made by any of them is measured as the embedder's
@@ -261,6 +264,73 @@ ES_API void es_shape_space_get_info(const es_shape_space *ss, es_shape_space_inf
  * ES_EINVAL names an edge whose length is not positive. */
 ES_API es_status es_shape_space_frame(es_ctx *ctx, es_shape_space *ss, const double *len,
                                       double t, double *xyz);
+
+/* ---- the conformal morph (edge-length-interpolation Sec. 5, Fig. 11) ----------
+ * A closed genus-0 mesh with lengths l is discretely conformally equivalent
+ * (l~_ab = e^((u_a + u_b) / 2) l_ab, the paper's eq. 13, Springborn,
+ * Schröder and Pinkall 2008) to a mesh inscribed in a sphere; frame k has
+ * lengths e^(k (u_a + u_b) / 2) l_ab and is embedded from the two ends'
+ * dihedrals interpolated (the paper: "as usual"), so k = 0 is the mesh and
+ * k = 1 the sphere. How the factors are found (the paper cites [27, 4]
+ * only) is written at conformal.c: one vertex to infinity, the disk left
+ * flattened by CETM's Newton iteration with the boundary held by inversion,
+ * inverse stereographic projection, Moebius centring, the factors read back
+ * from the sphere's chordal lengths. An open mesh is closed first
+ * (es_conformal_close), as the paper closes the back of its face. */
+typedef struct es_conformal_info {
+    int64_t infinity;       /* the vertex sent to infinity (the projection's pole) */
+    int newton_iters;       /* flattening steps */
+    double angle_defect;    /* max |angle sum - 2 pi| left at the flat map's interior
+                               vertices (rad) */
+    int mobius_iters;       /* centring steps */
+    double centre_offset;   /* |area-weighted centroid| / radius after centring */
+    double radius;          /* of the sphere (the edge lengths keep the input's sum) */
+    double factor_residual; /* max_e |u_a + u_b - 2 log(s_e / l_e)|, s the sphere's
+                               chordal lengths: how exactly the sphere realizes u
+                               (rounding, unless faces are broken) */
+    int64_t broken_faces;   /* faces whose flat lengths break the triangle inequality
+                               (obtuse triangles where the scale changes fast): laid
+                               out around, the sphere misses u on their long sides */
+    double u_min, u_max;    /* range of the factors */
+} es_conformal_info;
+
+/* Factors u (V) taking lengths len (E) of `mesh` (closed, genus 0, one
+ * piece) to the sphere, and the sphere's vertices (3 x V, centred at the
+ * origin; NULL to skip). infinity: the vertex sent to the pole (< 0: the
+ * one of largest degree, e.g. a closed hole's apex). info may be NULL.
+ * ES_EINVAL names what is wrong with the mesh or a length; ES_ENOCONV if
+ * the flattening does not converge; ES_ENUMERIC from the factorizations,
+ * and when the sphere misses the factors by more than 1e-6 without broken
+ * faces (a long protrusion shrunk beyond double precision: the cat's
+ * tail, goast's finger) or by more than 0.25 (log) with them. */
+ES_API es_status es_conformal_sphere(es_ctx *ctx, const es_mesh *mesh, const double *len,
+                                     int64_t infinity, double *u, double *sphere,
+                                     es_conformal_info *info);
+
+/* Lengths of frame k: out_e = len_e e^(k (u_a + u_b) / 2). ES_EINVAL
+ * names an edge whose length is not finite and positive. */
+ES_API es_status es_conformal_lengths(es_ctx *ctx, const es_mesh *mesh, const double *len,
+                                      const double *u, double k, double *out);
+
+/* Embed frame k: the lengths of xyz (3 x V, the mesh) under the factors u,
+ * from the dihedrals of xyz and sphere interpolated along the shortest arc
+ * with weights (1 - k, k), started and aligned as es_embed_solve does with
+ * init positions `start` (the previous frame; NULL: xyz). opts and report
+ * as es_embed_solve's. */
+ES_API es_status es_conformal_frame(es_ctx *ctx, es_embedder *emb, const double *xyz,
+                                    const double *sphere, const double *u, double k,
+                                    const double *start, const es_embed_opts *opts,
+                                    double *out, es_embed_report *report);
+
+/* Close every boundary loop of `mesh` by a fan from a new vertex over the
+ * loop's centroid (of xyz, or the mesh's positions when xyz is NULL),
+ * raised along the fan's outward normal by the loop's largest distance
+ * from its centroid (a cone; conformal_close.c says why): a new mesh
+ * (*closed, caller frees)
+ * whose positions (es_mesh_xyz) are xyz followed by one apex per loop; the
+ * mesh's vertices keep their indices. A closed mesh comes back as a copy. */
+ES_API es_status es_conformal_close(es_ctx *ctx, const es_mesh *mesh, const double *xyz,
+                                    es_mesh **closed);
 
 #ifdef __cplusplus
 }
