@@ -6,6 +6,8 @@
  *    frame together themselves from the rows' positions as ingested; the
  *    report is es_morph_report's (the embedder's scale), the stored result
  *    has no prior deviation;
+ *  - conformal (edge-length-interpolation Sec. 5) takes one row to the
+ *    sphere, its mesh closed off first when open, each frame embedded;
  *  - paper (edge-length-interpolation as published) embeds each frame of
  *    the rows' interpolated lengths from their averaged dihedrals by
  *    es_embed_paper_solve, aligned frame to frame;
@@ -30,6 +32,9 @@ typedef struct mwalk {
     const es_mesh *mesh;
     const char *name;
     int64_t ra, rb;
+    const es_mesh *file_mesh;   /* the frame files' topology, when not mesh's (an open
+                                   store's meshes closed off for the conformal morph) */
+    const double *file_xyz;
 } mwalk;
 
 static double now_s(void)
@@ -56,11 +61,12 @@ static es_status emit(mwalk *w, int64_t i, const char *heading, const double *ta
     int64_t rows[2] = {w->ra, w->rb};
     es_status rc;
     es__study_frame_names(o, w->name, i, fname, sizeof fname, rname, sizeof rname);
-    if ((rc = es_mesh_write(w->ctx, fname, ES_FORMAT_AUTO, w->mesh, xyz, NULL)) != ES_OK)
+    if ((rc = es_mesh_write(w->ctx, fname, ES_FORMAT_AUTO, w->file_mesh ? w->file_mesh : w->mesh,
+                            w->file_mesh ? w->file_xyz : xyz, NULL)) != ES_OK)
         return rc;
     if (o->frame) o->frame(o->userdata, i, o->steps, fname, heading, rep);
     if (!o->command) return ES_OK;
-    es_provenance prov = {o->command, rows, 2, params};
+    es_provenance prov = {o->command, rows, w->rb < 0 ? 1 : 2, params};
     snprintf(init, sizeof init, "%s", es_morph_method_name(o->method));
     if (emb)
         return es_study_store_embedding(w->ctx, w->store, rname, &prov, emb, target, xyz, rep,
@@ -174,6 +180,62 @@ static es_status paper(mwalk *w, const double *xa, const double *xb)
     return rc;
 }
 
+/* The conformal morph (edge-length-interpolation Sec. 5) of row A, closed
+ * off first when its mesh is open: frame k = t of lengths e^(k (u_a + u_b)
+ * / 2) l_ab, embedded from the dihedrals of A and the sphere interpolated,
+ * aligned frame to frame. The files have the closed mesh; the stored
+ * results the store's vertices and edges of it. */
+static es_status conformal(mwalk *w, const double *xa)
+{
+    es_ctx *ctx = w->ctx;
+    const es_study_interp_opts *o = w->o;
+    const int64_t *ed = es_mesh_edges(w->mesh);
+    int64_t nv = es_mesh_nverts(w->mesh), ne = es_mesh_nedges(w->mesh), cv, ce;
+    es_mesh *closed = NULL;
+    es_embedder *emb = NULL;
+    es_conformal_info info;
+    double *buf = NULL, *len, *lk, *u, *sph, *xyz, *prev, *target;
+    es_status rc = es_conformal_close(ctx, w->mesh, xa, &closed);
+    if (rc != ES_OK) return rc;
+    cv = es_mesh_nverts(closed), ce = es_mesh_nedges(closed);
+    if (!(buf = es__alloc_array(ctx, 2 * ce + 10 * cv + ne, sizeof *buf))) {
+        es_mesh_free(closed);
+        return ES_ENOMEM;
+    }
+    len = buf, lk = len + ce, u = lk + ce, sph = u + cv, xyz = sph + 3 * cv, prev = xyz + 3 * cv;
+    target = prev + 3 * cv;
+    if ((rc = es_edge_lengths(ctx, closed, es_mesh_xyz(closed), len)) == ES_OK)
+        rc = es_conformal_sphere(ctx, closed, len, -1, u, sph, &info);
+    for (int64_t i = 0; rc == ES_OK && i < o->steps; i++)   /* all frames checked first */
+        rc = es_conformal_lengths(ctx, closed, len, u, step_t(o, i), lk);
+    if (rc == ES_OK) rc = es_embedder_new(ctx, closed, &emb);
+    w->file_mesh = closed;
+    w->file_xyz = xyz;
+    for (int64_t i = 0; rc == ES_OK && i < o->steps; i++) {
+        double k = step_t(o, i);
+        char heading[160], params[1024];
+        es_embed_report rep;
+        if ((rc = es_conformal_lengths(ctx, closed, len, u, k, lk)) != ES_OK ||
+            (rc = es_conformal_frame(ctx, emb, es_mesh_xyz(closed), sph, u, k, i ? prev : NULL,
+                                     &o->embed, xyz, &rep)) != ES_OK)
+            break;
+        for (int64_t e = 0; e < ne; e++) target[e] = lk[es_mesh_find_edge(closed, ed[2 * e],
+                                                                          ed[2 * e + 1])];
+        snprintf(heading, sizeof heading, "k = %.4g (conformal; %lld holes closed, factors in "
+                 "[%.3g, %.3g])", k, (long long)(cv - nv), info.u_min, info.u_max);
+        snprintf(params, sizeof params, "method=conformal; from=%s; k=%.17g", o->from, k);
+        rc = emit(w, i, heading, target, xyz, &rep, NULL, es_embedder_vertex_closure(emb),
+                  es_embedder_vertex_edge_error(emb), params);
+        memcpy(prev, xyz, 3 * (size_t)cv * sizeof *prev);
+        es__progress(ctx, "interp", i + 1, o->steps);
+    }
+    w->file_mesh = NULL;
+    es_embedder_free(emb);
+    es_mesh_free(closed);
+    es__free(ctx, buf);
+    return rc;
+}
+
 /* Frame i of the path: lengths (normalized) and scale of weights w. */
 static es_status dd_frame(mwalk *w, int64_t n, const double *l, const double *sc,
                           const double *wt, int64_t i, double *v, double *scale)
@@ -263,7 +325,7 @@ static es_status end_row(es_ctx *ctx, es_store *s, const es_study_interp_opts *o
 es_status es__study_interp_method(es_ctx *ctx, es_store *store, const es_study_interp_opts *o,
                                   const es_mesh *mesh, const char *name)
 {
-    mwalk w = {ctx, store, o, mesh, name, -1, -1};
+    mwalk w = {ctx, store, o, mesh, name, -1, -1, NULL, NULL};
     double *xa = NULL, *xb = NULL;
     es_status rc;
     if (!es_morph_method_name(o->method))
@@ -272,16 +334,22 @@ es_status es__study_interp_method(es_ctx *ctx, es_store *store, const es_study_i
         ES_FAIL(ctx, ES_EINVAL, "interp --method %s walks from A to B: --weights is the "
                 "edge-length method's", es_morph_method_name(o->method));
     if ((rc = end_row(ctx, store, o, o->from, &w.ra)) != ES_OK ||
-        (rc = end_row(ctx, store, o, o->to, &w.rb)) != ES_OK)
+        (o->method != ES_MORPH_CONFORMAL && (rc = end_row(ctx, store, o, o->to, &w.rb)) != ES_OK))
         return rc;
-    if (o->method == ES_MORPH_DATA_DRIVEN) rc = data_driven(&w);
-    else {
+    if (o->method == ES_MORPH_CONFORMAL && o->to)
+        ES_FAIL(ctx, ES_EINVAL, "interp --method conformal maps one row to the sphere: give "
+                "--from only (got --to %s)", o->to);
+    if (o->method == ES_MORPH_DATA_DRIVEN) {
+        rc = data_driven(&w);
+    } else {
         int64_t nv = es_mesh_nverts(mesh);
         if (!(xa = es__alloc_array(ctx, 6 * nv, sizeof *xa))) return ES_ENOMEM;
         xb = xa + 3 * nv;
         if ((rc = es_store_read_positions(ctx, store, w.ra, xa)) == ES_OK &&
-            (rc = es_store_read_positions(ctx, store, w.rb, xb)) == ES_OK)
-            rc = o->method == ES_MORPH_PAPER ? paper(&w, xa, xb) : geometric(&w, xa, xb);
+            (w.rb < 0 || (rc = es_store_read_positions(ctx, store, w.rb, xb)) == ES_OK))
+            rc = o->method == ES_MORPH_CONFORMAL ? conformal(&w, xa)
+                 : o->method == ES_MORPH_PAPER   ? paper(&w, xa, xb)
+                                                 : geometric(&w, xa, xb);
         es__free(ctx, xa);
     }
     if (rc == ES_OK && o->command) rc = es_store_commit(ctx, store);

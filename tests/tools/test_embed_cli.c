@@ -86,8 +86,9 @@ static void check_methods(const char *dir, const char *store)
 /* embed --paper / --method paper: the published pipeline runs its stage 1
  * (L-BFGS) on an open mesh (two boundary loops) as on a closed one (the old
  * --paper started from the prior's positions and ran 0 dihedral iterations
- * there), says so, and is stored like any embedding. */
-static void check_paper(const char *dir)
+ * there), says so, and is stored like any embedding. interp --method
+ * conformal on the same open tubes. */
+static void check_paper_conformal(const char *dir)
 {
     static es_test_out r;
     char tubes[4200], store[4400], man[4400], out[4400];
@@ -120,6 +121,36 @@ static void check_paper(const char *dir)
     }
     ES_RUN(&r, dir, "embed", store, "--point", "mean", "-o", out, "--method", "fast");
     ES_CHECK_MSG(r.status == 2 && strstr(r.err, "default or paper"), "%d %s", r.status, r.err);
+    /* interp --method conformal: one row to the sphere; the open tube closed
+     * off (two apexes more in the files), the last frame realizes the
+     * factors, results stored on the store's vertices */
+    {
+        char pat[4400], row[300], p[4400], buf[64];
+        es_meshdata md = {0};
+        es_store *s = NULL;
+        snprintf(pat, sizeof pat, "%s/conf_%%d.obj", dir);
+        snprintf(row, sizeof row, "row:%s", set.names[1]);
+        ES_RUN(&r, dir, "interp", store, "--from", row, "--method", "conformal", "--steps", "3",
+               "-o", pat, "--name", "conf");
+        ES_CHECK_MSG(r.status == 0 && strstr(r.out, "k = 0.5 (conformal; 2 holes closed"),
+                     "interp --method conformal: %d %s %s", r.status, r.out, r.err);
+        snprintf(p, sizeof p, "%s/conf_2.obj", dir);
+        ES_CHECK_OK(ctx, es_meshdata_read(ctx, p, ES_FORMAT_OBJ, &md));
+        ES_CHECK(md.nverts == set.nverts + 2);
+        es_meshdata_clear(ctx, &md);
+        ES_CHECK_OK(ctx, es_store_open(ctx, store, ES_STORE_READ, &s));
+        if (s) {
+            ES_CHECK_OK(ctx, es_store_get_attr(ctx, s, "embed/conf_02", "rms_ratio", buf,
+                                               sizeof buf));
+            ES_CHECK_MSG(atof(buf) < 1e-8, "conformal k = 1: RMS ratio %s", buf);
+            ES_CHECK_OK(ctx, es_store_get_attr(ctx, s, "embed/conf_02", "init", buf, sizeof buf));
+            ES_CHECK_MSG(!strcmp(buf, "conformal"), "init %s", buf);
+        }
+        es_store_close(s);
+        ES_RUN(&r, dir, "interp", store, "--from", row, "--to", row, "--method", "conformal",
+               "-o", pat, "--no-store");
+        ES_CHECK_MSG(r.status == 1 && strstr(r.err, "--from only"), "%d %s", r.status, r.err);
+    }
     es_synth_set_clear(ctx, &set);
     es_ctx_free(ctx);
 }
@@ -299,7 +330,7 @@ int main(void)
     ES_CHECK(r.status == 2 && strstr(r.err, "pattern"));
 
     check_methods(dir, store);
-    check_paper(dir);
+    check_paper_conformal(dir);
 
     /* embed a stored row from the nearest other start, and from a given row */
     snprintf(out, sizeof out, "%s/e.obj", dir);

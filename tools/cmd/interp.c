@@ -12,6 +12,7 @@
 
 static const char usage[] =
     "usage: edgespace interp STORE --from A --to B [--steps N] -o PATTERN\n"
+    "       edgespace interp STORE --from row:ID --method conformal -o PATTERN\n"
     "       edgespace interp STORE --weights \"0.2*row:a + 0.3*row:b + 0.5*row:c\" -o OUT\n"
     "\n"
     "Interpolate stored shapes in edge-length space (weighted mean of normalized\n"
@@ -48,7 +49,10 @@ static const char usage[] =
     "                        in A's frame; data-driven (Gao et al. 2017): a path\n"
     "                        through the store's rows, each frame embedded as above;\n"
     "                        paper: the published pipeline (embed --paper) on each\n"
-    "                        frame from the rows' averaged dihedrals\n"
+    "                        frame from the rows' averaged dihedrals; conformal\n"
+    "                        (--from row:ID only): the row mapped to the sphere by\n"
+    "                        discrete conformal factors, t = their k (an open mesh\n"
+    "                        closed off first; frame files of the closed mesh)\n"
     "  -h, --help            show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -145,7 +149,7 @@ int cmd_interp(int argc, char **argv)
     if (!o.output) return cli_usage_error("interp", "--output is required");
     if (o.weights && (o.from || o.to))
         return cli_usage_error("interp", "--weights excludes --from/--to");
-    if (!o.weights && (!o.from || !o.to))
+    if (!o.weights && (!o.from || (!o.to && !(method && !strcmp(method, "conformal")))))
         return cli_usage_error("interp", "give --from A --to B, or --weights");
     if (o.weights) o.steps = 1;
     char probe[4096], stored[300];

@@ -426,7 +426,11 @@ typedef struct es_study_interp_opts {
                                frame as the point of its row weights, like the
                                default; paper: the published pipeline
                                (es_embed_paper_solve) from the rows' averaged
-                               dihedrals, aligned frame to frame */
+                               dihedrals, aligned frame to frame; conformal: row
+                               `from` alone (to NULL) mapped to the sphere, t the
+                               factors' k (es_conformal_*; an open mesh is closed
+                               off: the frame files have the closed mesh, the
+                               stored results the store's vertices and edges) */
     es_study_frame_fn frame;   /* called after each frame (may be NULL) */
     void *userdata;
 } es_study_interp_opts;
