@@ -53,6 +53,11 @@ static const char usage[] =
     "                        (--from row:ID only): the row mapped to the sphere by\n"
     "                        discrete conformal factors, t = their k (an open mesh\n"
     "                        closed off first; frame files of the closed mesh)\n"
+    "      --seed S          seed of the multiscale hierarchies' random seed faces\n"
+    "                        (default the library's)\n"
+    "      --tries N         multiscale: hierarchies from seeds S .. S+N-1, each frame\n"
+    "                        kept from the one of least energy (its length and\n"
+    "                        dihedral misfit; default 4, 1: one hierarchy)\n"
     "  -h, --help            show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -95,12 +100,12 @@ int cmd_interp(int argc, char **argv)
         {"no-store", no_argument, NULL, 'N'},   {"replace", no_argument, NULL, 'X'},
         {"help", no_argument, NULL, 'h'},       {"bending", required_argument, NULL, 'B'},
         {"refine-iters", required_argument, NULL, 'R'}, {"pca", required_argument, NULL, 'c'},
-        {"method", required_argument, NULL, 'm'},
-        {NULL, 0, NULL, 0}};
+        {"method", required_argument, NULL, 'm'}, {"seed", required_argument, NULL, 'S'},
+        {"tries", required_argument, NULL, 'T'}, {NULL, 0, NULL, 0}};
     es_study_interp_opts o;
     es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
     int c, store_it = 1;
-    int64_t iters;
+    int64_t iters, seed = -1, tries;
     es_ctx *ctx;
     es_store *s = NULL;
     es_status rc;
@@ -140,6 +145,15 @@ int cmd_interp(int argc, char **argv)
                 return cli_usage_error("interp", "--refine-iters wants a count >= 0");
             o.embed.refine_max_iter = (int)iters;
             break;
+        case 'S':
+            if (cli_parse_i64(optarg, &seed) || seed < 0)
+                return cli_usage_error("interp", "--seed wants an integer >= 0");
+            break;
+        case 'T':
+            if (cli_parse_i64(optarg, &tries) || tries < 1 || tries > 64)
+                return cli_usage_error("interp", "--tries wants 1 .. 64");
+            o.multiscale.tries = (int)tries;
+            break;
         case 'X': wmode = ES_STORE_REPLACE; break;
         case 'h': fputs(usage, stdout); return CLI_OK;
         default: return cli_usage_error("interp", "bad option");
@@ -157,6 +171,7 @@ int cmd_interp(int argc, char **argv)
         return cli_usage_error("interp", "with several frames, --output must be a pattern "
                                "with one integer conversion, like 'out_%%02d.obj'");
     if (!(ctx = cli_ctx_new("interp"))) return CLI_FAIL;
+    if (seed >= 0) es_ctx_set_seed(ctx, (uint64_t)seed);
     if (o.weights && !weights_are_rows(ctx, o.weights)) {
         es_ctx_free(ctx);
         return cli_usage_error("interp", "--weights wants 'w1*row:a + w2*row:b ...' with two "

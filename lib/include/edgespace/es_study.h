@@ -433,6 +433,8 @@ typedef struct es_study_interp_opts {
                                stored results the store's vertices and edges) */
     es_study_frame_fn frame;   /* called after each frame (may be NULL) */
     void *userdata;
+    es_multiscale_opts multiscale; /* method multiscale: its hierarchy (es_morph.h;
+                                   its seeds from the context's) */
 } es_study_interp_opts;
 ES_API void es_study_interp_opts_init(es_study_interp_opts *opts);
 
