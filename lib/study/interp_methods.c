@@ -112,7 +112,7 @@ static es_status geometric(mwalk *w, const double *xa, const double *xb)
         rc = geom_target(w, in, la, lb, step_t(o, i), len);
     if (rc == ES_OK)
         rc = o->method == ES_MORPH_MULTISCALE ? es_multiscale_new(ctx, w->mesh, &o->multiscale, &ms)
-                                              : es_shape_space_new(ctx, w->mesh, xa, xb, &ss);
+                                              : es_shape_space_new(ctx, w->mesh, xa, xb, NULL, &ss);
     for (int64_t i = 0; rc == ES_OK && i < o->steps; i++) {
         double t = step_t(o, i), wt[2] = {1 - t, t}, t0 = now_s();
         char heading[96], params[1024];

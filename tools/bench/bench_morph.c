@@ -8,8 +8,7 @@
  * edge-length errors against each frame's own target (RMS ratio and max
  * relative, es_embed_report) at the midpoint and the worst inner frame.
  * The data-driven rows also print how far the path stays from the rows
- * against the straight line (the frame heading). Shape-space runs only on
- * meshes of at most SHAPE_SPACE_MAX_V vertices. Frames are written to a
+ * against the straight line (the frame heading). Frames are written to a
  * scratch folder; nothing is stored.
  *
  *   bench_morph [steps]     (default 9; data from ../shared/data)
@@ -24,10 +23,6 @@
 
 #include "bench_clock.h"
 
-/* The averaging algorithm of Wuhrer et al. makes O(V) candidates per
- * vertex, O(V^2) in all (their Sec. 6): 6 s per frame (wall, loaded
- * machine) at 1,919 vertices, and past 2.4 GB at 3,448 when stopped. */
-enum { SHAPE_SPACE_MAX_V = 2500 };
 
 #ifndef ES_SHARED_DIR
 #define ES_SHARED_DIR "../shared"
@@ -109,11 +104,6 @@ static void run(es_ctx *ctx, const char *tmp, const char *set, const char *a, co
     for (size_t m = 0; m < sizeof methods / sizeof methods[0]; m++) {
         es_study_interp_opts o;
         acc ac = {0};
-        if (methods[m] == ES_MORPH_SHAPE_SPACE && es_store_nverts(s) > SHAPE_SPACE_MAX_V) {
-            printf("%-22s %-12s %4lld %-12s  skipped: O(V^2) candidates (Sec. 6)\n", set, b,
-                   (long long)es_store_nverts(s), es_morph_method_name(methods[m]));
-            continue;
-        }
         double w0 = bench_wall_s(), c0 = bench_process_cpu_s();
         es_study_interp_opts_init(&o);
         o.from = from, o.to = to, o.steps = steps, o.output = pat, o.method = methods[m];

@@ -100,6 +100,46 @@ ES_API es_status es_data_path(es_ctx *ctx, int64_t dim, int64_t n, const double 
                               const es_data_path_opts *opts, int64_t nframes, double *frames,
                               double *weights, es_data_path_info *info);
 
+/* ---- Gao et al.'s shape representation (Sec. 3.1, eq. 1) ------------------------
+ * Patch-based linear rotation-invariant coordinates (Baran et al. 2009) of
+ * a mesh against a base mesh, without the mean position and rotation: per
+ * face the scale/shear S_f of its deformation gradient (6 numbers) and
+ * log(G_p(f)^T R_f) (3), per pair of adjacent patches log(G_i^T G_j) (3);
+ * R_f the gradient's rotation, G_i the mean rotation of patch i. A rigid
+ * motion of the mesh leaves them unchanged; reconstruction solves for the
+ * patch rotations, then the positions, by two sparse least-squares systems
+ * (lri.c says how, and how the patches are made). Coordinates of several
+ * meshes blend linearly (Gao et al. interpolate and extrapolate them so). */
+typedef struct es_lri es_lri;
+
+typedef struct es_lri_opts {
+    int64_t patches;    /* 0: faces / 12, at most 2000 (the paper's 2000 patches on
+                           SCAPE's 25K faces) */
+} es_lri_opts;
+
+ES_API void es_lri_opts_init(es_lri_opts *opts);
+
+/* The coordinate system of `mesh` (borrowed) against base positions (3 x V,
+ * copied into what is kept). ES_EINVAL on a degenerate base face. */
+ES_API es_status es_lri_new(es_ctx *ctx, const es_mesh *mesh, const double *base,
+                            const es_lri_opts *opts, es_lri **out);
+ES_API void es_lri_free(es_lri *lri);
+/* Coordinates per mesh: 9 F + 3 (adjacent patch pairs). */
+ES_API int64_t es_lri_dim(const es_lri *lri);
+ES_API int64_t es_lri_npatches(const es_lri *lri);
+/* Coordinates x (es_lri_dim) of positions xyz (3 x V). ES_EINVAL on a
+ * degenerate face. */
+ES_API es_status es_lri_encode(es_ctx *ctx, es_lri *lri, const double *xyz, double *x);
+/* Positions (3 x V) of coordinates x, placed arbitrarily (the first patch
+ * of each part unrotated, its lowest vertex at the origin): align them. */
+ES_API es_status es_lri_decode(es_ctx *ctx, es_lri *lri, const double *x, double *xyz);
+/* Place reconstructed positions y (3 x V) between the source xs and target
+ * xt at s (Sec. 3.2.3): the rigid motions taking y onto each by least
+ * squares, their rotations interpolated as quaternions (the shorter way)
+ * and their translations linearly, applied to y: out (3 x V). */
+ES_API es_status es_lri_place(es_ctx *ctx, int64_t nv, const double *y, const double *xs,
+                              const double *xt, double s, double *out);
+
 /* Coordinates for es_data_path from long vectors (dim x n, leading
  * dimension ldx, e.g. the rows' normalized edge lengths): the examples'
  * principal component scores with every component, by classical scaling
@@ -264,21 +304,54 @@ ES_API es_status es_multiscale_interp(es_ctx *ctx, es_multiscale *ms, int64_t ni
  * the two candidates, centred at their midpoint); a vertex ends at the mean
  * of its candidates. On a triangulated polygon (the dual graph a tree)
  * every vertex has one candidate and frame t realizes its lengths exactly
- * (Theorem 1). Vertices in no face come out at the origin. */
+ * (Theorem 1). Vertices in no face come out at the origin.
+ * The bound. Sec. 6 says the averaging makes O(n) candidates per vertex,
+ * O(n^2) in all; it does not: a vertex reached across a shared edge takes
+ * as many new candidates as the edge's older end has, and those counts add
+ * up along the walk. Counted at the midpoints of real pairs
+ * (info.paper_candidates, tools/bench/bench_shape_space.c): facecap (1,919
+ * vertices) 3.9e5, finger (2,046) 5.6e7, sfm_surrey (3,448) 9.2e9, cactus
+ * (5,261) 5.6e8, Spacetime Faces (7,118) 3.4e12, cat (7,207) 7.3e9,
+ * face-study (9,409) 1.4e12: no power of V bounds it (the issue measured
+ * 2.2e11 on an 8.4K horse and 4e13 on a 10K body; the old notes here said
+ * O(V^2), wrong too). So a vertex stores at most opts.cap candidates, each
+ * slot weighted by how many of the paper's it stands for: a candidate made
+ * from a slot of weight w has weight w (the paper would make w there, one
+ * per candidate the slot merged); a vertex's position is the weighted mean
+ * of all its candidates (exactly the paper's mean while no slot merged);
+ * a vertex one candidate over the cap merges its two oldest slots into
+ * their weighted mean (the newest, which the next face takes as "the
+ * latest", stay exact). Memory is then at most cap slots per vertex and
+ * time O(cap) per tree arc. Measured: cap 32 is 2.9e-4 (RMS, of the
+ * diagonal) from the unbounded rule on facecap and 3.5e-4 on the closed
+ * test tube, within 4e-5 of cap 256 on every real pair; face-study's
+ * midpoint 0.13 s and 99 MiB peak, where the rule itself would make 1.4e12
+ * candidates (33 TB). */
 typedef struct es_shape_space es_shape_space;
+
+typedef struct es_shape_space_opts {
+    int64_t cap;            /* stored candidates per vertex, >= 2 (32) */
+} es_shape_space_opts;
+
+ES_API void es_shape_space_opts_init(es_shape_space_opts *opts);
 
 typedef struct es_shape_space_info {
     int64_t dual_arcs;      /* interior edges: arcs of the dual graph */
     int64_t tree_arcs;      /* arcs of the spanning forest */
-    int64_t candidates;     /* candidate positions made by the last frame */
-    int64_t max_candidates; /* most candidates of one vertex in the last frame */
+    int64_t candidates;     /* candidate slots stored at the end of the last frame */
+    int64_t max_candidates; /* most slots of one vertex (<= cap) */
+    double paper_candidates; /* candidates the paper's averaging makes for that frame
+                               (the slots' weights: exact, however many merged) */
+    double paper_max;       /* the most of one vertex */
 } es_shape_space_info;
 
 /* The shape-space points of poses xa and xb (3 x V each, copied; B is
- * aligned to A) and the spanning forest. The mesh is borrowed. ES_EINVAL
- * on a non-finite position or a degenerate face (no normal). */
+ * aligned to A) and the spanning forest. The mesh is borrowed. opts NULL:
+ * defaults. ES_EINVAL on a non-finite position, a degenerate face (no
+ * normal) or a cap below 2. */
 ES_API es_status es_shape_space_new(es_ctx *ctx, const es_mesh *mesh, const double *xa,
-                                    const double *xb, es_shape_space **out);
+                                    const double *xb, const es_shape_space_opts *opts,
+                                    es_shape_space **out);
 ES_API void es_shape_space_free(es_shape_space *ss);
 ES_API void es_shape_space_get_info(const es_shape_space *ss, es_shape_space_info *info);
 
