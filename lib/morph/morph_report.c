@@ -12,7 +12,7 @@
 #include <math.h>
 
 static const char *const names[] = {"edge-length", "multiscale", "shape-space", "data-driven",
-                                    "paper",       "conformal"};
+                                    "paper",       "conformal",  "data-driven-el"};
 
 const char *es_morph_method_name(es_morph_method m)
 {

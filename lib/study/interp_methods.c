@@ -11,10 +11,12 @@
  *  - paper (edge-length-interpolation as published) embeds each frame of
  *    the rows' interpolated lengths from their averaged dihedrals by
  *    es_embed_paper_solve, aligned frame to frame;
- *  - data-driven (Gao et al.) finds a path through all rows (es_data_path
- *    on their edge-length PCA scores with every component) and embeds each
- *    frame as the point of its row weights, as interp_walk.c embeds lerp:
- *    near the prior of those weights, in the store's frame.
+ *  - data-driven (Gao et al.) finds a path through all rows (es_data_path)
+ *    in their patch-based rotation-invariant coordinates and decodes each
+ *    frame, as the paper does; data-driven-el finds it in the rows'
+ *    edge-length PCA scores and embeds each frame as the point of its row
+ *    weights, as interp_walk.c embeds lerp: near the prior of those
+ *    weights, in the store's frame.
  * As the default walk does, every frame's lengths are checked before the
  * first file is written. */
 #include "study/study_pkg.h"
@@ -256,56 +258,105 @@ static es_status dd_frame(mwalk *w, int64_t n, const double *l, const double *sc
     return ES_OK;
 }
 
-static es_status data_driven(mwalk *w)
+/* Gao et al.'s path through all rows (es_data_path with opts->path, frames
+ * evenly along it). data-driven (lri 1), as the paper: the path in the
+ * rows' patch-based rotation-invariant coordinates (es_lri, base: row A),
+ * each frame the coordinates' combination decoded and placed between A and
+ * B by the interpolated rigid motion (es_lri_place); its report measures
+ * the frame against the same combination of the rows' lengths.
+ * data-driven-el (lri 0), the project's: the path in the rows' edge-length
+ * PCA scores, each frame the point of its row weights embedded near its
+ * prior like the default walk. */
+static es_status data_driven(mwalk *w, int lri)
 {
     es_ctx *ctx = w->ctx;
     const es_study_interp_opts *o = w->o;
+    const char *name = es_morph_method_name(o->method);
     int64_t n = es_store_nrows(w->store), ne = es_mesh_nedges(w->mesh);
-    int64_t nv = es_mesh_nverts(w->mesh), nc = 0, m = o->steps;
-    double *l = es__alloc_array(ctx, ne * n + n + n * n + n * m * 2 + ne + 3 * nv * 2 + 2 * ne,
+    int64_t nv = es_mesh_nverts(w->mesh), nc = 0, m = o->steps, dim = ne;
+    double *l = es__alloc_array(ctx, ne * n + n + n * n + n * m * 2 + 2 * ne + 8 * nv + 2 * ne,
                                 sizeof *l);
     double *sc = l + ne * n, *coords = sc + n, *frames = coords + n * n, *wts = frames + n * m;
-    double *v = wts + n * m, *xyz = v + ne, *prior = xyz + 3 * nv, *alpha = prior + 3 * nv;
-    double *sd = alpha + ne, scale;
+    double *v = wts + n * m, *tl = v + ne, *xyz = tl + ne, *prior = xyz + 3 * nv;
+    double *alpha = prior + 3 * nv, *sd = alpha + ne, *vc = sd + ne, *ve = vc + nv, scale;
+    double *X = NULL, *feat = NULL, *fx = NULL, *y = NULL;
     es_data_path_info info;
     es_study_rows *rows = NULL;
     es_embedder *emb = NULL;
+    es_lri *L = NULL;
     es_status rc = l ? ES_OK : ES_ENOMEM;
     if (rc == ES_OK && (o->t0 != 0 || o->t1 != 1))
-        rc = es__fail(ctx, ES_EINVAL, "interp --method data-driven: the path runs from A to B "
-                      "(t0 0, t1 1), not beyond");
+        rc = es__fail(ctx, ES_EINVAL, "interp --method %s: the path runs from A to B (t0 0, t1 "
+                      "1), not beyond", name);
     if (rc == ES_OK && m < 2)
-        rc = es__fail(ctx, ES_EINVAL, "interp --method data-driven: give 2 or more steps");
+        rc = es__fail(ctx, ES_EINVAL, "interp --method %s: give 2 or more steps", name);
     if (rc == ES_OK) rc = es_store_read_lengths(ctx, w->store, 0, n, (es_mat){l, ne, n, ne});
     if (rc == ES_OK) rc = es_store_read_scales(ctx, w->store, sc);
-    if (rc == ES_OK) rc = es_data_path_coords(ctx, ne, n, l, ne, coords, &nc);
+    if (rc == ES_OK && lri) {   /* every row's coordinates against row A */
+        if (!(X = es__alloc_array(ctx, 3 * nv * n + 3 * nv, sizeof *X))) rc = ES_ENOMEM;
+        y = X + 3 * nv * n;
+        for (int64_t r = 0; rc == ES_OK && r < n; r++)
+            rc = es_store_read_positions(ctx, w->store, r, X + 3 * nv * r);
+        if (rc == ES_OK) rc = es_lri_new(ctx, w->mesh, X + 3 * nv * w->ra, NULL, &L);
+        if (rc == ES_OK) {
+            dim = es_lri_dim(L);
+            if (!(feat = es__alloc_array(ctx, dim * (n + 1), sizeof *feat))) rc = ES_ENOMEM;
+            fx = feat + dim * n;
+        }
+        for (int64_t r = 0; rc == ES_OK && r < n; r++) {
+            rc = es_lri_encode(ctx, L, X + 3 * nv * r, feat + dim * r);
+            es__progress(ctx, "interp: shape coordinates", r + 1, n);
+        }
+    }
+    if (rc == ES_OK) rc = es_data_path_coords(ctx, dim, n, lri ? feat : l, dim, coords, &nc);
     if (rc == ES_OK && nc < 1)
-        rc = es__fail(ctx, ES_EINVAL, "interp --method data-driven: the rows are all alike");
+        rc = es__fail(ctx, ES_EINVAL, "interp --method %s: the rows are all alike", name);
     if (rc == ES_OK)
-        rc = es_data_path(ctx, nc, n, coords, n, w->ra, w->rb, NULL, m, frames, wts, &info);
+        rc = es_data_path(ctx, nc, n, coords, n, w->ra, w->rb, &o->path, m, frames, wts, &info);
     for (int64_t i = 0; rc == ES_OK && i < m; i++)
         rc = dd_frame(w, n, l, sc, wts + i * n, i, v, &scale);
-    if (rc == ES_OK) rc = es_study_rows_load(ctx, w->store, w->mesh, &rows);
-    if (rc == ES_OK) rc = es_embedder_new(ctx, w->mesh, &emb);
+    if (rc == ES_OK && !lri) rc = es_study_rows_load(ctx, w->store, w->mesh, &rows);
+    if (rc == ES_OK && !lri) rc = es_embedder_new(ctx, w->mesh, &emb);
     for (int64_t i = 0; rc == ES_OK && i < m; i++) {
         const double *wi = wts + i * n;
+        double s = (double)i / (double)(m - 1), t0 = now_s();
         es_embed_prior pr = {prior, alpha, sd, NULL};
         es_embed_report rep;
-        char heading[160], params[1024];
+        char heading[200], params[1024];
         dd_frame(w, n, l, sc, wi, i, v, &scale);
-        if ((rc = es_study_prior(ctx, rows, wi, prior, alpha, sd)) != ES_OK ||
-            (rc = es_embed_prior_solve(ctx, emb, v, scale, &pr, &o->embed, xyz, &rep)) != ES_OK)
+        if (lri) {
+            for (int64_t k = 0; k < dim; k++) fx[k] = 0;
+            for (int64_t r = 0; r < n; r++)
+                for (int64_t k = 0; wi[r] != 0 && k < dim; k++) fx[k] += wi[r] * feat[dim * r + k];
+            for (int64_t e = 0; e < ne; e++) tl[e] = v[e] * scale;
+            memset(&rep, 0, sizeof rep);
+            if ((rc = es_lri_decode(ctx, L, fx, y)) != ES_OK ||
+                (rc = es_lri_place(ctx, nv, y, X + 3 * nv * w->ra, X + 3 * nv * w->rb, s,
+                                   xyz)) != ES_OK)
+                break;
+            rep.t_total = now_s() - t0;
+            if ((rc = es_morph_report(ctx, w->mesh, tl, xyz, o->embed.realized_rtol, &rep, vc,
+                                      ve)) != ES_OK)
+                break;
+        } else if ((rc = es_study_prior(ctx, rows, wi, prior, alpha, sd)) != ES_OK ||
+                   (rc = es_embed_prior_solve(ctx, emb, v, scale, &pr, &o->embed, xyz,
+                                              &rep)) != ES_OK) {
             break;
-        snprintf(heading, sizeof heading, "s = %.4g along a path by %lld rows (data-driven; "
-                 "nearest row at most %.3g neighbour arcs away, the straight line %.3g)",
-                 (double)i / (double)(m - 1), (long long)info.hops, info.max_near,
-                 info.line_max_near);
-        snprintf(params, sizeof params, "method=data-driven; from=%s; to=%s; s=%.17g", o->from,
-                 o->to, (double)i / (double)(m - 1));
-        rc = emit(w, i, heading, v, xyz, &rep, emb, NULL, NULL, params);
+        }
+        snprintf(heading, sizeof heading, "s = %.4g along a path by %lld rows (%s; nearest row "
+                 "at most %.3g neighbour arcs away, the straight line %.3g)", s,
+                 (long long)info.hops, name, info.max_near, info.line_max_near);
+        snprintf(params, sizeof params, "method=%s; from=%s; to=%s; s=%.17g; knn=%lld; "
+                 "sigma=%.17g", name, o->from, o->to, s, (long long)o->path.knn, o->path.sigma);
+        rc = lri ? emit(w, i, heading, tl, xyz, &rep, NULL, vc, ve, params)
+                 : emit(w, i, heading, v, xyz, &rep, emb, NULL, NULL, params);
+        es__progress(ctx, "interp", i + 1, m);
     }
+    es_lri_free(L);
     es_embedder_free(emb);
     es_study_rows_free(rows);
+    es__free(ctx, X);
+    es__free(ctx, feat);
     es__free(ctx, l);
     return rc;
 }
@@ -339,8 +390,8 @@ es_status es__study_interp_method(es_ctx *ctx, es_store *store, const es_study_i
     if (o->method == ES_MORPH_CONFORMAL && o->to)
         ES_FAIL(ctx, ES_EINVAL, "interp --method conformal maps one row to the sphere: give "
                 "--from only (got --to %s)", o->to);
-    if (o->method == ES_MORPH_DATA_DRIVEN) {
-        rc = data_driven(&w);
+    if (o->method == ES_MORPH_DATA_DRIVEN || o->method == ES_MORPH_DATA_DRIVEN_EL) {
+        rc = data_driven(&w, o->method == ES_MORPH_DATA_DRIVEN);
     } else {
         int64_t nv = es_mesh_nverts(mesh);
         if (!(xa = es__alloc_array(ctx, 6 * nv, sizeof *xa))) return ES_ENOMEM;

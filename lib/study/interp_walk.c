@@ -29,6 +29,7 @@ void es_study_interp_opts_init(es_study_interp_opts *o)
     o->steps = 9;
     es_embed_opts_init(&o->embed);
     es_multiscale_opts_init(&o->multiscale);
+    es_data_path_opts_init(&o->path);
 }
 
 /* t of frame i of `steps` from t0 to t1 inclusive. */

@@ -46,9 +46,10 @@ static void check_frames_do_not_jump(const char *dir, const char *stem, int widt
 static void check_methods(const char *dir, const char *store)
 {
     static es_test_out r;
-    static const char *const methods[] = {"multiscale", "shape-space", "data-driven", "paper"};
+    static const char *const methods[] = {"multiscale", "shape-space", "data-driven", "paper",
+                                          "data-driven-el"};
     char pat[4400], p[4400], name[64], buf[256];
-    for (int m = 0; m < 4; m++) {
+    for (int m = 0; m < 5; m++) {
         snprintf(pat, sizeof pat, "%s/m%d_%%02d.obj", dir, m);
         snprintf(name, sizeof name, "m%d", m);
         ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-1", "--steps",
@@ -95,6 +96,30 @@ static void check_methods(const char *dir, const char *store)
         ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-2", "--method",
                "multiscale", "--tries", "0", "-o", f[0]);
         ES_CHECK_MSG(r.status == 2 && strstr(r.err, "--tries"), "%d %s", r.status, r.err);
+        /* data-driven's K and sigma: taken (recorded in the stored parameters), bad
+         * values refused */
+        snprintf(pat, sizeof pat, "%s/dd_%%d.obj", dir);
+        ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-2", "--method",
+               "data-driven", "--knn", "1", "--sigma", "0.5", "--steps", "3", "-o", pat,
+               "--name", "ddk");
+        ES_CHECK_MSG(r.status == 0, "--knn 1 --sigma 0.5: %d %s", r.status, r.err);
+        {
+            es_ctx *c2 = NULL;
+            es_store *st = NULL;
+            ES_CHECK(es_ctx_new(&c2) == ES_OK);
+            if (c2) ES_CHECK_OK(c2, es_store_open(c2, store, ES_STORE_READ, &st));
+            if (st) {
+                char par[1024];
+                ES_CHECK_OK(c2, es_store_get_attr(c2, st, "embed/ddk_01", "params", par,
+                                                  sizeof par));
+                ES_CHECK_MSG(strstr(par, "knn=1;") && strstr(par, "sigma=0.5"), "%s", par);
+            }
+            es_store_close(st);
+            es_ctx_free(c2);
+        }
+        ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-2", "--method",
+               "data-driven", "--sigma", "0", "-o", pat);
+        ES_CHECK_MSG(r.status == 2 && strstr(r.err, "--sigma"), "%d %s", r.status, r.err);
     }
     ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-1", "--method",
            "sideways", "-o", pat);

@@ -47,12 +47,18 @@ static const char usage[] =
     "                        multiscale (Winkler et al. 2010), shape-space (Wuhrer\n"
     "                        et al. 2010), each frame put together by the method,\n"
     "                        in A's frame; data-driven (Gao et al. 2017): a path\n"
-    "                        through the store's rows, each frame embedded as above;\n"
+    "                        through the store's rows in the paper's rotation-\n"
+    "                        invariant coordinates, each frame decoded from them;\n"
+    "                        data-driven-el: the same path in edge-length space,\n"
+    "                        each frame embedded as above;\n"
     "                        paper: the published pipeline (embed --paper) on each\n"
     "                        frame from the rows' averaged dihedrals; conformal\n"
     "                        (--from row:ID only): the row mapped to the sphere by\n"
     "                        discrete conformal factors, t = their k (an open mesh\n"
     "                        closed off first; frame files of the closed mesh)\n"
+    "      --knn K           data-driven: neighbours per row in the path's graph (6)\n"
+    "      --sigma S         data-driven: the examples' pull falls off as exp(-d / S),\n"
+    "                        d in mean neighbour distances (default 1)\n"
     "      --seed S          seed of the multiscale hierarchies' random seed faces\n"
     "                        (default the library's)\n"
     "      --tries N         multiscale: hierarchies from seeds S .. S+N-1, each frame\n"
@@ -101,7 +107,8 @@ int cmd_interp(int argc, char **argv)
         {"help", no_argument, NULL, 'h'},       {"bending", required_argument, NULL, 'B'},
         {"refine-iters", required_argument, NULL, 'R'}, {"pca", required_argument, NULL, 'c'},
         {"method", required_argument, NULL, 'm'}, {"seed", required_argument, NULL, 'S'},
-        {"tries", required_argument, NULL, 'T'}, {NULL, 0, NULL, 0}};
+        {"tries", required_argument, NULL, 'T'}, {"knn", required_argument, NULL, 'K'},
+        {"sigma", required_argument, NULL, 'G'}, {NULL, 0, NULL, 0}};
     es_study_interp_opts o;
     es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
     int c, store_it = 1;
@@ -153,6 +160,14 @@ int cmd_interp(int argc, char **argv)
             if (cli_parse_i64(optarg, &tries) || tries < 1 || tries > 64)
                 return cli_usage_error("interp", "--tries wants 1 .. 64");
             o.multiscale.tries = (int)tries;
+            break;
+        case 'K':
+            if (cli_parse_i64(optarg, &o.path.knn) || o.path.knn < 1)
+                return cli_usage_error("interp", "--knn wants a count >= 1");
+            break;
+        case 'G':
+            if (cli_parse_double(optarg, &o.path.sigma) || !(o.path.sigma > 0))
+                return cli_usage_error("interp", "--sigma wants a positive number");
             break;
         case 'X': wmode = ES_STORE_REPLACE; break;
         case 'h': fputs(usage, stdout); return CLI_OK;

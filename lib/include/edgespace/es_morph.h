@@ -159,16 +159,21 @@ typedef enum es_morph_method {
     ES_MORPH_EDGE_LENGTH = 0,   /* the project's: lengths interpolated, each frame embedded */
     ES_MORPH_MULTISCALE,        /* Winkler et al. 2010 */
     ES_MORPH_SHAPE_SPACE,       /* Wuhrer et al. 2010 */
-    ES_MORPH_DATA_DRIVEN,       /* Gao et al. 2017, each frame embedded */
+    ES_MORPH_DATA_DRIVEN,       /* Gao et al. 2017 as the paper: the path in the rows'
+                                   patch-based rotation-invariant coordinates (es_lri),
+                                   each frame decoded */
     ES_MORPH_PAPER,             /* edge-length-interpolation's pipeline as published: the
                                    lengths and averaged dihedrals of es_interp_targets,
                                    each frame by es_embed_paper_solve */
-    ES_MORPH_CONFORMAL          /* edge-length-interpolation Sec. 5: one shape to the sphere
+    ES_MORPH_CONFORMAL,         /* edge-length-interpolation Sec. 5: one shape to the sphere
                                    (es_conformal_*) */
+    ES_MORPH_DATA_DRIVEN_EL     /* Gao et al.'s path in edge-length space, each frame
+                                   embedded (ES_MORPH_DATA_DRIVEN: in the paper's own
+                                   coordinates, es_lri, each frame decoded) */
 } es_morph_method;
 
 /* "edge-length", "multiscale", "shape-space", "data-driven", "paper",
- * "conformal". */
+ * "conformal", "data-driven-el". */
 ES_API const char *es_morph_method_name(es_morph_method method);
 /* The method of a name; ES_ENOTFOUND lists the known names. */
 ES_API es_status es_morph_method_from_name(es_ctx *ctx, const char *name,

@@ -421,9 +421,12 @@ typedef struct es_study_interp_opts {
                                "row:ID"): multiscale and shape-space put each frame
                                together themselves (positions in row A's frame);
                                data-driven follows a path through the store's rows
-                               (es_data_path on their edge-length PCA scores, frames
-                               evenly along it, t0 and t1 0 and 1) and embeds each
-                               frame as the point of its row weights, like the
+                               (es_data_path on their es_lri coordinates against row
+                               A, frames evenly along it, t0 and t1 0 and 1) and
+                               decodes each frame, placed between A and B by the
+                               interpolated rigid motion; data-driven-el the same
+                               path on the rows' edge-length PCA scores, each frame
+                               embedded as the point of its row weights, like the
                                default; paper: the published pipeline
                                (es_embed_paper_solve) from the rows' averaged
                                dihedrals, aligned frame to frame; conformal: row
@@ -435,6 +438,8 @@ typedef struct es_study_interp_opts {
     void *userdata;
     es_multiscale_opts multiscale; /* method multiscale: its hierarchy (es_morph.h;
                                    its seeds from the context's) */
+    es_data_path_opts path; /* methods data-driven and data-driven-el: the path's K,
+                               sigma and the rest (es_data_path_opts_init) */
 } es_study_interp_opts;
 ES_API void es_study_interp_opts_init(es_study_interp_opts *opts);
 
