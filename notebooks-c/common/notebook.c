@@ -171,6 +171,30 @@ const char *nb_dataset(notebook *n, const char *set)
     return buf;
 }
 
+int nb_read_mesh(notebook *n, const char *dir, const char *file, es_mesh **mesh, double **xyz)
+{
+    char path[8192];
+    es_meshdata md;
+    es_status rc;
+    snprintf(path, sizeof path, "%s/%s", dir, file);
+    *xyz = NULL;
+    if ((rc = es_meshdata_read(n->ctx, path, ES_FORMAT_AUTO, &md)) != ES_OK)
+        return nb_fail(n, rc, path);
+    if (!*mesh) {
+        rc = es_mesh_new(n->ctx, md.nverts, md.nfaces, md.faces, md.xyz, mesh);
+    } else if (md.nverts != es_mesh_nverts(*mesh) || md.nfaces != es_mesh_nfaces(*mesh) ||
+               memcmp(md.faces, es_mesh_faces(*mesh), 3 * sizeof(int64_t) * (size_t)md.nfaces)) {
+        es_meshdata_clear(n->ctx, &md);
+        fprintf(stderr, "%s: %s: another face list than the study's first mesh\n", n->name,
+                path);
+        return nb_fail(n, ES_EMISMATCH, path);
+    }
+    if (rc == ES_OK && !(*xyz = malloc(3 * sizeof(double) * (size_t)md.nverts))) rc = ES_ENOMEM;
+    if (rc == ES_OK) memcpy(*xyz, md.xyz, 3 * sizeof(double) * (size_t)md.nverts);
+    es_meshdata_clear(n->ctx, &md);
+    return rc == ES_OK ? 0 : nb_fail(n, rc, path);
+}
+
 void nb_input(notebook *n, const char *key, const char *fmt, ...)
 {
     va_list ap;

@@ -117,6 +117,12 @@ void nb_output(notebook *nb, const char *file);
  * it; a miss makes nb_close return 1. NaN metrics fail. Returns pass. */
 int nb_check(notebook *nb, const char *name, double metric, const char *op, double bound);
 
+/* Read the mesh file <dir>/<file> (an input of the study): its positions
+ * into a malloc'd 3 x V array *xyz and, when *mesh is NULL, its topology
+ * (with these positions as reference) into *mesh; a later file must have
+ * the same face list. Returns 0, or 1 after nb_fail. */
+int nb_read_mesh(notebook *nb, const char *dir, const char *file, es_mesh **mesh, double **xyz);
+
 /* Seconds on a monotonic clock. */
 double nb_now(void);
 
