@@ -32,6 +32,7 @@
  *     1e-10 (or 300 steps; the test asks 1e-6); such maps scale chordal
  *     distances by
  *     sqrt(|phi'(x)| |phi'(y)|), so conformal equivalence holds throughout;
+ *     and mirrored if need be so that its faces' normals point outward;
  *  6. scaled so that the edge lengths keep the input's sum (the morph
  *     changes shape, not size), and u read back from the sphere's chordal
  *     lengths s by least squares on u_a + u_b = 2 log(s_e / l_e): E
@@ -498,6 +499,23 @@ es_status es_conformal_sphere(es_ctx *ctx, const es_mesh *mesh, const double *le
     }
     inf.mobius_iters = centre(&c, x, area + c.nv, area, &off);
     inf.centre_offset = off;
+    /* the projection reverses orientation (the plane's counter-clockwise
+     * faces, seen from outside the sphere, turn clockwise): mirrored so that
+     * the faces' normals point outward, as a mesh's usually do (a reflection
+     * keeps every length). Inside out, the sphere's dihedrals interpolated
+     * with the face's crumpled every middle frame of the morph. */
+    {
+        double vol = 0;
+        for (int64_t f = 0; f < c.nf; f++) {
+            const double *p0 = x + 3 * c.F[3 * f], *p1 = x + 3 * c.F[3 * f + 1];
+            const double *p2 = x + 3 * c.F[3 * f + 2];
+            double cr[3];
+            es__v3_cross(p1, p2, cr);
+            vol += es__v3_dot(p0, cr) / 6;
+        }
+        if (vol < 0)
+            for (int64_t v = 0; v < c.nv; v++) x[3 * v] = -x[3 * v];
+    }
     /* the input's length sum */
     for (int64_t e = 0; e < c.ne; e++) {
         double d[3];

@@ -397,7 +397,7 @@ typedef struct es_conformal_info {
 
 /* Factors u (V) taking lengths len (E) of `mesh` (closed, genus 0, one
  * piece) to the sphere, and the sphere's vertices (3 x V, centred at the
- * origin; NULL to skip). infinity: the vertex sent to the pole (< 0: the
+ * origin, faces counter-clockwise seen from outside; NULL to skip). infinity: the vertex sent to the pole (< 0: the
  * one of largest degree, e.g. a closed hole's apex). info may be NULL.
  * ES_EINVAL names what is wrong with the mesh or a length; ES_ENOCONV if
  * the flattening does not converge; ES_ENUMERIC from the factorizations,
