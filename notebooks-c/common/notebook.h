@@ -16,7 +16,8 @@
  * else $EDGESPACE_SHARED/data, else the NB_SHARED_DIR given at build time
  * (../shared beside the source tree) + /data; --synthetic ignores it all
  * and makes the project's own synthetic data. --small picks the small
- * sizes the test suite runs (also $EDGESPACE_NOTEBOOK_SMALL=1).
+ * sizes the test suite runs (also $EDGESPACE_NOTEBOOK_SMALL=1); --all adds
+ * the inputs a default run leaves out because they take minutes.
  */
 #ifndef EDGESPACE_NOTEBOOK_H
 #define EDGESPACE_NOTEBOOK_H
@@ -49,6 +50,7 @@ typedef struct notebook {
     char datadir[4096];         /* folder of the data sets, "" if none */
     int synthetic;              /* --synthetic given */
     int small;                  /* --small given */
+    int all;                    /* --all given: inputs a default run leaves out for time */
     uint64_t seed;
     es_ctx *ctx;
     FILE *report;               /* report.md */
