@@ -14,8 +14,9 @@
  *  - max_iter 0 gives stages 2-3 from the start's dihedrals (which average
  *    the noise only partly: over twice as far from the mesh); bad settings
  *    are refused.
- * SciPy's own fmin_l_bfgs_b on the same energy is the oracle in
- * python/tests/test_paper_oracle.py. */
+ * With --real (the slow suite, ../shared/data): facecap's face (open) and
+ * goast's finger (closed) from noisy dihedrals. SciPy's own fmin_l_bfgs_b
+ * on the same energy is the oracle in python/tests/test_paper_oracle.py. */
 #include "es_test.h"
 
 #include <edgespace/edgespace.h>
@@ -154,11 +155,59 @@ static void midpoint(es_ctx *ctx)
     es_synth_set_clear(ctx, &set);
 }
 
-int main(void)
+/* ../shared/data (--real, the slow suite): facecap's neutral face (open:
+ * eye, mouth and neck holes) from its own lengths and dihedrals with 0.02
+ * rad of noise, and the finger (closed): stage 1 runs, the mesh comes back. */
+static void real(es_ctx *ctx)
+{
+    static const char *const files[] = {"facecap_arkit/neutral.obj", "goast_finger/finger0.obj"};
+    const char *data = es_test_shared_data();
+    if (!data) {
+        fprintf(stderr, "no ../shared/data: real meshes skipped\n");
+        return;
+    }
+    for (int i = 0; i < 2; i++) {
+        char path[4096];
+        es_meshdata md;
+        es_mesh *m = NULL;
+        es_embedder *emb = NULL;
+        snprintf(path, sizeof path, "%s/%s", data, files[i]);
+        ES_CHECK_OK(ctx, es_meshdata_read(ctx, path, ES_FORMAT_AUTO, &md));
+        ES_CHECK_OK(ctx, es_mesh_new(ctx, md.nverts, md.nfaces, md.faces, NULL, &m));
+        if (m) ES_CHECK_OK(ctx, es_embedder_new(ctx, m, &emb));
+        if (emb) {
+            int64_t ne = es_mesh_nedges(m), nv = md.nverts;
+            double *l = malloc((size_t)ne * sizeof *l), *a = malloc((size_t)ne * sizeof *a);
+            double *out = malloc(3 * (size_t)nv * sizeof *out), d;
+            es_embed_report r;
+            ES_CHECK_OK(ctx, es_edge_lengths(ctx, m, md.xyz, l));
+            ES_CHECK_OK(ctx, es_dihedral_angles(ctx, m, md.xyz, a));
+            add_noise(m, a, 0.02, 11);
+            ES_CHECK_OK(ctx, es_embed_paper_solve(ctx, emb, l, 0, a, NULL, NULL, out, &r));
+            d = aligned_dist(ctx, nv, out, md.xyz);
+            fprintf(stderr, "%s: E %.3g -> %.3g in %lld L-BFGS iterations (%.1f s); back to "
+                    "%.2g x diag, RMS ratio %.2g\n", files[i], r.closure_before,
+                    r.closure_stage1, (long long)r.dihedral_iters, r.t_total, d, r.rms_ratio);
+            ES_CHECK(r.dihedral_iters > 10 && r.closure_stage1 < 1e-3 * r.closure_before);
+            ES_CHECK_MSG(d < 5e-3, "%s: %g x diag", files[i], d);
+            free(l), free(a), free(out);
+        }
+        es_embedder_free(emb);
+        es_mesh_free(m);
+        es_meshdata_clear(ctx, &md);
+    }
+}
+
+int main(int argc, char **argv)
 {
     es_ctx *ctx = NULL;
     ES_TEST_BEGIN();
     if (es_ctx_new(&ctx) != ES_OK) return 1;
+    if (argc > 1 && !strcmp(argv[1], "--real")) {
+        real(ctx);
+        es_ctx_free(ctx);
+        ES_TEST_END();
+    }
     roundtrip(ctx, ES_SYNTH_TUBE, "open tube");
     roundtrip(ctx, ES_SYNTH_FACE, "synthetic face (4 holes)");
     roundtrip(ctx, ES_SYNTH_TUBE_CLOSED, "closed tube");
