@@ -460,6 +460,11 @@ typedef struct es_study_embed_opts {
     int cache;              /* 1 (the default): the session's cache beside the store
                                (es_study_embedder_open) */
     es_embed_opts embed;    /* solver options (es_embed_opts_init) */
+    int paper;              /* 1: the published pipeline (es_embed_paper_solve, default
+                               L-BFGS settings; embed's alignment and report settings)
+                               from the same start's dihedrals: the prior's weighted
+                               circular mean of the rows' (the paper: their average), or
+                               the explicit start's (0) */
 } es_study_embed_opts;
 ES_API void es_study_embed_opts_init(es_study_embed_opts *opts);
 
@@ -501,12 +506,25 @@ typedef struct es_study_interp_opts {
                                "row:ID"): multiscale and shape-space put each frame
                                together themselves (positions in row A's frame);
                                data-driven follows a path through the store's rows
-                               (es_data_path on their edge-length PCA scores, frames
-                               evenly along it, t0 and t1 0 and 1) and embeds each
-                               frame as the point of its row weights, like the
-                               default */
+                               (es_data_path on their es_lri coordinates against row
+                               A, frames evenly along it, t0 and t1 0 and 1) and
+                               decodes each frame, placed between A and B by the
+                               interpolated rigid motion; data-driven-el the same
+                               path on the rows' edge-length PCA scores, each frame
+                               embedded as the point of its row weights, like the
+                               default; paper: the published pipeline
+                               (es_embed_paper_solve) from the rows' averaged
+                               dihedrals, aligned frame to frame; conformal: row
+                               `from` alone (to NULL) mapped to the sphere, t the
+                               factors' k (es_conformal_*; an open mesh is closed
+                               off: the frame files have the closed mesh, the
+                               stored results the store's vertices and edges) */
     es_study_frame_fn frame;   /* called after each frame (may be NULL) */
     void *userdata;
+    es_multiscale_opts multiscale; /* method multiscale: its hierarchy (es_morph.h;
+                                   its seeds from the context's) */
+    es_data_path_opts path; /* methods data-driven and data-driven-el: the path's K,
+                               sigma and the rest (es_data_path_opts_init) */
 } es_study_interp_opts;
 ES_API void es_study_interp_opts_init(es_study_interp_opts *opts);
 
