@@ -373,6 +373,43 @@ ES_API es_status es_embed_prior_from_rows_sc(es_ctx *ctx, int64_t nverts, int64_
  * writes at most n bytes with NUL, returns buf. */
 ES_API const char *es_embed_report_format(const es_embed_report *rep, char *buf, size_t n);
 
+/* ---- the published pipeline, for comparison (paper.c) ------------------------
+ * edge-length-interpolation Section 2 as published: stage 1 minimizes the
+ * closure energy E(alpha) (eq. 3) by L-BFGS from the initial dihedrals (the
+ * paper: SciPy's fmin_l_bfgs_b from the inputs' averaged dihedrals; here
+ * SciPy's default settings), stages 2-3 turn the minimizer into frames and
+ * positions by least squares, and nothing follows: no refinement against
+ * the lengths, no choice whether stage 1 helps (es_embed_solve's changes).
+ * On open meshes stage 1 works on the interior vertices' closure, as on
+ * closed ones. */
+typedef struct es_embed_paper_opts {
+    int history;            /* L-BFGS correction pairs, m (10) */
+    int max_iter;           /* iterations, and evaluations of E (15000); 0: no stage 1 */
+    double factr;           /* stop when E falls by <= factr x DBL_EPSILON x max(|E|, 1)
+                               in an iteration (1e7) ... */
+    double pgtol;           /* ... or when max |dE/dalpha| <= pgtol (1e-5) */
+    es_embed_opts embed;    /* alignment and report settings of stages 2-3
+                               (es_embed_opts_init); its stage-1, refinement, prior and
+                               continuation fields are not used */
+} es_embed_paper_opts;
+
+ES_API void es_embed_paper_opts_init(es_embed_paper_opts *opts);
+
+/* Embed target lengths (E; scale as es_embed_solve) by the published
+ * pipeline from init_alpha (E, the averaged dihedrals), or from the
+ * dihedrals of init_xyz when init_alpha is NULL; the output is aligned as
+ * es_embed_solve aligns it (to init_xyz when given). The report is
+ * es_embed_solve's for stages 2-3 with stage 1's figures put in:
+ * closure_before (E at the start), closure_stage1 (E at the L-BFGS
+ * minimizer: the "error" of the paper's Table 1), dihedral_iters (L-BFGS
+ * iterations), t_dihedral, and t_total for the whole. Errors as
+ * es_embed_solve, and ES_EINVAL for settings out of range. */
+ES_API es_status es_embed_paper_solve(es_ctx *ctx, es_embedder *emb, const double *target,
+                                      double scale, const double *init_alpha,
+                                      const double *init_xyz,
+                                      const es_embed_paper_opts *opts, double *xyz,
+                                      es_embed_report *report);
+
 #ifdef __cplusplus
 }
 #endif
