@@ -542,7 +542,7 @@ static int embed(notebook *nb, study *s)
          * free directions of the open face near the data's bending, and puts
          * the output in the store's frame: every face stands alike */
         es_study_embed_result res;
-        if ((rc = es_study_embedder_solve(se, s->pts + p * s->E, s->pt_scale[p], s->w + p * s->N,
+        if ((rc = es_study_embedder_solve(nb->ctx, se, s->pts + p * s->E, s->pt_scale[p], s->w + p * s->N,
                                           &eo, 0, 0, s->xyz + p * V3, &res)) != ES_OK) {
             nb_fail(nb, rc, s->pt_name[p]);
             break;
