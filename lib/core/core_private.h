@@ -77,6 +77,10 @@ es_status es__replace_begin(es_ctx *ctx, const char *path, es__file_replace *w);
 es_status es__replace_end(es_ctx *ctx, es__file_replace *w, es_status rc);
 char *es__strdup(es_ctx *ctx, const char *s);
 
+/* The k-th smallest (0-based) of a[0..n-1], k < n, NaN-free; reorders a
+ * (order_stat.c). */
+double es__kth_smallest(double *a, int64_t n, int64_t k);
+
 /* Checked products; false on overflow. */
 static inline bool es__mul_size(size_t a, size_t b, size_t *out)
 {

@@ -182,12 +182,6 @@ es_status es__bend_flaps(es_embedder *emb)
     return ES_OK;
 }
 
-static int cmp_dbl(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
 /* Area of a triangle from its edge lengths (Heron in Kahan's ordering). */
 static double tri_area(double a, double b, double c)
 {
@@ -232,8 +226,7 @@ void es__bend_weights(const es_embedder *emb, const double *L, const double *sd,
     for (int64_t e = 0; e < emb->ne; e++)
         if (emb->flap[6 * e] >= 0) t[n++] = sd[e];
     if (n > 0) {
-        qsort(t, (size_t)n, sizeof *t, cmp_dbl);
-        s0 = sd_floor * t[n / 2];
+        s0 = sd_floor * es__kth_smallest(t, n, n / 2);
         if (s0 > 0)
             for (int64_t e = 0; e < emb->ne; e++) omega[e] /= 1 + (sd[e] / s0) * (sd[e] / s0);
     }

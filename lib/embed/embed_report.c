@@ -10,12 +10,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y ? 1 : 0;
-}
-
 es_status es_embed_length_error(es_ctx *ctx, const es_mesh *mesh, const double *xyz,
                                  const double *target, int normalize, double *rms_ratio,
                                  double *max_rel, double *p99_rel)
@@ -43,13 +37,13 @@ es_status es_embed_length_error(es_ctx *ctx, const es_mesh *mesh, const double *
         double d = len[e] * f - target[e];
         ss += d * d;
         rel[e] = fabs(d) / target[e];
+        if (rel[e] != rel[e]) rel[e] = INFINITY;   /* NaN: counted as the worst */
         if (!(rel[e] <= mx)) mx = rel[e];
     }
     if (rms_ratio) *rms_ratio = sqrt(ss / (double)ne) / (st / (double)ne);
     if (max_rel) *max_rel = mx;
     if (p99_rel) {
-        qsort(rel, (size_t)ne, sizeof *rel, cmp_double);
-        *p99_rel = rel[(int64_t)floor(0.99 * (double)(ne - 1))];
+        *p99_rel = es__kth_smallest(rel, ne, (int64_t)floor(0.99 * (double)(ne - 1)));
     }
     es__free(ctx, rel);
     es__free(ctx, len);

@@ -269,6 +269,7 @@ void es_store_close(es_store *store)
     } H5E_END_TRY
 }
 
+uint64_t es_store_generation(const es_store *s) { return s ? s->generation : 0; }
 int64_t es_store_nrows(const es_store *s) { return s ? s->nrows : 0; }
 int64_t es_store_nedges(const es_store *s) { return s ? s->nedges : 0; }
 int64_t es_store_nverts(const es_store *s) { return s ? s->nverts : 0; }

@@ -45,6 +45,7 @@ struct es_store {
     struct stat orig;      /* identity of the original when it was copied */
     struct stat opened;    /* identity of the file the in-memory rows came from */
     unsigned tmp_counter;
+    uint64_t generation;   /* es_store_generation: bumped by every write */
     int64_t nrows, nverts, nfaces, nedges;
     es_topology_kind kind;
     char fingerprint[17];

@@ -155,6 +155,8 @@ es_status es__store_begin_write(es_store *s)
     if (s->broken)
         ES_FAIL(ctx, ES_EIO, "store: an earlier write to '%s' failed; reopen the store",
                 s->path);
+    /* whatever is about to be written: values read before are stale */
+    s->generation++;
     if (s->work) return ES_OK;
     es__store_clean_stale(s->path);
     if (!(s->work = es__store_temp_name(s))) return ES_ENOMEM;

@@ -34,11 +34,13 @@ struct es_study_embedder {
     double *correction, *start;          /* 3V each: x_last - prior_last, the warm start */
     int last_ok;                         /* the last output bent <= 1.1 x its prior */
     int have_last;
+    es__leaf_cache *leaves;              /* the points' leaves, kept (embed_leaves.c) */
 };
 
 void es_study_embedder_free(es_study_embedder *se)
 {
     if (!se) return;
+    es__leaf_cache_free(se->leaves);
     es_embedder_free(se->emb);
     es_study_rows_free(se->rows);
     es_mesh_free(se->mesh);
@@ -83,7 +85,9 @@ es_status es_study_embedder_open(es_ctx *ctx, es_store *store, int use_cache,
             (rc = es__study_cache_load(ctx, store, key, &order, &se->rows)) != ES_OK)
             goto fail;
     }
-    if ((rc = es_embedder_new_ordered(ctx, se->mesh, order, &se->emb)) != ES_OK) goto fail;
+    if ((rc = es_embedder_new_ordered(ctx, se->mesh, order, &se->emb)) != ES_OK ||
+        (rc = es__leaf_cache_new(ctx, store, se->mesh, &se->leaves)) != ES_OK)
+        goto fail;
     if (!se->rows) {
         if ((rc = es_study_rows_load(ctx, store, se->mesh, &se->rows)) != ES_OK) goto fail;
         if (use_cache) es__study_cache_save(ctx, store, key, es_embedder_ordering(se->emb), se->rows);
@@ -178,8 +182,9 @@ es_status es_study_embedder_point(es_ctx *ctx, es_study_embedder *se, const char
     es_status rc;
     if (!se) ES_FAIL(ctx, ES_EINVAL, "embed: no session");
     if (!point) ES_FAIL(ctx, ES_EINVAL, "embed: no point given");
-    if ((rc = es_study_point_weights(ctx, se->store, point, pca_name, se->target, &own,
-                                     se->w)) != ES_OK)
+    if ((rc = es__leaf_cache_ready(se->leaves, pca_name)) != ES_OK ||
+        (rc = es__study_point_weights_via(ctx, se->store, point, pca_name, es__leaf_cache_resolve,
+                                          se->leaves, se->mesh, se->target, &own, se->w)) != ES_OK)
         return rc;
     return es_study_embedder_solve(ctx, se, se->target, scale > 0 ? scale : own, se->w, eo, warm,
                                    es__study_point_is_one_mesh(ctx, point), xyz, res);

@@ -3,6 +3,7 @@
  * interp and every other consumer of a point share. */
 #include "core/core_private.h"
 #include "edgespace/es_study.h"
+#include "study/study_pkg.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -108,6 +109,32 @@ es_status es_study_point_weights(es_ctx *ctx, es_store *store, const char *spec,
                                  const char *pca_name, double *lengths, double *scale,
                                  double *w)
 {
+    return es__study_point_weights_via(ctx, store, spec, pca_name, NULL, NULL, NULL, lengths,
+                                       scale, w);
+}
+
+/* An expression's lengths with its leaves from `resolve` (es_study_resolve
+ * behind a cache, say) on the store's topology `mesh`. */
+static es_status resolved_point(es_ctx *ctx, es_store *store, const char *spec,
+                                es_point_resolve_fn resolve, void *ud, const es_mesh *mesh,
+                                double *lengths, double *scale, double *w)
+{
+    es_point_expr *x = NULL;
+    es_point_info info;
+    es_status rc;
+    if ((rc = es_point_parse(ctx, spec, &x)) != ES_OK) return rc;
+    rc = es_point_eval_rows(ctx, x, es_store_nedges(store), w ? es_store_nrows(store) : 0,
+                            resolve, ud, mesh, lengths, w, &info);
+    es_point_expr_free(x);
+    if (rc == ES_OK && isfinite(info.scale) && info.scale > 0) *scale = info.scale;
+    return rc;
+}
+
+es_status es__study_point_weights_via(es_ctx *ctx, es_store *store, const char *spec,
+                                      const char *pca_name, es_point_resolve_fn resolve,
+                                      void *ud, const es_mesh *mesh, double *lengths,
+                                      double *scale, double *w)
+{
     char path[512];
     int64_t ne = es_store_nedges(store);
     es_status rc;
@@ -119,6 +146,8 @@ es_status es_study_point_weights(es_ctx *ctx, es_store *store, const char *spec,
         rc = row_point(ctx, store, spec + 4, lengths, scale, w);
     } else if (es_store_has(store, path)) {
         rc = stored_point(ctx, store, spec, lengths, scale, w);
+    } else if (resolve) {
+        rc = resolved_point(ctx, store, spec, resolve, ud, mesh, lengths, scale, w);
     } else {   /* an expression (es_point.h syntax) */
         es_point_info info;
         double *v = NULL;

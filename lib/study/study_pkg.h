@@ -107,6 +107,30 @@ void es__study_cache_save(es_ctx *ctx, es_store *s, uint64_t key, const int64_t 
  * coefficient 1): exactly realizable (embed_session.c). */
 int es__study_point_is_one_mesh(es_ctx *ctx, const char *spec);
 
+/* es_study_point_weights with an expression's leaves from `resolve` (NULL:
+ * es_study_point's own, read afresh) on the store's topology mesh. */
+es_status es__study_point_weights_via(es_ctx *ctx, es_store *store, const char *spec,
+                                      const char *pca_name, es_point_resolve_fn resolve,
+                                      void *ud, const es_mesh *mesh, double *lengths,
+                                      double *scale, double *w);
+
+/* A point's leaves kept for an embedding session (embed_leaves.c): the
+ * leaves read from stored results (means, components, differences,
+ * coefficients) resolved once and then copied, while the store's
+ * generation is the one they were read at. Files and rows are read each
+ * time (a file can change; a row is one read). */
+typedef struct es__leaf_cache es__leaf_cache;
+es_status es__leaf_cache_new(es_ctx *ctx, es_store *store, const es_mesh *mesh,
+                            es__leaf_cache **out);
+void es__leaf_cache_free(es__leaf_cache *c);
+/* Point the cache at the PCA that pc:K leaves name (NULL: the default one)
+ * and drop what the store's writes since have made stale; call before each
+ * evaluation. */
+es_status es__leaf_cache_ready(es__leaf_cache *c, const char *pca_name);
+/* The es_point_resolve_fn; userdata: the cache. */
+es_status es__leaf_cache_resolve(es_ctx *ctx, void *ud, es_point_leaf kind, const char *arg,
+                                 int64_t index, double *vec, double *scale, double *w);
+
 /* ---- embeddings and interpolation by the other papers' methods ------------ */
 
 /* Store a mesh result as /analysis/embed/<name> (what es_study_store_embedding

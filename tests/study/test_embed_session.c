@@ -204,6 +204,42 @@ int main(void)
         es_study_embedder_free(se);
         free(walk);
     }
+    {   /* the session keeps a point's leaves (embed_leaves.c): its embedding of an
+         * expression is the one of the lengths, scale and row weights that
+         * es_study_point_weights reads afresh from the store (the oracle), on every
+         * repeat (leaves from the cache), and after the PCA is replaced through the
+         * handle (the store's generation drops the kept leaves) */
+        es_study_embedder *se = NULL;
+        es_study_embed_result r;
+        int64_t ne = es_store_nedges(s), N = es_store_nrows(s);
+        double *l0 = malloc((size_t)(ne + N) * sizeof *l0), *w0 = l0 + ne, sc;
+        const char *pt = "mean + 1.5*pc:2 - 0.5*pc:1";
+        ES_CHECK_OK(ctx, es_study_embedder_open(ctx, s, 1, &se));
+        for (int pca = 0; pca < 2; pca++) {
+            uint64_t gen = es_store_generation(s);
+            ES_CHECK_OK(ctx, es_study_point_weights(ctx, s, pt, "p", l0, &sc, w0));
+            ES_CHECK_OK(ctx, es_study_embedder_solve(ctx, se, l0, sc, w0, NULL, 0, 0, ref, &r));
+            for (int pass = 0; pass < 3; pass++) {
+                ES_CHECK_OK(ctx, es_study_embedder_point(ctx, se, pt, "p", 0, NULL, 0, got, &r));
+                ES_CHECK(same(ref, got, n3));
+            }
+            ES_CHECK(es_store_generation(s) == gen);   /* reading writes nothing */
+            if (pca == 0) {   /* the PCA replaced (of the neutral rows, 3 components) */
+                memcpy(got + n3, ref, (size_t)n3 * sizeof *ref);
+                ES_CHECK_OK(ctx, es_store_delete_result(ctx, s, "pca", "p"));
+                po.ncomp = 3;
+                ES_CHECK_OK(ctx, es_study_pca(ctx, s, "p", "expression=neutral", &po, "test", NULL,
+                                              NULL, NULL));
+                ES_CHECK(es_store_generation(s) != gen);
+            } else {
+                ES_CHECK(!same(got + n3, got, n3));   /* not the old PCA's point */
+            }
+        }
+        es_study_embedder_free(se);
+        free(l0);
+        es_store_abort(s);   /* the replaced PCA is not kept */
+        s = NULL;
+    }
     es_store_close(s);
     free(ref), free(got);
     es_ctx_free(ctx);

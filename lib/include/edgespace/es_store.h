@@ -95,6 +95,12 @@ ES_API void es_store_close(es_store *store);
 /* Close, discarding every uncommitted write. NULL: no-op. */
 ES_API void es_store_abort(es_store *store);
 
+/* A number that changes whenever this handle starts a write (rows,
+ * results, attributes, deletions): a cache of values read through the
+ * handle is current while the number it was made at is. Other handles' and
+ * other processes' writes are not counted (a handle reads the file it
+ * opened). */
+ES_API uint64_t es_store_generation(const es_store *store);
 ES_API int64_t es_store_nrows(const es_store *store);
 ES_API int64_t es_store_nedges(const es_store *store);
 ES_API int64_t es_store_nverts(const es_store *store);

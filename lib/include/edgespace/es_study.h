@@ -412,8 +412,12 @@ typedef struct es_study_embed_result {
  * (a read-only folder) only costs the time, and the log says so. The
  * session borrows the store (it must outlive the session) and remembers its
  * last output: a warm embedding starts from it instead of the prior's
- * realization (a walk's next frame, a slider's next position). One thread
- * at a time. */
+ * realization (a walk's next frame, a slider's next position). The leaves
+ * of its points read from stored results (means, pc:K, differences,
+ * coefficients) are kept and reused until the store handle writes anything
+ * (es_store_generation): a slider's "mean + t*pc:1" reads the store once.
+ * Results written by another process after the handle opened are not seen,
+ * as with any read through it. One thread at a time. */
 typedef struct es_study_embedder es_study_embedder;
 ES_API es_status es_study_embedder_open(es_ctx *ctx, es_store *store, int use_cache,
                                         es_study_embedder **out);
