@@ -438,6 +438,17 @@ class Store:
         self.ctx.call(lib.es_store_get_ints, self.ptr, _s(path), v, n)
         return A.view(v[0], (n[0],), A.Freed(self.ctx, v[0]), "i8")
 
+    def get_strings(self, path):
+        """A stored 1-D string dataset "<kind>/<name>/<dataset>" as a list of str."""
+        v, n = ffi.new("char ***"), ffi.new("int64_t *")
+        self.ctx.call(lib.es_store_get_strings, self.ptr, _s(path), v, n)
+        out = []
+        for i in range(n[0]):
+            out.append(A.string(v[0][i]))
+            lib.es_free(self.ctx.ptr, v[0][i])
+        lib.es_free(self.ctx.ptr, v[0])
+        return out
+
     def get_attr(self, path, key):
         buf = ffi.new("char[]", 4096)
         self.ctx.call(lib.es_store_get_attr, self.ptr, _s(path), _s(key), buf, 4096)
