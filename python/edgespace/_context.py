@@ -27,18 +27,29 @@ class EdgespaceWarning(UserWarning):
     """A warning logged by libedgespace (es__warn)."""
 
 
+def _in_kernel():
+    """True in a Jupyter kernel (an IPython shell with a kernel). Not "is
+    ipykernel imported": ipywidgets imports it in any process."""
+    ip = sys.modules.get("IPython")
+    shell = ip.get_ipython() if ip is not None and hasattr(ip, "get_ipython") else None
+    return getattr(shell, "kernel", None) is not None
+
+
 def _tqdm():
     """tqdm's bar class for where we run: widgets in a Jupyter kernel that has
-    ipywidgets, text on a terminal; None where neither would read well (a
-    kernel without widgets, where text bars leave blank lines) or without
-    tqdm."""
+    ipywidgets 7 or later (tqdm.notebook's need: with Debian 12's ipywidgets
+    6 its bars raise AttributeError), text elsewhere; None where neither
+    would read well (a kernel without those widgets, where text bars leave
+    blank lines) or without tqdm."""
     try:
-        if "ipykernel" in sys.modules:
-            import ipywidgets  # noqa: F401
+        if _in_kernel():
+            import ipywidgets
+            if int(ipywidgets.__version__.split(".")[0]) < 7:
+                return None
             from tqdm.notebook import tqdm
         else:
             from tqdm.std import tqdm
-    except ImportError:
+    except (ImportError, ValueError):
         return None
     return tqdm
 
