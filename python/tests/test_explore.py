@@ -1,0 +1,527 @@
+"""edgespace explore: the explorer's computations (edgespace/explore/core.py),
+its server as `edgespace explore` starts it (security, bad requests,
+concurrent clients), and the page driven in headless Chromium.
+
+Oracles: `edgespace embed` (the command) of the point the page shows, with
+the explorer's options, to 1e-9 of the bounding-box diagonal; the library's
+own evaluation of the point expression (es_study_point_weights); numpy
+edge lengths; h5py for what a save stores; Chromium (python3-selenium and
+chromium-driver) as the client of the page, without a display."""
+import asyncio
+import base64
+import hashlib
+import http.client
+import json
+import os
+import re
+import shutil
+import signal
+import subprocess
+import time
+
+import h5py
+import numpy as np
+import pytest
+
+import edgespace as es
+
+pytest.importorskip("aiohttp")
+from edgespace.explore import Explorer, RequestError   # noqa: E402 (needs aiohttp)
+
+from conftest import cli_path   # noqa: E402
+
+URL_RE = re.compile(r"^(http://127\.0\.0\.1:(\d+)/\?token=([A-Za-z0-9_-]+))$", re.M)
+
+
+@pytest.fixture(scope="module")
+def study(base_store, tmp_path_factory):
+    """The synthetic faces with a PCA, a paired difference and a model."""
+    path = tmp_path_factory.mktemp("explore") / "faces.h5"
+    shutil.copyfile(base_store, path)
+    with es.Store(path, write=True, ctx=es.Context(progress=None)) as s:
+        s.pca("p", ncomp=4)
+        s.diff("smile", key="subject", column="expression", from_="neutral", to="happy")
+        s.model("~ expression", name="m", permutations=0)
+    return path
+
+
+@pytest.fixture(scope="module")
+def cold(study):
+    """An explorer as `edgespace explore --cold` makes it."""
+    ex = Explorer(study, pca="p", warm=False)
+    yield ex
+    ex.close()
+
+
+def cli_embed(store, expr, out, fast=True):
+    """`edgespace embed` of a point, not stored: its positions (V, 3)."""
+    args = [cli_path(), "embed", str(store), "--pca", "p", "--point", expr, "-o", str(out),
+            "--no-store"] + (["--fast"] if fast else [])
+    r = subprocess.run(args, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    with es.Store(store) as s:
+        return s.mesh.read_positions(out)
+
+
+def bbox(V):
+    return float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
+
+
+# -- the computations --------------------------------------------------------------
+def test_the_sliders_are_the_stores_directions(cold):
+    keys = [d.key for d in cold.directions]
+    assert keys == ["pc1", "pc2", "pc3", "pc4", "diff:smile", "coef:m:expression=happy",
+                    "coef:m:expression=neutral"]
+    d = cold.by_key["coef:m:expression=happy"]
+    assert 1.0 < d.hi < 1.5 and d.lo == -d.hi      # 3 sd of a 0/1 column with 6 of 18 ones
+    assert cold.default_color_column() == "expression"
+    info = cold.describe()
+    assert len(info["rows"]["ids"]) == 18 and len(info["rows"]["scores"][0]) == 4
+    # scores in sd: each column's sample variance is 1
+    z = np.array(info["rows"]["scores"])
+    assert np.allclose(z.var(axis=0, ddof=1), 1.0, rtol=1e-9)
+
+
+def test_a_position_is_the_point_its_expression_names(cold, study):
+    c = cold.coordinates({"pc1": 1.5, "pc3": -0.25, "diff:smile": 0.5,
+                          "coef:m:expression=happy": 0.7, "pc2": 0})
+    expr = cold.point_expression(c)
+    assert expr == ("mean + 1.5*pc:1 - 0.25*pc:3 + 0.5*diff:smile "
+                    "+ 0.7*coef:m:expression=happy")
+    L, w = cold._lengths(c)
+    with es.Store(study) as s:       # the library's evaluation of the text
+        pt = s.point_weights(expr, pca="p")
+    assert np.max(np.abs(L - pt.lengths)) <= 1e-13 * np.max(pt.lengths)
+    assert np.max(np.abs(w - pt.weights)) <= 1e-13 * np.max(np.abs(pt.weights))
+    assert pt.scale == cold.scale0
+
+
+def test_a_cold_position_is_edgespace_embed_of_its_expression(cold, study, tmp_path):
+    shape = cold.embed({"pc1": 1.25, "diff:smile": -0.5})
+    V = cli_embed(study, shape.expr, tmp_path / "cli.ply")
+    assert np.max(np.abs(shape.V - V)) <= 1e-9 * bbox(V)
+    assert shape.report["rms_ratio"] < 2e-3 and shape.realizability() is None
+    assert np.all(shape.heat["displacement"] >= 0) and shape.heat["displacement"].max() > 0
+
+
+def test_warm_positions_realize_their_lengths_near_the_cold_ones(study):
+    ex = Explorer(study, pca="p")
+    try:
+        E = ex.store.edges
+        for t in np.linspace(-2, 2, 9):
+            shape = ex.embed({"pc1": float(t)})
+            L, _ = ex._lengths(shape.t)
+            got = np.linalg.norm(shape.V[E[:, 0]] - shape.V[E[:, 1]], axis=1)
+            want = L * ex.scale0
+            rms = np.sqrt(np.mean((got - want) ** 2)) / want.mean()
+            # the report tells the truth; the slider accuracy (es_embed_opts_fast: 30
+            # local-global iterations) leaves up to 0.3 % here at +-2 sd
+            assert np.isclose(rms, shape.report["rms_ratio"], rtol=1e-6) and rms < 5e-3
+        assert "last output" in shape.report["init"]
+    finally:
+        ex.close()
+    with es.Store(study) as s:
+        cold_V = s.embedder().embed(shape.expr, pca="p", warm=False, fast=True).V
+    assert np.sqrt(np.mean(np.sum((shape.V - cold_V) ** 2, axis=1))) < 0.01 * bbox(cold_V)
+
+
+def test_a_point_that_breaks_the_triangle_inequality_is_flagged(cold):
+    shape = cold.embed({"pc1": 3})      # on these faces: 5 faces broken
+    r = shape.report
+    assert r["n_bad_faces"] > 0 and r["n_projected"] > 0
+    assert shape.realizability().startswith(f"not realizable: {r['n_bad_faces']} faces break")
+
+
+def test_a_row_is_its_own_mesh_with_its_scores(cold, study):
+    shape = cold.row_shape("face_s03_angry")
+    assert shape.expr == "row:face_s03_angry" and shape.report is None
+    with es.Store(study) as s:
+        i = s.find_row("face_s03_angry")
+        E = s.edges
+        want = s.lengths(i)[0] * s.scales()[i]
+        pca = s.load_pca("p")
+    got = np.linalg.norm(shape.V[E[:, 0]] - shape.V[E[:, 1]], axis=1)
+    assert np.allclose(got, want, rtol=1e-9)          # the row, moved rigidly
+    j = list(pca.rows).index(i)
+    assert np.isclose(shape.t["pc2"], pca.scores[j, 1] / np.sqrt(pca.eigenvalues[1]))
+
+
+@pytest.mark.parametrize("coords, message", [
+    ({"pc9": 1}, "no slider 'pc9'"),
+    ({"diff:smiel": 1}, "did you mean diff:smile"),
+    ({"pc1": "abc"}, "'abc' is not a number"),
+    ({"pc1": "NaN"}, "'NaN' is not a number"),
+    ({"pc1": True}, "is not a number"),
+    ({"pc1": float("nan")}, "outside what can be explored"),
+    ({"pc1": 1e300}, "outside what can be explored (|t| <= 30 sd)"),
+    ({"pc1": -31}, "outside"),
+    ({"diff:smile": 15}, "this position has"),          # lengths <= 0
+    ([1, 2], "coordinates must be an object"),
+])
+def test_bad_positions_are_refused_with_a_message(cold, coords, message):
+    with pytest.raises(RequestError) as e:
+        cold.embed(coords)
+    assert message in str(e.value)
+    assert cold.embed({"pc1": 0.5}).expr == "mean + 0.5*pc:1"   # and it goes on
+
+
+def test_saving_writes_a_mesh_and_a_point_and_nothing_else(study, tmp_path):
+    store = tmp_path / "faces.h5"
+    shutil.copyfile(study, store)
+    digest = hashlib.sha256(store.read_bytes()).hexdigest()
+    ex = Explorer(store, pca="p", warm=False)
+    try:
+        shape = ex.embed({"pc2": -1.0, "diff:smile": 0.75})
+        # exploring never writes the store (opened read-only)
+        assert hashlib.sha256(store.read_bytes()).hexdigest() == digest
+        for bad in ("../x", "", ".hidden", "a/b", "x" * 65, None):
+            with pytest.raises(RequestError, match="a name is"):
+                ex.save(bad, shape)
+        with pytest.raises(RequestError, match="format"):
+            ex.save("ok", shape, fmt="stl")
+        out = ex.save("smile_ish", shape, fmt="ply")
+        assert out["path"] == str(tmp_path / "smile_ish.ply")
+        with es.Store(store) as s:
+            assert np.array_equal(s.mesh.read_positions(out["path"]), shape.V)
+            pt = s.point_weights(shape.expr, pca="p")
+        with h5py.File(store, "r") as f:
+            g = f["analysis/point/smile_ish"]
+            assert np.array_equal(g["lengths"][()], pt.lengths)
+            assert g.attrs["expression"] in (shape.expr, shape.expr.encode())
+        # a second save of that name: refused, nothing written
+        digest = hashlib.sha256(store.read_bytes()).hexdigest()
+        with pytest.raises(RequestError, match="exists"):
+            ex.save("smile_ish", shape, fmt="ply")
+        with pytest.raises(RequestError, match="point/smile_ish"):
+            ex.save("smile_ish", shape, fmt="obj")       # the file is new, the point is not
+        assert not (tmp_path / "smile_ish.obj").exists()
+        assert hashlib.sha256(store.read_bytes()).hexdigest() == digest
+        png = ex.save_png("view", b"\x89PNG\r\n\x1a\n")
+        assert os.path.exists(png) and ex.saved["view.png"] == png
+    finally:
+        ex.close()
+
+
+# -- the server, as the command starts it ------------------------------------------------
+class Server:
+    """`edgespace explore STORE ARGS...` in a subprocess, until stop()."""
+
+    def __init__(self, store, *args):
+        self.proc = subprocess.Popen([cli_path(), "explore", str(store), *args],
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        out = ""
+        deadline = time.time() + 60
+        while time.time() < deadline:
+            line = self.proc.stdout.readline()
+            if not line:
+                break
+            out += line
+            m = URL_RE.search(out)
+            if m:
+                self.url, self.port, self.token = m.group(1), int(m.group(2)), m.group(3)
+                return
+        self.proc.kill()
+        raise AssertionError(f"edgespace explore printed no URL:\n{out}\n{self.proc.stderr.read()}")
+
+    def get(self, path, headers=None, token=True):
+        c = http.client.HTTPConnection("127.0.0.1", self.port, timeout=30)
+        h = dict(headers or {})
+        if token:
+            h["X-Edgespace-Token"] = self.token
+        c.request("GET", path, headers=h)
+        r = c.getresponse()
+        body = r.read()
+        c.close()
+        return r.status, body
+
+    def stop(self):
+        self.proc.send_signal(signal.SIGTERM)
+        try:
+            rc = self.proc.wait(30)
+        finally:
+            if self.proc.poll() is None:
+                self.proc.kill()
+        err = self.proc.stderr.read()
+        self.proc.stdout.close()
+        self.proc.stderr.close()
+        return rc, err
+
+
+@pytest.fixture(scope="module")
+def server(study):
+    s = Server(study, "--pca", "p", "--cold")
+    yield s
+    rc, err = s.stop()
+    assert rc == 0, err
+
+
+def test_the_command_checks_its_options(study):
+    r = subprocess.run([cli_path(), "explore", "--help"], capture_output=True, text=True)
+    assert r.returncode == 0 and "127.0.0.1" in r.stdout and "--port" in r.stdout
+    for args in ([], ["a.h5", "b.h5"], [str(study), "--port", "70000"],
+                 [str(study), "--port", "x"]):
+        r = subprocess.run([cli_path(), "explore", *args], capture_output=True, text=True)
+        assert r.returncode == 2, args
+    r = subprocess.run([cli_path(), "explore", str(study) + ".missing"], capture_output=True,
+                       text=True, timeout=60)
+    assert r.returncode == 1 and "cannot open" in r.stderr
+
+
+def test_every_request_needs_the_token_and_this_host(server):
+    assert server.get("/?token=" + server.token, token=False)[0] == 200
+    assert server.get("/", token=False)[0] == 403
+    assert server.get("/?token=wrong", token=False)[0] == 403
+    assert server.get("/api/info", headers={"X-Edgespace-Token": "x" * 32}, token=False)[0] == 403
+    # DNS rebinding: a page of another site that resolves to 127.0.0.1
+    status, body = server.get("/api/info", headers={"Host": f"evil.example:{server.port}"})
+    assert status == 403 and b"Host" in body
+    status, body = server.get("/api/info")
+    info = json.loads(body)
+    assert status == 200 and info["pca"] == "p" and info["nverts"] == 780 and not info["warm"]
+
+
+def test_no_file_but_the_pages_and_three_js_is_served(server, study):
+    assert server.get("/static/explore.js")[0] == 200
+    assert server.get("/vendor/three/build/three.module.js")[0] in (200, 404)   # 404: no npm
+    for path in ("/static/core.py", "/static/..%2fcore.py", "/vendor/three/package.json",
+                 "/vendor/three/../../core.py", "/vendor/three/build/%2e%2e/package.json",
+                 "/vendor/three/%2e%2e/%2e%2e/%2e%2e/__init__.py", "/files/faces.h5",
+                 "/files/..%2ffaces.h5", "/etc/passwd", "/api/../../etc/passwd"):
+        status, _ = server.get(path)
+        assert status in (403, 404), path
+
+
+async def _socket(server, session, **kw):
+    return await session.ws_connect(f"ws://127.0.0.1:{server.port}/ws?token={server.token}",
+                                    **kw)
+
+
+async def _answer(ws, seq, timeout=60):
+    """The message answering request seq (a shape header, error or saved)."""
+    while True:
+        msg = await asyncio.wait_for(ws.receive(), timeout)
+        if msg.type.name == "BINARY":
+            n = int.from_bytes(msg.data[:4], "little")
+            hdr = json.loads(msg.data[4:4 + n])
+            hdr["V"] = np.frombuffer(msg.data, "<f8", 3 * hdr["nverts"], 4 + n).reshape(-1, 3)
+        elif msg.type.name == "TEXT":
+            hdr = json.loads(msg.data)
+        else:
+            return {"op": msg.type.name.lower(), "code": ws.close_code}
+        if hdr.get("seq") == seq or (hdr["op"] == "error" and hdr.get("seq") is None):
+            return hdr
+
+
+def test_bad_requests_are_answered_with_errors_and_the_server_goes_on(server):
+    import aiohttp
+
+    async def run():
+        async with aiohttp.ClientSession() as session:
+            ws = await _socket(server, session)
+            cases = [("{not json", None, "not JSON"), ("[1]", None, "a JSON object"),
+                     ('{"op": "fly", "seq": 1}', 1, "unknown request 'fly'"),
+                     ('{"op": "embed", "seq": 2, "coords": {"pc7": 1}}', 2, "no slider 'pc7'"),
+                     ('{"op": "embed", "seq": 3, "coords": {"pc1": "1.5x"}}', 3, "not a number"),
+                     ('{"op": "embed", "seq": 4, "coords": {"pc1": NaN}}', 4, "not a number"),
+                     ('{"op": "embed", "seq": 5, "coords": {"pc1": 1e308}}', 5, "outside"),
+                     ('{"op": "row", "seq": 6, "id": "face_s99_happy"}', 6, "no row"),
+                     ('{"op": "save", "seq": 7, "shape": 99, "name": "x"}', 7, "save again"),
+                     ('{"op": "embed", "seq": "8"}', None, "seq must be an integer")]
+            for text, seq, message in cases:
+                await ws.send_str(text)
+                a = await _answer(ws, seq)
+                assert a["op"] == "error" and message in a["message"], (text, a)
+            await ws.send_str('{"op": "embed", "seq": 9, "coords": {"pc1": 0.5}}')
+            a = await _answer(ws, 9)
+            assert a["op"] == "shape" and a["expr"] == "mean + 0.5*pc:1"
+            # a message over the size bound closes that socket (1009), nothing else
+            await ws.send_str(json.dumps({"op": "embed", "seq": 10, "pad": "x" * 70000}))
+            a = await _answer(ws, 10)
+            assert a["op"] in ("close", "closed", "closing") and a["code"] == 1009
+            ws2 = await _socket(server, session)
+            await ws2.send_str('{"op": "embed", "seq": 1, "coords": {"pc2": -1}}')
+            assert (await _answer(ws2, 1))["op"] == "shape"
+            await ws2.close()
+            # a socket opened from another site's page
+            with pytest.raises(aiohttp.WSServerHandshakeError):
+                await _socket(server, session, headers={"Origin": "http://evil.example"})
+    asyncio.run(run())
+
+
+def test_concurrent_clients_each_get_their_newest_position(server):
+    import aiohttp
+
+    async def client(session, k):
+        ws = await _socket(server, session)
+        last = None
+        for i in range(6):       # faster than the embeddings: older ones are superseded
+            last = {"op": "embed", "seq": i + 1, "coords": {"pc1": 0.1 * k + 0.05 * i}}
+            await ws.send_str(json.dumps(last))
+        answers = []
+        while True:
+            msg = await asyncio.wait_for(ws.receive(), 60)
+            if msg.type.name == "BINARY":
+                n = int.from_bytes(msg.data[:4], "little")
+                a = json.loads(msg.data[4:4 + n])
+            else:
+                a = json.loads(msg.data)
+            answers.append(a)
+            if a.get("seq") == 6 and a["op"] != "superseded":
+                break
+        await ws.close()
+        return last, answers
+
+    async def run():
+        async with aiohttp.ClientSession() as session:
+            results = await asyncio.gather(*(client(session, k) for k in range(3)))
+            # more pages than the server keeps open: told so, not crashed
+            socks = [await _socket(server, session) for _ in range(8)]
+            extra = await _socket(server, session)
+            msg = json.loads((await asyncio.wait_for(extra.receive(), 30)).data)
+            assert msg["op"] == "error" and "pages are open" in msg["message"]
+            for s in socks:
+                await s.close()
+            await extra.close()
+            return results
+    for k, (last, answers) in enumerate(asyncio.run(run())):
+        final = answers[-1]
+        assert final["op"] == "shape", answers
+        assert final["t"] == {"pc1": last["coords"]["pc1"]} or final["t"] == {}
+        seqs = [a["seq"] for a in answers]
+        assert sorted(seqs) == list(range(1, 7)), seqs      # every request answered once
+        assert any(a["op"] == "superseded" for a in answers) or len(answers) == 6
+
+
+# -- the page, in Chromium -----------------------------------------------------------------
+def chromium():
+    """A headless Chromium driven by selenium (python3-selenium,
+    chromium-driver), or a skip naming what is missing."""
+    webdriver = pytest.importorskip("selenium.webdriver")
+    from selenium.webdriver.chrome.service import Service
+    driver = shutil.which("chromedriver")
+    if not driver or not shutil.which("chromium"):
+        pytest.skip("chromium and chromium-driver are not installed (tools/setup.sh)")
+    o = webdriver.ChromeOptions()
+    for a in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage",
+              "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+              "--window-size=1400,900", "--disable-gpu-sandbox"):
+        o.add_argument(a)
+    o.binary_location = shutil.which("chromium")
+    return webdriver.Chrome(service=Service(driver), options=o)
+
+
+def wait_for(driver, script, timeout=60, what=""):
+    deadline = time.time() + timeout
+    while time.time() < deadline:
+        v = driver.execute_script(script)
+        if v:
+            return v
+        time.sleep(0.05)
+    errors = driver.execute_script("return window.esExplorer && window.esExplorer.errors")
+    raise AssertionError(f"timed out waiting for {what or script} (errors: {errors})")
+
+
+SETTLED = """const x = window.esExplorer; if (!x || !x.last) return false;
+const t = x.timings; const seq = x.state.seq;
+return x.last.seq === seq || (t.length && t[t.length - 1].error) ? x.last.seq : false;"""
+
+
+def screenshot_dir(tmp_path):
+    d = os.environ.get("EDGESPACE_SCREENSHOTS")
+    if d:
+        os.makedirs(d, exist_ok=True)
+        return d
+    return str(tmp_path)
+
+
+def test_the_page_in_chromium(study, tmp_path):
+    if not os.path.isfile(os.path.join(os.path.dirname(es.__file__), "explore", "web",
+                                       "node_modules", "three", "build", "three.module.js")):
+        pytest.skip("three.js is not installed (tools/setup.sh: npm ci)")
+    store = tmp_path / "faces.h5"
+    shutil.copyfile(study, store)
+    srv = Server(store, "--pca", "p", "--cold")
+    d = None
+    try:
+        d = chromium()
+        d.get(srv.url)
+        wait_for(d, SETTLED, what="the mean's mesh")
+        assert d.execute_script("return window.esExplorer.errors") == []
+        from selenium.webdriver.common.action_chains import ActionChains
+        from selenium.webdriver.common.by import By
+        from selenium.webdriver.common.keys import Keys
+        # drag PC 1's slider as a user does: press on it, move right, let go
+        rng = d.find_element(By.ID, "s-pc1")
+        ActionChains(d).click_and_hold(rng).move_by_offset(25, 0).pause(0.2) \
+            .move_by_offset(20, 0).release().perform()
+        seq = wait_for(d, SETTLED, what="the dragged position's mesh")
+        assert seq > 1
+        expr = d.execute_script("return window.esExplorer.last.expr")
+        assert re.fullmatch(r"mean \+ [0-9.]+\*pc:1", expr), expr
+        assert d.find_element(By.ID, "expr").get_attribute("value") == expr
+        assert expr in d.find_element(By.ID, "cmd").text
+        got = np.array(d.execute_script("return Array.from(window.esExplorer.last.positions)"))
+        V = cli_embed(store, expr, tmp_path / "cli.ply").reshape(-1)
+        assert got.shape == V.shape and np.max(np.abs(got - V)) <= 1e-9 * bbox(V.reshape(-1, 3))
+        # the heat map and its colour bar; the mesh is drawn (not a blank canvas)
+        d.execute_script("const h = document.getElementById('heat'); h.value = 'displacement';"
+                         "h.dispatchEvent(new Event('change'));")
+        assert d.find_element(By.ID, "colorbar").is_displayed()
+        drawn = d.execute_script("""const c = document.querySelector('#canvas-box canvas');
+            const g = document.createElement('canvas'); g.width = c.width; g.height = c.height;
+            const x = g.getContext('2d'); x.drawImage(c, 0, 0);
+            const p = x.getImageData(0, 0, c.width, c.height).data; let n = 0;
+            for (let i = 0; i < p.length; i += 4) if (p[i] < 200 || p[i + 2] < 200) n++;
+            return n / (p.length / 4);""")
+        assert drawn > 0.05, drawn
+        shots = screenshot_dir(tmp_path)
+        d.save_screenshot(os.path.join(shots, "explore_page.png"))
+        png = d.execute_script("return window.esExplorer.png()")
+        raw = base64.b64decode(png.split(",", 1)[1])
+        assert png.startswith("data:image/png;base64,") and raw[:8] == b"\x89PNG\r\n\x1a\n"
+        with open(os.path.join(shots, "explore_view.png"), "wb") as f:
+            f.write(raw)
+        # a point that is not realizable: the warning
+        d.execute_script("window.esExplorer.setSlider('pc1', 3)")
+        wait_for(d, SETTLED, what="pc1 = 3")
+        warning = d.find_element(By.ID, "warning")
+        assert warning.is_displayed() and "triangle inequality" in warning.text
+        d.save_screenshot(os.path.join(shots, "explore_warning.png"))
+        # bad input typed or sent: an error in the page, and the page goes on
+        box = d.find_element(By.ID, "t-pc2")
+        for typed, message in (("abc", "'abc' is not a number"), ("1e300", "outside")):
+            box.clear()
+            box.send_keys(typed, Keys.ENTER)
+            wait_for(d, f"return document.getElementById('error').textContent.includes("
+                        f"{json.dumps(message)}) && !document.getElementById('error').hidden",
+                     what=message)
+        d.execute_script("window.esExplorer.send({op: 'embed', coords: {pc42: 1}})")
+        wait_for(d, "return document.getElementById('error').textContent.includes("
+                    "\"no slider 'pc42'\")", what="unknown PC")
+        d.save_screenshot(os.path.join(shots, "explore_error.png"))
+        # a click on a row of the scatter: its mesh, its scores on the sliders
+        d.find_element(By.CSS_SELECTOR, "#scatter circle[data-row='face_s02_angry']").click()
+        wait_for(d, "return window.esExplorer.last && window.esExplorer.last.row === "
+                    "'face_s02_angry'", what="the row's mesh")
+        assert d.find_element(By.ID, "expr").get_attribute("value") == "row:face_s02_angry"
+        assert d.find_element(By.ID, "error").get_attribute("hidden")
+        # save this shape: the mesh beside the store, the point in it
+        d.find_element(By.ID, "save-name").send_keys("angry2")
+        d.find_element(By.ID, "save").click()
+        wait_for(d, "return window.esExplorer.state.saved.length === 1", what="the save")
+        got = np.array(d.execute_script("return Array.from(window.esExplorer.last.positions)"))
+        with es.Store(store) as s:
+            assert np.array_equal(s.mesh.read_positions(tmp_path / "angry2.ply").reshape(-1),
+                                  got)
+            assert "angry2" in s.results("point")
+        href = d.find_element(By.CSS_SELECTOR, "#saved a").get_attribute("href")
+        status, body = srv.get("/" + href.split("/", 3)[3])
+        assert status == 200 and body.startswith(b"ply")
+        d.find_element(By.ID, "save").click()       # the same name again: refused
+        wait_for(d, "return document.getElementById('error').textContent.includes('exists')",
+                 what="the refusal")
+    finally:
+        if d is not None:
+            d.quit()
+        rc, err = srv.stop()
+    assert rc == 0, err
