@@ -525,3 +525,34 @@ def test_the_page_in_chromium(study, tmp_path):
             d.quit()
         rc, err = srv.stop()
     assert rc == 0, err
+
+
+def test_face_study_with_every_kind_of_slider(tmp_path):
+    """Real data when ../shared has it: face-study (9.4K vertices) with a PCA,
+    a smile and a model of expression and subject, whose subject
+    coefficients are directions so large that mean + 1*coef has negative
+    lengths (the explorer evaluates directions without that check); a
+    position of each kind is edgespace embed's."""
+    from conftest import SOURCE_ROOT
+    shared = os.environ.get("EDGESPACE_SHARED", os.path.join(SOURCE_ROOT, "..", "shared"))
+    data = os.path.join(shared, "data", "face-study")
+    if not os.path.isdir(data):
+        pytest.skip(f"no face-study at {data}")
+    store = tmp_path / "face.h5"
+    ctx = es.Context(progress=None)
+    es.ingest(store, manifest=os.path.join(data, "manifest.csv"), ctx=ctx)
+    with es.Store(store, write=True, ctx=ctx) as s:
+        s.pca("p", ncomp=5)
+        s.diff("smile", key="subject", column="expression", from_="neutral", to="happy")
+        s.model("~ expression + subject", name="es", permutations=0)
+    ex = Explorer(store, pca="p", warm=False)
+    try:
+        keys = [d.key for d in ex.directions]
+        assert keys[:6] == ["pc1", "pc2", "pc3", "pc4", "pc5", "diff:smile"]
+        assert "coef:es:expression=happy" in keys and "coef:es:subject=s030" in keys
+        shape = ex.embed({"pc1": -1.5, "pc3": 0.75, "coef:es:expression=happy": 0.5,
+                          "coef:es:subject=s002": 0.25})
+    finally:
+        ex.close()
+    V = cli_embed(store, shape.expr, tmp_path / "cli.ply")
+    assert np.max(np.abs(shape.V - V)) <= 1e-9 * bbox(V)

@@ -12,7 +12,7 @@ as the point syntax reads it), stored paired differences (`diff:NAME`) and
 the coefficients of stored linear models in edge-length space
 (`coef:MODEL:COEF`). Every point is a combination of stored rows, and so is
 each direction: the mean's and each direction's lengths and row weights are
-evaluated once, by the library (es_study_point_weights of "MEAN" and of
+evaluated once, by the library (es_study_point of "MEAN" and of
 "MEAN + 1*TERM", the direction being their difference, so that a direction
 is exactly what the point syntax means by its leaf), and a position's
 lengths and weights are then sums of arrays, solved directly
@@ -85,7 +85,9 @@ class Direction:
 class Shape:
     """A mesh the explorer shows: positions V (V, 3), the point expression,
     the embedding report (None for a row's own mesh), per-vertex heat maps
-    {name: (V,) array} and the seconds the computation took."""
+    {name: (V,) array}, and the seconds the computation took on the clock
+    and of the computing thread's CPU (on a busy machine the first is the
+    larger)."""
     V: np.ndarray
     expr: str
     t: dict
@@ -93,6 +95,7 @@ class Shape:
     heat: dict
     seconds: float
     row: str = None
+    cpu_seconds: float = 0.0
 
     def realizability(self):
         """None, or the warning the page shows: the point's lengths break the
@@ -202,12 +205,15 @@ class Explorer:
         self.columns = [c for c in s.columns]
         self.labels = {c: list(s.label(c)) for c in self.columns}
         self._log("evaluating the mean and the directions")
-        base = s.point_weights(self.mean_expr, pca=self.pca_name)
+        # es_study_point (Store.point, not stored) rather than _weights: it
+        # evaluates "mean + 1*TERM" even where a large direction (a subject's
+        # coefficient) makes lengths negative, which a point to embed may not
+        base = s.point(self.mean_expr, pca=self.pca_name)
         self.L0, self.w0, self.scale0 = base.lengths, base.weights, base.scale
         self.directions = self._pc_directions() + self._diff_directions() + \
             self._coef_directions()
         for d in self.directions:
-            p = s.point_weights(f"{self.mean_expr} + 1*{d.term}", pca=self.pca_name)
+            p = s.point(f"{self.mean_expr} + 1*{d.term}", pca=self.pca_name)
             d.dL, d.dw = p.lengths - self.L0, p.weights - self.w0
         self.by_key = {d.key: d for d in self.directions}
         self._log("opening the embedding session")
@@ -364,7 +370,7 @@ class Explorer:
 
     # -- shapes ----------------------------------------------------------------
     def _solve(self, coords, warm):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.thread_time()
         L, w = self._lengths(coords)
         bad = np.flatnonzero(~(L > 0))
         if bad.size:
@@ -376,7 +382,7 @@ class Explorer:
                 "displacement": np.zeros(emb.V.shape[0]) if self.mean_V is None else
                 np.linalg.norm(emb.V - self.mean_V, axis=1)}
         return Shape(emb.V, self.point_expression(coords), dict(coords), emb.report, heat,
-                     time.perf_counter() - t0)
+                     time.perf_counter() - t0, cpu_seconds=time.thread_time() - c0)
 
     def embed(self, coords):
         """The Shape of a slider position (coordinates as coordinates() takes
@@ -398,7 +404,7 @@ class Explorer:
             raise RequestError(f"no row '{str(row_id)[:80]}'{hint}")
         i = self.row_index[row_id]
         with self._lock:
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.thread_time()
             w = np.zeros(len(self.ids))
             w[i] = 1.0
             V = self.session.prior_positions(w)
@@ -413,7 +419,7 @@ class Explorer:
                     t[d.key] = float(self.pca.scores[j, k] / sd[k])
         heat = {"displacement": np.linalg.norm(V - self.mean_V, axis=1)}
         return Shape(V, f"row:{quote_word(row_id)}", t, None, heat,
-                     time.perf_counter() - t0, row=row_id)
+                     time.perf_counter() - t0, row=row_id, cpu_seconds=time.thread_time() - c0)
 
     # -- saving ----------------------------------------------------------------
     def save(self, name, shape, fmt="ply"):

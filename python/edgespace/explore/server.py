@@ -88,6 +88,7 @@ def shape_message(seq, shape, explorer):
     hdr = {"op": "shape", "seq": seq, "expr": shape.expr, "t": shape.t, "row": shape.row,
            "command": explorer.command_line(shape.expr), "report": shape.report,
            "warning": shape.realizability(), "seconds": shape.seconds,
+           "cpu_seconds": shape.cpu_seconds,
            "nverts": int(shape.V.shape[0]),
            "heat": [{"name": n, "label": HEAT_MAPS[n], "min": float(shape.heat[n].min()),
                      "max": float(shape.heat[n].max())} for n in names]}

@@ -136,7 +136,7 @@ function onShape(buf) {
   drawShape();
   const t = state.timings[hdr.seq];
   if (t) {
-    Object.assign(t, { tRecv, server: hdr.seconds });
+    Object.assign(t, { tRecv, server: hdr.seconds, serverCpu: hdr.cpu_seconds });
     requestAnimationFrame(() => { t.tDrawn = performance.now(); });
   }
 }
