@@ -490,7 +490,7 @@ def test_the_page_in_chromium(study, tmp_path):
         # bad input typed or sent: an error in the page, and the page goes on
         box = d.find_element(By.ID, "t-pc2")
         for typed, message in (("abc", "'abc' is not a number"), ("1e300", "outside")):
-            box.clear()
+            box.send_keys(Keys.CONTROL, "a")       # the typed text replaces what is there
             box.send_keys(typed, Keys.ENTER)
             wait_for(d, f"return document.getElementById('error').textContent.includes("
                         f"{json.dumps(message)}) && !document.getElementById('error').hidden",
