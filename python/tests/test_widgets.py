@@ -15,7 +15,6 @@ import pytest
 import edgespace as es
 
 pytest.importorskip("ipywidgets")
-pytest.importorskip("aiohttp")     # edgespace.explore's package imports its server lazily only
 from conftest import cli_path   # noqa: E402
 
 PNG = b"\x89PNG\r\n\x1a\n"

@@ -70,6 +70,8 @@ def main(argv=None):
     try:
         return run(a.store, pca=a.pca, host=a.host, port=a.port, warm=not a.cold,
                    fast=not a.accurate, cache=not a.no_cache, ready=ready)
+    except KeyboardInterrupt:       # Ctrl-C before the server listened
+        return 130
     except OSError as e:
         _log(f"{e.strerror or e}" + (f" ({e.filename})" if getattr(e, "filename", None) else ""))
         return 1
