@@ -195,6 +195,7 @@ class Store:
         if self._ptr is None:
             return
         self._close_sessions()
+        self._mesh = None     # freed now, while its context lives
         try:
             if self.writable:
                 self.commit()
@@ -206,6 +207,7 @@ class Store:
         """Close, discarding uncommitted writes."""
         if self._ptr is not None:
             self._close_sessions()
+            self._mesh = None
             ffi.gc(self._ptr, None)   # no es_store_close at collection
             lib.es_store_abort(self._ptr)
             self._ptr = None
