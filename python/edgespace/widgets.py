@@ -34,13 +34,13 @@ from .store import Store
 CURRENT = "(slider position)"
 
 
-def explore(store, pca=None, warm=True, fast=True, size=480):
+def explore(store, pca=None, pcs=20, warm=True, fast=True, size=480):
     """An ExplorerWidget on `store` (a path, or an open Store whose path is
     opened again read-only: the widget computes in a thread of its own).
-    pca: the PCA whose components are sliders; warm/fast: as
+    pca: the PCA whose components are sliders, pcs how many; warm/fast: as
     edgespace.explore.Explorer; size: the view's width and height in pixels."""
     path = store.path if isinstance(store, Store) else store
-    return ExplorerWidget(Explorer(path, pca=pca, warm=warm, fast=fast), size)
+    return ExplorerWidget(Explorer(path, pca=pca, pcs=pcs, warm=warm, fast=fast), size)
 
 
 def _rotate(v, axis, degrees):
@@ -238,14 +238,14 @@ class ExplorerWidget(W.HBox):
         ex, info = self.explorer, self.explorer.describe_rows()
         if not self._pcs:
             return
-        i, j = self.sx.value, self.sy.value
-        x = [r[i] for r in info["scores"]] + [self.shape.t.get(self._pcs[i].key, 0.0)]
-        y = [r[j] for r in info["scores"]] + [self.shape.t.get(self._pcs[j].key, 0.0)]
+        i, j = self._pcs[self.sx.value], self._pcs[self.sy.value]
+        x = [r[int(i.term[3:]) - 1] for r in info["scores"]] + [self.shape.t.get(i.key, 0.0)]
+        y = [r[int(j.term[3:]) - 1] for r in info["scores"]] + [self.shape.t.get(j.key, 0.0)]
         col = self.color.value
         labels = (list(info["labels"][col]) if col else ["row"] * len(info["ids"])) + [CURRENT]
         self.scatter.value = bytes(plot_scatter(
-            np.array(x), np.array(y), labels=labels, xlabel=f"{self._pcs[i].label} (sd)",
-            ylabel=f"{self._pcs[j].label} (sd)", legend_title=col or None, ctx=ex.ctx))
+            np.array(x), np.array(y), labels=labels, xlabel=f"{i.label} (sd)",
+            ylabel=f"{j.label} (sd)", legend_title=col or None, ctx=ex.ctx))
 
     # -- saving ------------------------------------------------------------------------
     def _save(self):

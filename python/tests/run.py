@@ -76,7 +76,7 @@ def main(argv):
     lack = missing(groups)
     if lack:
         # meson shows the test as SKIP and prints this with --print-errorlogs
-        print(f"SKIP: {', '.join(lack)} missing for {sys.executable} "
+        print(f"SKIP: the Debian packages {' '.join(lack)} are missing for {sys.executable} "
               "(bash tools/setup.sh installs them)")
         return 77
     import pytest

@@ -82,6 +82,15 @@ def test_the_sliders_are_the_stores_directions(cold):
     assert np.allclose(z.var(axis=0, ddof=1), 1.0, rtol=1e-9)
 
 
+def test_the_first_pcs_only_when_asked(study):
+    ex = Explorer(study, pca="p", pcs=2)
+    try:
+        assert [d.key for d in ex.directions][:3] == ["pc1", "pc2", "diff:smile"]
+        assert len(ex.describe()["rows"]["scores"][0]) == 4     # the scatter has them all
+    finally:
+        ex.close()
+
+
 def test_a_position_is_the_point_its_expression_names(cold, study):
     c = cold.coordinates({"pc1": 1.5, "pc3": -0.25, "diff:smile": 0.5,
                           "coef:m:expression=happy": 0.7, "pc2": 0})
@@ -259,7 +268,7 @@ def test_the_command_checks_its_options(study):
     r = subprocess.run([cli_path(), "explore", "--help"], capture_output=True, text=True)
     assert r.returncode == 0 and "127.0.0.1" in r.stdout and "--port" in r.stdout
     for args in ([], ["a.h5", "b.h5"], [str(study), "--port", "70000"],
-                 [str(study), "--port", "x"]):
+                 [str(study), "--port", "x"], [str(study), "--pcs", "-1"]):
         r = subprocess.run([cli_path(), "explore", *args], capture_output=True, text=True)
         assert r.returncode == 2, args
     r = subprocess.run([cli_path(), "explore", str(study) + ".missing"], capture_output=True,

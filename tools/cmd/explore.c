@@ -25,7 +25,7 @@
 #endif
 
 static const char usage[] =
-    "usage: edgespace explore STORE [--port N] [--pca NAME] [options]\n"
+    "usage: edgespace explore STORE [--port N] [--pca NAME] [--pcs K] [options]\n"
     "\n"
     "Serve a page to explore the store's shape space by hand, and print its URL.\n"
     "The page has the PCA scatter of the rows coloured by a label column (hover:\n"
@@ -45,6 +45,8 @@ static const char usage[] =
     "      --port N       TCP port (default 0: any free one)\n"
     "      --pca NAME     the PCA of the sliders and the scatter (needed when several\n"
     "                     are stored and none is named 'default')\n"
+    "      --pcs K        a slider for each of the first K components (default 20;\n"
+    "                     0: all)\n"
     "      --host ADDR    listen on ADDR instead of 127.0.0.1 (anyone who reaches it\n"
     "                     with the URL can read the store)\n"
     "      --cold         every position from its own prior, as edgespace embed does\n"
@@ -93,8 +95,9 @@ int cmd_explore(int argc, char **argv)
         {"port", required_argument, NULL, 'p'}, {"pca", required_argument, NULL, 'c'},
         {"host", required_argument, NULL, 'H'}, {"cold", no_argument, NULL, 'C'},
         {"accurate", no_argument, NULL, 'A'},   {"no-cache", no_argument, NULL, 'N'},
-        {"help", no_argument, NULL, 'h'},       {NULL, 0, NULL, 0}};
-    const char *pca = NULL, *host = "127.0.0.1", *port = "0";
+        {"pcs", required_argument, NULL, 'k'},  {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0}};
+    const char *pca = NULL, *host = "127.0.0.1", *port = "0", *pcs = "20";
     int c, cold = 0, accurate = 0, no_cache = 0;
     int64_t n;
     optind = 1;
@@ -106,6 +109,11 @@ int cmd_explore(int argc, char **argv)
             port = optarg;
             break;
         case 'c': pca = optarg; break;
+        case 'k':
+            if (cli_parse_i64(optarg, &n) || n < 0)
+                return cli_usage_error("explore", "--pcs wants 0 (all) or a count");
+            pcs = optarg;
+            break;
         case 'H':
             if (!*optarg) return cli_usage_error("explore", "--host wants an address");
             host = optarg;
@@ -124,7 +132,7 @@ int cmd_explore(int argc, char **argv)
         fprintf(stderr, "edgespace explore: cannot set the environment: %s\n", strerror(errno));
         return CLI_FAIL;
     }
-    const char *args[16];
+    const char *args[20];
     int k = 0;
     args[k++] = python;
     args[k++] = "-m";
@@ -134,6 +142,8 @@ int cmd_explore(int argc, char **argv)
     args[k++] = port;
     args[k++] = "--host";
     args[k++] = host;
+    args[k++] = "--pcs";
+    args[k++] = pcs;
     if (pca) {
         args[k++] = "--pca";
         args[k++] = pca;

@@ -11,11 +11,11 @@ from .core import HEAT_MAPS, Direction, Explorer, RequestError, Shape
 __all__ = ["Explorer", "Direction", "Shape", "RequestError", "HEAT_MAPS", "serve"]
 
 
-def serve(store, pca=None, host="127.0.0.1", port=0, warm=True, fast=True, cache=True,
+def serve(store, pca=None, host="127.0.0.1", port=0, warm=True, fast=True, cache=True, pcs=20,
           ready=None, log=None):
     """Run the explorer's web server on `store` until interrupted (Ctrl-C,
     SIGTERM); ready(url) is called once it listens. What `edgespace explore`
     runs; __main__.py parses its options."""
     from .__main__ import run
-    return run(store, pca=pca, host=host, port=port, warm=warm, fast=fast, cache=cache,
+    return run(store, pca=pca, host=host, port=port, warm=warm, fast=fast, cache=cache, pcs=pcs,
                ready=ready, log=log)

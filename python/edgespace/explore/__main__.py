@@ -1,5 +1,5 @@
-"""python3 -m edgespace.explore STORE [--port N] [--pca NAME] [--host ADDR]
-[--cold] [--accurate] [--no-cache]: the program `edgespace explore`
+"""python3 -m edgespace.explore STORE [--port N] [--pca NAME] [--pcs K]
+[--host ADDR] [--cold] [--accurate] [--no-cache]: the program `edgespace explore`
 (tools/cmd/explore.c) runs. Prints the URL (with its token) on a line of
 its own on standard output once the server listens; progress and requests
 refused go to standard error, one line each. Exit status 0 after Ctrl-C or
@@ -17,12 +17,12 @@ def _log(msg):
     print(f"{PROG}: {msg}", file=sys.stderr, flush=True)
 
 
-def run(store, pca=None, host="127.0.0.1", port=0, warm=True, fast=True, cache=True,
+def run(store, pca=None, host="127.0.0.1", port=0, warm=True, fast=True, cache=True, pcs=20,
         ready=None, log=_log):
     from .core import Explorer
     from .server import ExploreServer
     log = log or (lambda msg: None)
-    explorer = Explorer(store, pca=pca, warm=warm, fast=fast, cache=cache, log=log)
+    explorer = Explorer(store, pca=pca, warm=warm, fast=fast, cache=cache, pcs=pcs, log=log)
     server = ExploreServer(explorer, host=host, port=port, log=log)
     loop = asyncio.new_event_loop()
     stop = asyncio.Event()
@@ -52,6 +52,7 @@ def main(argv=None):
     ap.add_argument("store")
     ap.add_argument("--port", type=int, default=0)
     ap.add_argument("--pca", default=None)
+    ap.add_argument("--pcs", type=int, default=20)
     ap.add_argument("--host", default="127.0.0.1")
     ap.add_argument("--cold", action="store_true")
     ap.add_argument("--accurate", action="store_true")
@@ -59,6 +60,8 @@ def main(argv=None):
     a = ap.parse_args(argv)
     if not 0 <= a.port <= 65535:
         ap.error("--port wants 0 (any free port) to 65535")
+    if a.pcs < 0:
+        ap.error("--pcs wants 0 (all) or more")
 
     def ready(url):
         from .server import LOOPBACK
@@ -69,7 +72,7 @@ def main(argv=None):
 
     try:
         return run(a.store, pca=a.pca, host=a.host, port=a.port, warm=not a.cold,
-                   fast=not a.accurate, cache=not a.no_cache, ready=ready)
+                   fast=not a.accurate, cache=not a.no_cache, pcs=a.pcs, ready=ready)
     except KeyboardInterrupt:       # Ctrl-C before the server listened
         return 130
     except OSError as e:

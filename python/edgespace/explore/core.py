@@ -12,9 +12,10 @@ as the point syntax reads it), stored paired differences (`diff:NAME`) and
 the coefficients of stored linear models in edge-length space
 (`coef:MODEL:COEF`). Every point is a combination of stored rows, and so is
 each direction: the mean's and each direction's lengths and row weights are
-evaluated once, by the library (es_study_point of "MEAN" and of
-"MEAN + 1*TERM", the direction being their difference, so that a direction
-is exactly what the point syntax means by its leaf), and a position's
+evaluated once, by the library (es_study_point of "MEAN", and of "ROW" and
+"ROW + 1*TERM" for one row, the direction being their difference, so that
+a direction is what the point syntax means by its leaf to the last bits of
+the row's lengths), and a position's
 lengths and weights are then sums of arrays, solved directly
 (es_study_embedder_solve) without parsing an expression per position. The
 expression shown for a position (point_expression) is the same point
@@ -34,6 +35,7 @@ import re
 import threading
 import time
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -41,7 +43,6 @@ from .._context import Context
 from .._errors import Error, ExistsError
 from .._native import has as _has_symbol
 from ..render import auto_view
-from ..session import StudyEmbedder
 from ..store import Store
 
 # A slider may be moved, or typed, this many times past its range (a PC: +-3
@@ -166,12 +167,14 @@ def shell_quote(s):
 class Explorer:
     """An exploration of the store at `path` (read-only): see the module's
     text. pca: the PCA whose components are sliders (None: the only one, else
-    the one named 'default'). warm: each position starts from the last one's
-    correction of its prior (a slider's speed); cold (warm=False): each from
-    its own prior, as `edgespace embed` does. fast: es_embed_opts_fast (the
-    slider accuracy), else the default options."""
+    the one named 'default'); pcs: how many of them, the first (0: all; a
+    PCA keeps N - 1 by default). warm: each position starts from the last
+    one's correction of its prior (a slider's speed); cold (warm=False): each
+    from its own prior, as `edgespace embed` does. fast: es_embed_opts_fast
+    (the slider accuracy), else the default options."""
 
-    def __init__(self, path, pca=None, warm=True, fast=True, cache=True, log=None, ctx=None):
+    def __init__(self, path, pca=None, warm=True, fast=True, cache=True, pcs=20, log=None,
+                 ctx=None):
         self.path = os.path.abspath(str(path))
         self.folder = os.path.dirname(self.path)
         self.warm, self.fast = bool(warm), bool(fast)
@@ -182,13 +185,13 @@ class Explorer:
         self._rows_info = None
         self.store = Store(self.path, ctx=self.ctx)
         try:
-            self._load(pca, cache)
+            self._load(pca, cache, int(pcs))
         except BaseException:
             self.store.abort()
             raise
 
     # -- set-up ------------------------------------------------------------
-    def _load(self, pca_name, cache):
+    def _load(self, pca_name, cache, pcs):
         s = self.store
         if s.topology_kind != "mesh":
             raise RequestError(f"'{self.path}' holds {s.topology_kind} data: exploring needs "
@@ -197,12 +200,19 @@ class Explorer:
         if not pcas:
             raise RequestError(f"'{self.path}' has no PCA: run `edgespace pca "
                                f"{shell_quote(self.path)} --name NAME` first")
-        self.pca = s.load_pca(pca_name)
+        pca = s.load_pca(pca_name)
+        # copies: the fit's memory is the library's, freed here with its context
+        # alive, not by a collection at exit in whatever order the objects go
+        self.pca = SimpleNamespace(
+            ncomp=int(pca.ncomp), eigenvalues=np.array(pca.eigenvalues),
+            explained=np.array(pca.explained), scores=np.array(pca.scores),
+            rows=None if pca.rows is None else np.array(pca.rows))
+        del pca
         self.pca_name = pca_name if pca_name else (pcas[0] if len(pcas) == 1 else "default")
         self.mean_expr = mean_expression(s.get_attr(f"pca/{self.pca_name}", "filter"))
         self.ids = list(s.ids)
         self.row_index = {r: i for i, r in enumerate(self.ids)}
-        self.columns = [c for c in s.columns]
+        self.columns = list(s.columns)
         self.labels = {c: list(s.label(c)) for c in self.columns}
         self._log("evaluating the mean and the directions")
         # es_study_point (Store.point, not stored) rather than _weights: it
@@ -210,15 +220,18 @@ class Explorer:
         # coefficient) makes lengths negative, which a point to embed may not
         base = s.point(self.mean_expr, pca=self.pca_name)
         self.L0, self.w0, self.scale0 = base.lengths, base.weights, base.scale
-        self.directions = self._pc_directions() + self._diff_directions() + \
+        self.directions = self._pc_directions(pcs) + self._diff_directions() + \
             self._coef_directions()
+        # a direction is (ROW + 1*TERM) - ROW: one row is read, where the mean
+        # reads them all (on face-study 10 ms a direction rather than 60)
+        row = f"row:{quote_word(self.ids[0])}"
+        r0 = s.point(row, pca=self.pca_name)
         for d in self.directions:
-            p = s.point(f"{self.mean_expr} + 1*{d.term}", pca=self.pca_name)
-            d.dL, d.dw = p.lengths - self.L0, p.weights - self.w0
+            p = s.point(f"{row} + 1*{d.term}", pca=self.pca_name)
+            d.dL, d.dw = p.lengths - r0.lengths, p.weights - r0.weights
         self.by_key = {d.key: d for d in self.directions}
         self._log("opening the embedding session")
-        self.session = StudyEmbedder(s, cache)
-        s._sessions.append(self.session)
+        self.session = s.embedder(cache)
         self.faces = s.faces
         self._log("embedding the mean")
         self.mean_V = None
@@ -231,10 +244,10 @@ class Explorer:
             d, u = auto_view(self.mean_V, self.faces, ctx=self.ctx)
             self.view = {"dir": [float(x) for x in d], "up": [float(x) for x in u]}
 
-    def _pc_directions(self):
+    def _pc_directions(self, pcs):
         p = self.pca
         out = []
-        for k in range(p.ncomp):
+        for k in range(p.ncomp if pcs <= 0 else min(pcs, p.ncomp)):
             if not p.eigenvalues[k] > 0:
                 continue
             out.append(Direction(f"pc{k + 1}", f"pc:{k + 1}", "pc",

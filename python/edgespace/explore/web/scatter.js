@@ -36,7 +36,8 @@ export class Scatter {
     const { svg, info } = this;
     svg.replaceChildren();
     const W = +svg.getAttribute('width'), H = +svg.getAttribute('height');
-    const i = +this.sx.value, j = +this.sy.value, rows = info.rows;
+    const rows = info.rows;
+    const i = this.component(+this.sx.value), j = this.component(+this.sy.value);
     if (!this.pcs.length || !rows.ids.length) {
       el('text', { x: 20, y: 40 }, svg).textContent = 'no scores to plot';
       return;
@@ -76,6 +77,9 @@ export class Scatter {
     this.marker = el('g', {}, svg);
     this.mark(this.coords);
   }
+
+  // The score column of the k-th PC slider (its key is "pcK").
+  component(k) { return +this.pcs[k].key.slice(2) - 1; }
 
   // The current position (slider coordinates {pcK: t}) as a cross.
   mark(coords) {
