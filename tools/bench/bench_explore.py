@@ -99,7 +99,8 @@ def main():
         store = a.store or face_study(tmp)
         t0 = time.time()
         srv = Server(store, *(["--pca", a.pca] if a.pca else []))
-        print(f"store {store}; the server listened after {time.time() - t0:.1f} s")
+        print(f"store {store}; the server listened after {time.time() - t0:.1f} s; "
+              f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs")
         d = chromium()
         try:
             d.get(srv.url)
@@ -122,6 +123,7 @@ def main():
                 time.sleep(0.2)
                 last = d.execute_script("return window.esExplorer.state.seq")
                 report(label, d.execute_script("return window.esExplorer.timings"), first, last)
+            print(f"load average at the end {os.getloadavg()[0]:.1f}")
             if a.screenshot:
                 d.save_screenshot(a.screenshot)
         finally:

@@ -137,7 +137,6 @@ int cmd_explore(int argc, char **argv)
     args[k++] = python;
     args[k++] = "-m";
     args[k++] = "edgespace.explore";
-    args[k++] = argv[optind];
     args[k++] = "--port";
     args[k++] = port;
     args[k++] = "--host";
@@ -151,6 +150,8 @@ int cmd_explore(int argc, char **argv)
     if (cold) args[k++] = "--cold";
     if (accurate) args[k++] = "--accurate";
     if (no_cache) args[k++] = "--no-cache";
+    args[k++] = "--";           /* a store named "-x.h5" is not an option */
+    args[k++] = argv[optind];
     args[k] = NULL;
     fflush(NULL);
     execv(python, (char *const *)args);
