@@ -82,6 +82,11 @@ def test_the_sliders_are_the_stores_directions(cold):
     assert np.allclose(z.var(axis=0, ddof=1), 1.0, rtol=1e-9)
 
 
+def test_a_store_without_a_pca_says_what_to_run(base_store):
+    with pytest.raises(RequestError, match="has no PCA: run `edgespace pca"):
+        Explorer(base_store)
+
+
 def test_the_first_pcs_only_when_asked(study):
     ex = Explorer(study, pca="p", pcs=2)
     try:
