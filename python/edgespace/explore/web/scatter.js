@@ -56,7 +56,9 @@ export class Scatter {
       el('text', { x: this.X(t) - 6, y: H - 10 }, svg).textContent = t;
       el('text', { x: 4, y: this.Y(t) + 3 }, svg).textContent = t;
     }
-    el('text', { x: W / 2 - 40, y: H - 2 }, svg).textContent = `${this.pcs[i].label} (sd)`;
+    el('text', { x: W / 2 - 40, y: H - 2 }, svg).textContent = `${this.pcs[+this.sx.value].label} (sd)`;
+    el('text', { x: 10, y: H / 2 + 40, transform: `rotate(-90 10 ${H / 2 + 40})` }, svg)
+      .textContent = `${this.pcs[+this.sy.value].label} (sd)`;
     const col = this.color.value, labels = col ? rows.labels[col] : null;
     const levels = labels ? [...new Set(labels)].sort() : [];
     const colour = (k) => (labels ? PALETTE[levels.indexOf(labels[k]) % PALETTE.length] : PALETTE[0]);
