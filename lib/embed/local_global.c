@@ -59,8 +59,8 @@ static es_status prepare(es_embedder *emb, int history)
     }
     if (emb->F1) return ES_OK;
     if ((!emb->lg_w && !(emb->lg_w = es__alloc_array(emb->ctx, ne + 1, sizeof(double)))) ||
-        (!emb->lg_rest && !(emb->lg_rest = es__alloc_array(emb->ctx, 6 * emb->nf + 1, sizeof(double)))) ||
-        (!emb->lg_work && !(emb->lg_work = es__alloc_array(emb->ctx, 5 * 3 * nv + 1, sizeof(double)))))
+        (!emb->lg_rest && !(emb->lg_rest = es__alloc_array(emb->ctx, 9 * emb->nf + 1, sizeof(double)))) ||
+        (!emb->lg_work && !(emb->lg_work = es__alloc_array(emb->ctx, 6 * 3 * nv + 1, sizeof(double)))))
         return ES_ENOMEM;
     if (!emb->A1) emb->A1 = cholmod_l_copy_sparse(emb->H1, &emb->cm);
     if (!emb->LB) emb->LB = cholmod_l_allocate_dense((size_t)nv, 3, (size_t)nv, CHOLMOD_REAL, &emb->cm);
@@ -125,18 +125,22 @@ static es_status assemble(es_embedder *emb, const double *L)
 
 /* Each face's triangle of lengths L as the 2D vectors of its edges k = 0,
  * 1, 2 (edge k joins corners k and k + 1), from corner 0's angle by
- * Kahan's formula (emb->ang, es__corner_angles); a face whose lengths
- * break the triangle inequality is flattened to a segment there. */
+ * Kahan's formula (emb->ang, es__corner_angles), each times its edge's
+ * weight, then the three weights: 9 doubles a face, read in order by the
+ * local step (the weights gathered by edge cost a cache miss each). A face
+ * whose lengths break the triangle inequality is flattened to a segment. */
 static void rest_triangles(es_embedder *emb, const double *L)
 {
     const int64_t *FE = es_mesh_face_edges(emb->mesh);
     for (int64_t f = 0; f < emb->nf; f++) {
         double l0 = L[FE[3 * f]], l2 = L[FE[3 * f + 2]], th = emb->ang[3 * f];
         double t2x = l2 * cos(th), t2y = l2 * sin(th);
-        double *r = emb->lg_rest + 6 * f;
-        r[0] = l0, r[1] = 0;           /* corner 1 - corner 0 */
-        r[2] = t2x - l0, r[3] = t2y;   /* corner 2 - corner 1 */
-        r[4] = -t2x, r[5] = -t2y;      /* corner 0 - corner 2 */
+        double *r = emb->lg_rest + 9 * f, w[3];
+        for (int k = 0; k < 3; k++) w[k] = emb->lg_w[FE[3 * f + k]];
+        r[0] = w[0] * l0, r[1] = 0;                 /* corner 1 - corner 0 */
+        r[2] = w[1] * (t2x - l0), r[3] = w[1] * t2y;   /* corner 2 - corner 1 */
+        r[4] = -w[2] * t2x, r[5] = -w[2] * t2y;      /* corner 0 - corner 2 */
+        r[6] = w[0], r[7] = w[1], r[8] = w[2];
     }
 }
 
@@ -180,39 +184,49 @@ static void polar32(const double *S, double *R)
 
 /* The local step at xyz: every face's R_f; returns E(xyz) and writes the
  * global step's right-hand side b (V x 3, column-major), proximal part
- * included. */
-static double local_step(const es_embedder *emb, const double *xyz, double *b)
+ * included. The sums are made per vertex in xyz's interleaved layout (a
+ * face touches three vertices' 3 adjacent doubles, not nine scattered
+ * ones) in acc (3 V), then moved into b. With w_k r_k stored (rest_
+ * triangles), the residual is d_k - (R w_k r_k) / w_k. */
+static double local_step(const es_embedder *emb, const double *xyz, double *b, double *acc)
 {
-    const int64_t *F = es_mesh_faces(emb->mesh), *FE = es_mesh_face_edges(emb->mesh);
+    const int64_t *F = es_mesh_faces(emb->mesh);
     int64_t nv = emb->nv;
     double E = 0;
-    for (int64_t v = 0; v < nv; v++) {
-        double c = emb->off[v + 1] == emb->off[v] ? 1.0 : emb->lg_eps;
-        for (int k = 0; k < 3; k++) b[v + nv * k] = c * xyz[3 * v + k];
-    }
+    memset(acc, 0, (size_t)(3 * nv) * sizeof *acc);
     for (int64_t f = 0; f < emb->nf; f++) {
-        const int64_t *fv = F + 3 * f, *fe = FE + 3 * f;
-        const double *r = emb->lg_rest + 6 * f;
-        double d[3][3], w[3], S[6] = {0, 0, 0, 0, 0, 0}, R[6];
-        for (int k = 0; k < 3; k++) {
-            const double *pa = xyz + 3 * fv[k], *pb = xyz + 3 * fv[k == 2 ? 0 : k + 1];
-            w[k] = emb->lg_w[fe[k]];
-            for (int i = 0; i < 3; i++) {
-                d[k][i] = pb[i] - pa[i];
-                S[2 * i] += w[k] * d[k][i] * r[2 * k];
-                S[2 * i + 1] += w[k] * d[k][i] * r[2 * k + 1];
-            }
+        const int64_t *fv = F + 3 * f;
+        const double *r = emb->lg_rest + 9 * f, *w = r + 6;
+        const double *p0 = xyz + 3 * fv[0], *p1 = xyz + 3 * fv[1], *p2 = xyz + 3 * fv[2];
+        double d[3][3], S[6], R[6];
+        for (int i = 0; i < 3; i++) {
+            d[0][i] = p1[i] - p0[i];
+            d[1][i] = p2[i] - p1[i];
+            d[2][i] = p0[i] - p2[i];
+        }
+        /* S = sum_k w_k d_k r_k^T: the weights are in r */
+        for (int i = 0; i < 3; i++) {
+            S[2 * i] = d[0][i] * r[0] + d[1][i] * r[2] + d[2][i] * r[4];
+            S[2 * i + 1] = d[0][i] * r[1] + d[1][i] * r[3] + d[2][i] * r[5];
         }
         polar32(S, R);
+        double *a0 = acc + 3 * fv[0], *a1 = acc + 3 * fv[1], *a2 = acc + 3 * fv[2];
         for (int k = 0; k < 3; k++) {
-            int64_t a = fv[k], c = fv[k == 2 ? 0 : k + 1];
+            double *to = k == 0 ? a1 : k == 1 ? a2 : a0, *from = k == 0 ? a0 : k == 1 ? a1 : a2;
+            double iw = 1.0 / w[k], e = 0;
             for (int i = 0; i < 3; i++) {
-                double ri = R[2 * i] * r[2 * k] + R[2 * i + 1] * r[2 * k + 1], dv = d[k][i] - ri;
-                E += w[k] * dv * dv;
-                b[c + nv * i] += w[k] * ri;
-                b[a + nv * i] -= w[k] * ri;
+                double ri = R[2 * i] * r[2 * k] + R[2 * i + 1] * r[2 * k + 1];   /* w_k R r_k */
+                double dv = d[k][i] - ri * iw;
+                e += dv * dv;
+                to[i] += ri;
+                from[i] -= ri;
             }
+            E += w[k] * e;
         }
+    }
+    for (int64_t v = 0; v < nv; v++) {
+        double c = emb->off[v + 1] == emb->off[v] ? 1.0 : emb->lg_eps;
+        for (int k = 0; k < 3; k++) b[v + nv * k] = acc[3 * v + k] + c * xyz[3 * v + k];
     }
     return E;
 }
@@ -254,18 +268,18 @@ es_status es__lg_solve(es_embedder *emb, const double *L, double *xyz, const es_
 {
     int64_t n3 = 3 * emb->nv;
     const int accuracy = o->rms_tol > 0 && o->max_tol > 0;
-    double *g, *gn, *d, *xt, *b, *tmp, E, hist[5];
+    double *g, *gn, *d, *xt, *b, *tmp, *acc, E, hist[5];
     es_status rc;
     memset(res, 0, sizeof *res);
     if ((rc = prepare(emb, o->history > 0 ? o->history : 6)) != ES_OK ||
         (rc = assemble(emb, L)) != ES_OK)
         return rc;
-    g = emb->lg_work, gn = g + n3, d = gn + n3, xt = d + n3, tmp = xt + n3;
+    g = emb->lg_work, gn = g + n3, d = gn + n3, xt = d + n3, tmp = xt + n3, acc = tmp + n3;
     b = emb->LB->x;
     es__lbfgs_reset(&emb->lg_hist);
     es__corner_angles(emb->mesh, L, 0, emb->ang);
     rest_triangles(emb, L);
-    E = local_step(emb, xyz, b);
+    E = local_step(emb, xyz, b, acc);
     half_gradient(emb, xyz, b, g, tmp);
     for (int it = 0;; it++) {
         double rms, mx;
@@ -300,11 +314,11 @@ es_status es__lg_solve(es_embedder *emb, const double *L, double *xyz, const es_
         int ok = 0;
         for (int ls = 0; ls < 12 && !ok; ls++, t *= 0.5) {
             for (int64_t i = 0; i < n3; i++) xt[i] = xyz[i] - t * d[i];
-            Et = local_step(emb, xt, b);
+            Et = local_step(emb, xt, b, acc);
             ok = Et <= E + 1e-4 * t * slope;
         }
         if (!ok) {   /* b is xt's: make it xyz's again for the caller's reuse */
-            local_step(emb, xyz, b);
+            local_step(emb, xyz, b, acc);
             break;
         }
         half_gradient(emb, xt, b, gn, tmp);

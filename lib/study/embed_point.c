@@ -85,6 +85,21 @@ static es_status write_residuals(es_ctx *ctx, const char *path, const es_embedde
     return es__table_end(ctx, &t, ES_OK);
 }
 
+/* The published pipeline from dihedrals alpha (NULL: those of init_xyz),
+ * aligned to init_xyz; the start's description says so. */
+static es_status solve_paper(es_ctx *ctx, es_embedder *emb, const es_study_embed_opts *o,
+                             const double *target, double scale, const double *alpha,
+                             const double *init_xyz, double *xyz, es_study_embed_result *res)
+{
+    es_embed_paper_opts po;
+    size_t n = strlen(res->init);
+    es_embed_paper_opts_init(&po);
+    po.embed = o->embed;
+    snprintf(res->init + n, sizeof res->init - n, "; published pipeline (L-BFGS, stages 2-3)");
+    return es_embed_paper_solve(ctx, emb, target, scale, alpha, init_xyz, &po, xyz,
+                                &res->report);
+}
+
 es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o, double *xyz_out,
                          es_study_embed_result *res)
 {
@@ -99,6 +114,8 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
     es_status rc;
     memset(res, 0, sizeof *res);
     if (!o || !o->point) ES_FAIL(ctx, ES_EINVAL, "embed: no point given");
+    if (o->session && es_study_embedder_store(o->session) != s)
+        ES_FAIL(ctx, ES_EINVAL, "embed: the session given is of another store");
     if (o->name && (rc = es_store_result_check(ctx, s, "embed", o->name)) != ES_OK) return rc;
     if ((rc = es_store_mesh(ctx, s, &mesh)) != ES_OK) return rc;
     ne = es_mesh_nedges(mesh);
@@ -122,10 +139,20 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
         /* the session: the embedder and the rows for priors, from the cache
          * beside the store when it is current (a fresh process skips their
          * making) */
-        if ((rc = es_study_embedder_open(ctx, s, o->cache, &se)) != ES_OK ||
-            (rc = es_study_embedder_solve(se, target, res->scale, w, &o->embed, 0,
-                                          es__study_point_is_one_mesh(ctx, o->point), xyz,
-                                          res)) != ES_OK)
+        if (o->session) se = o->session;
+        else if ((rc = es_study_embedder_open(ctx, s, o->cache, &se)) != ES_OK) goto done;
+        if (o->paper) {
+            /* the published pipeline from the prior's dihedrals, in its frame */
+            snprintf(res->init, sizeof res->init, "prior's dihedrals and frame");
+            if ((rc = es_study_prior(ctx, es_study_embedder_rows(se), w, init_xyz, alpha,
+                                     sd)) != ES_OK ||
+                (rc = solve_paper(ctx, es_study_embedder_embedder(se), o, target, res->scale,
+                                  alpha, init_xyz, xyz, res)) != ES_OK)
+                goto done;
+        } else if ((rc = es_study_embedder_solve(ctx, se, target, res->scale, w, &o->embed,
+                                                 o->session && o->warm,
+                                                 es__study_point_is_one_mesh(ctx, o->point),
+                                                 xyz, res)) != ES_OK)
             goto done;
         emb = es_study_embedder_embedder(se);
         /* provenance: the rows the prior drew on */
@@ -139,8 +166,10 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
     } else if ((rc = choose_start(ctx, s, mesh, o->init, target, init_xyz, alpha, &init_row,
                                   &sel, &nsel, res->init, sizeof res->init)) != ES_OK ||
                (rc = es_embedder_new(ctx, mesh, &emb)) != ES_OK ||
-               (rc = es_embed_solve(ctx, emb, target, res->scale, sel ? alpha : NULL, init_xyz,
-                                    &o->embed, xyz, &res->report)) != ES_OK) {
+               (rc = o->paper ? solve_paper(ctx, emb, o, target, res->scale, sel ? alpha : NULL,
+                                            init_xyz, xyz, res)
+                              : es_embed_solve(ctx, emb, target, res->scale, sel ? alpha : NULL,
+                                               init_xyz, &o->embed, xyz, &res->report)) != ES_OK) {
         goto done;
     }
     /* with a stored result the files are staged beside their targets and
@@ -184,7 +213,7 @@ done:
     }
     if (se) emb = NULL;   /* the session's */
     es_embedder_free(emb);
-    es_study_embedder_free(se);
+    if (se != o->session) es_study_embedder_free(se);
     es_mesh_free(mesh);
     es__free(ctx, sel);
     es__free(ctx, target);

@@ -28,6 +28,8 @@ void es_study_interp_opts_init(es_study_interp_opts *o)
     o->t1 = 1;
     o->steps = 9;
     es_embed_opts_init(&o->embed);
+    es_multiscale_opts_init(&o->multiscale);
+    es_data_path_opts_init(&o->path);
 }
 
 /* t of frame i of `steps` from t0 to t1 inclusive. */
@@ -177,7 +179,7 @@ static es_status embed_frame(walk *wk, int64_t i, double t, const double *v, dou
     es_study_embed_result er;
     const es_embed_report *rep = &er.report;
     es_status rc;
-    if ((rc = es_study_embedder_solve(wk->se, v, scale, w, &o->embed, i > 0 && !o->cold, 0, res,
+    if ((rc = es_study_embedder_solve(ctx, wk->se, v, scale, w, &o->embed, i > 0 && !o->cold, 0, res,
                                       &er)) != ES_OK ||
         (rc = used_rows(ctx, n, w, &rows, &nrows)) != ES_OK) {
         es__free(ctx, rows);
@@ -237,7 +239,8 @@ es_status es_study_interp(es_ctx *ctx, es_store *store, const es_study_interp_op
     char probe[4096];
     es_status rc;
     if (!o || !o->output) ES_FAIL(ctx, ES_EINVAL, "interp: no output given");
-    if (o->weights ? (o->from || o->to) : (!o->from || !o->to))
+    if (o->weights ? (o->from || o->to)
+                   : (!o->from || (!o->to && o->method != ES_MORPH_CONFORMAL)))
         ES_FAIL(ctx, ES_EINVAL, "interp: give from and to, or weights");
     if (o->steps < 1) ES_FAIL(ctx, ES_EINVAL, "interp: steps must be >= 1");
     if (!o->weights && o->steps > 1 && es_study_frame_path(o->output, 0, probe, sizeof probe))

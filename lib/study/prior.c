@@ -20,8 +20,10 @@ struct es_study_rows {
     int64_t n, nv, ne;
     double *aligned;        /* 3V x n: row i's positions in the frame */
     double *alpha;          /* E x n: row i's dihedrals */
-    double *trig;           /* 2 E x n: their cosines, then their sines (made on first
-                               use by es_study_prior) */
+    double *trig;           /* 2 E x n: their cosines, then their sines (each row's made
+                               when a prior first uses it: a one-point command pays for
+                               the rows its point draws on, a session once) */
+    uint8_t *have_trig;     /* n */
     const double **pa, **pd, **pc, **ps;   /* column pointers for es_embed_prior_from_rows */
 };
 
@@ -31,6 +33,7 @@ void es_study_rows_free(es_study_rows *r)
     es__free(r->ctx, r->aligned);
     es__free(r->ctx, r->alpha);
     es__free(r->ctx, r->trig);
+    es__free(r->ctx, r->have_trig);
     es__free(r->ctx, (void *)r->pa);
     es__free(r->ctx, (void *)r->pd);
     es__free(r->ctx, (void *)r->pc);
@@ -151,24 +154,36 @@ done:
     return ES_OK;
 }
 
-/* Every row's cosines and sines of its dihedrals, once: the prior's
- * circular mean then needs no trigonometry per row (es_embed_prior_from_rows_sc). */
-static es_status make_trig(es_ctx *ctx, es_study_rows *r)
+/* The cosines and sines of the dihedrals of the rows weights w use, each
+ * row's once: the prior's circular mean then needs no trigonometry per
+ * point (es_embed_prior_from_rows_sc). */
+static es_status make_trig(es_ctx *ctx, es_study_rows *r, const double *w)
 {
     int64_t ne = r->ne, n = r->n;
-    r->trig = es__alloc_array(ctx, 2 * ne * n, sizeof *r->trig);
-    r->pc = es__alloc_array(ctx, n, sizeof *r->pc);
-    r->ps = es__alloc_array(ctx, n, sizeof *r->ps);
-    if (!r->trig || !r->pc || !r->ps) return ES_ENOMEM;
+    if (!r->trig) {
+        r->trig = es__alloc_array(ctx, 2 * ne * n, sizeof *r->trig);
+        r->have_trig = es__alloc_array(ctx, n, sizeof *r->have_trig);
+        r->pc = es__alloc_array(ctx, n, sizeof *r->pc);
+        r->ps = es__alloc_array(ctx, n, sizeof *r->ps);
+        if (!r->trig || !r->have_trig || !r->pc || !r->ps) {
+            es__free(ctx, r->trig);
+            r->trig = NULL;
+            return ES_ENOMEM;
+        }
+        for (int64_t j = 0; j < n; j++) {
+            r->pc[j] = r->trig + 2 * ne * j;
+            r->ps[j] = r->trig + 2 * ne * j + ne;
+        }
+    }
     for (int64_t j = 0; j < n; j++) {
-        double *c = r->trig + 2 * ne * j, *s = c + ne;
+        if (w[j] == 0 || r->have_trig[j]) continue;
+        double *c = (double *)r->pc[j], *s = (double *)r->ps[j];
         const double *a = r->alpha + ne * j;
         for (int64_t e = 0; e < ne; e++) {
             c[e] = cos(a[e]);
             s[e] = sin(a[e]);
         }
-        r->pc[j] = c;
-        r->ps[j] = s;
+        r->have_trig[j] = 1;
     }
     return ES_OK;
 }
@@ -177,8 +192,8 @@ es_status es_study_prior(es_ctx *ctx, const es_study_rows *r, const double *w, d
                          double *alpha, double *sd)
 {
     if (!r || !w) ES_FAIL(ctx, ES_EINVAL, "prior: no rows or weights");
-    if (!r->trig && (alpha || sd)) {
-        es_status rc = make_trig(ctx, (es_study_rows *)r);   /* a cache inside the rows */
+    if (alpha || sd) {
+        es_status rc = make_trig(ctx, (es_study_rows *)r, w);   /* a cache inside the rows */
         if (rc != ES_OK) return rc;
     }
     return es_embed_prior_from_rows_sc(ctx, r->nv, r->ne, r->n, r->pa, r->pd, r->pc, r->ps, w,

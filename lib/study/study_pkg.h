@@ -67,6 +67,21 @@ ES__TABLE(es__t_model_scores);
 ES__TABLE(es__t_model_permutations);
 #undef ES__TABLE
 
+/* A model's requests as written (model_requests.c): --reference
+ * "LEVEL|FACTOR=LEVEL,..." onto the columns (cols[v].reference points into
+ * *held, a copy of spec that the caller frees after es_design_build);
+ * --at "NAME=VALUE|mean,..." into at (nvars, NaN: the mean); --error
+ * "TERM=ERROR" items into error (nterms, -1: the residual). */
+es_status es__model_references(es_ctx *ctx, const es_formula *f, const char *spec, int64_t n,
+                               es_model_column *cols, char **held);
+es_status es__model_at(es_ctx *ctx, const es_design *d, const es_formula *f, const char *spec,
+                       double *at);
+es_status es__model_errors(es_ctx *ctx, const es_design *d, const char *const *spec,
+                           int64_t count, int64_t *error);
+
+/* "~ a + b" of a design's terms ("~ 1" without any) into buf. */
+void es__model_null_label(const es_design *d, char *buf, size_t len);
+
 /* Store a model as model/<o->name> (model_results.c). */
 es_status es__model_save(es_ctx *ctx, es_store *s, const es_study_model_opts *o,
                          const es_study_model_result *r);

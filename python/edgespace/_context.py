@@ -38,13 +38,15 @@ def _in_kernel():
 def _tqdm():
     """tqdm's bar class for where we run: widgets in a Jupyter kernel that has
     ipywidgets 7 or later (tqdm.notebook's need: with Debian 12's ipywidgets
-    6 its bars raise AttributeError), text elsewhere; None where neither
-    would read well (a kernel without those widgets, where text bars leave
-    blank lines) or without tqdm."""
+    6 its bars raise AttributeError, and its widget messages are ones nbclient
+    cannot read, so a notebook executed by nbconvert fails with KeyError
+    'state'), text elsewhere; None where neither would read well (a kernel
+    without usable widgets, where text bars leave blank lines) or without
+    tqdm."""
     try:
         if _in_kernel():
             import ipywidgets
-            if int(ipywidgets.__version__.split(".")[0]) < 7:
+            if int(str(getattr(ipywidgets, "__version__", "0")).split(".")[0]) < 7:
                 return None
             from tqdm.notebook import tqdm
         else:

@@ -26,6 +26,7 @@ class StudyEmbedder:
         self.ctx.call(lib.es_study_embedder_open, store.ptr, 1 if cache else 0, p)
         self._ptr = A.owned(self.ctx, p[0], lib.es_study_embedder_free)
         self.faces = store.mesh.faces
+        self.nrows = store.nrows   # the rows it was made for
 
     @property
     def ptr(self):
@@ -60,8 +61,8 @@ class StudyEmbedder:
         eo = self._opts(fast, opts)
         xyz = np.empty((self.store.nverts, 3))
         res = ffi.new("es_study_embed_result *")
-        self._call(lib.es_study_embedder_solve, self.ptr, A.dptr(L), float(scale), A.dptr(w), eo,
-                   1 if warm else 0, 1 if exact else 0, A.dptr(xyz), res)
+        self.ctx.call(lib.es_study_embedder_solve, self.ptr, A.dptr(L), float(scale), A.dptr(w), eo,
+                      1 if warm else 0, 1 if exact else 0, A.dptr(xyz), res)
         return self._result(xyz, res)
 
     def vertex_deviation(self):
@@ -93,15 +94,9 @@ class StudyEmbedder:
         res = ffi.new("es_study_embed_result *")
         keep = [ffi.new("char[]", str(point).encode()),
                 ffi.new("char[]", str(pca).encode()) if pca is not None else ffi.NULL]
-        self._call(lib.es_study_embedder_point, self.ptr, keep[0], keep[1], float(scale), eo,
-                   1 if warm else 0, A.dptr(xyz), res)
+        self.ctx.call(lib.es_study_embedder_point, self.ptr, keep[0], keep[1], float(scale), eo,
+                      1 if warm else 0, A.dptr(xyz), res)
         return self._result(xyz, res)
-
-    def _call(self, fn, *args):
-        """A session call: it takes the session, not a context, first (the
-        session's context gets the message), so ctx.call's context argument
-        is dropped."""
-        return self.ctx.call(lambda _ctx, *a: fn(*a), *args)
 
     def forget(self):
         """The next warm embedding starts from its own prior."""

@@ -33,6 +33,9 @@ GROUPS = {
     # drives the page in test_explore.py
     "explore": {"aiohttp": "python3-aiohttp", "ipywidgets": "python3-ipywidgets"},
     "browser": {"selenium": "python3-selenium"},
+    # oracles: SciPy's fmin_l_bfgs_b, the minimizer of the published pipeline
+    # (test_paper_oracle.py; skipped without it, and --check fails)
+    "oracle": {"scipy": "python3-scipy"},
 }
 PROGRAMS = {"notebooks": {"jupyter-nbconvert": "jupyter-nbconvert"},
             "browser": {"chromium": "chromium", "chromedriver": "chromium-driver"}}

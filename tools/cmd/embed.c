@@ -42,8 +42,11 @@ CLI_EMBED_HELP
     "                       edge error and, with the prior, distance from the prior's\n"
     "                       realization / bbox diagonal (header closure,edge_error\n"
     "                       [,deviation]; render MESH --scalars CSV draws the first)\n"
-    "      --paper          the published method's stages only (stage 1 always, no\n"
-    "                       refinement), for comparison\n"
+    "  -m, --method M       default (the above) or paper: the published pipeline\n"
+    "                       for comparison (L-BFGS on the closure energy from the\n"
+    "                       start's dihedrals, frames and positions by least squares,\n"
+    "                       no refinement; open meshes too)\n"
+    "      --paper          the same as --method paper\n"
     "      --no-cache       neither read nor write STORE.es-cache (the embedder's\n"
     "                       vertex order and the rows made ready for priors, kept\n"
     "                       beside the store so the next command skips them)\n"
@@ -61,7 +64,7 @@ int cmd_embed(int argc, char **argv)
         {"paper", no_argument, NULL, 'P'},       {"replace", no_argument, NULL, 'X'},
         {"help", no_argument, NULL, 'h'},        CLI_EMBED_LONGOPTS,
         {"residuals", required_argument, NULL, 'r'}, {"pca", required_argument, NULL, 'c'},
-        {"no-cache", no_argument, NULL, 'C'},
+        {"no-cache", no_argument, NULL, 'C'},    {"method", required_argument, NULL, 'm'},
         {NULL, 0, NULL, 0}};
     char namebuf[256], text[1024], *cmd = NULL;
     es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
@@ -73,7 +76,7 @@ int cmd_embed(int argc, char **argv)
     es_status rc;
     es_study_embed_opts_init(&o);
     optind = 1;
-    while ((c = getopt_long(argc, argv, "p:o:i:s:n:h", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "p:o:i:s:n:m:h", longopts, NULL)) != -1) {
         switch (c) {
         case 'p': o.point = optarg; break;
         case 'o': o.output = optarg; break;
@@ -86,9 +89,11 @@ int cmd_embed(int argc, char **argv)
             break;
         case 'n': o.name = optarg; break;
         case 'N': store_it = 0; break;
-        case 'P':   /* the published method's stages only */
-            o.embed.dihedral_mode = ES_EMBED_DIHEDRAL_ON;
-            o.embed.refine_max_iter = 0;
+        case 'P': o.paper = 1; break;
+        case 'm':
+            if (strcmp(optarg, "default") && strcmp(optarg, "paper"))
+                return cli_usage_error("embed", "--method wants default or paper");
+            o.paper = !strcmp(optarg, "paper");
             break;
         case 'C': o.cache = 0; break;
         case 'X': wmode = ES_STORE_REPLACE; break;

@@ -20,6 +20,12 @@
  * Optionally (continuation_steps > 0 with initial positions) stage 4 runs
  * along the path from the initial mesh's own lengths (which it realizes
  * exactly) to the target, warm-started step by step.
+ * From positions (es_embed_prior_solve on open meshes: the prior's
+ * realization, or a warm start) the solve is instead local-global
+ * iterations on the triangles the target lengths make, with L-BFGS on a
+ * factored V x V Laplacian (lib/embed/local_global.c), and stage 4 only
+ * finishes where they did not meet the accuracy asked for (es_embed_opts:
+ * solver, lg_*).
  *
  * Conventions are those of ../shared/oracle/embed (es_geom.h signs): the
  * angle alpha_e is the signed bending angle, alpha = 0 flat, < 0 convex;
@@ -151,9 +157,15 @@ typedef struct es_embed_opts {
     double lg_rtol;           /* local-global also stops when its energy falls by less
                                  than this fraction per iteration over five (1e-4) */
     int lg_history;           /* L-BFGS pairs kept (default 6) */
-    int lg_polish;            /* 1: the Levenberg-Marquardt finish where the local-global
-                                 iterations did not meet the tolerances (default); 0:
-                                 local-global alone (interactive use: es_embed_opts_fast) */
+    int lg_polish;            /* where the local-global iterations did not meet the
+                                 tolerances: Levenberg-Marquardt iterations at most
+                                 (and at most refine_max_iter) toward them (default 4;
+                                 0: local-global alone, es_embed_opts_fast) */
+    double realize_bend;      /* for such a target (no mesh has its lengths) the
+                                 Levenberg-Marquardt finish always runs, with the prior's
+                                 bending term held at realize_bend x prior_mu, so that the
+                                 data's bending decides where the lengths cannot be met
+                                 (default 3; 0: as for any target) */
     double realize_margin;    /* target lengths that break the triangle inequality on a
                                  face are replaced by the nearest lengths (relative least
                                  squares) whose every face has its longest edge at most
@@ -361,6 +373,43 @@ ES_API es_status es_embed_prior_from_rows_sc(es_ctx *ctx, int64_t nverts, int64_
 /* One-line and multi-line text of a report (for commands and notebooks):
  * writes at most n bytes with NUL, returns buf. */
 ES_API const char *es_embed_report_format(const es_embed_report *rep, char *buf, size_t n);
+
+/* ---- the published pipeline, for comparison (paper.c) ------------------------
+ * edge-length-interpolation Section 2 as published: stage 1 minimizes the
+ * closure energy E(alpha) (eq. 3) by L-BFGS from the initial dihedrals (the
+ * paper: SciPy's fmin_l_bfgs_b from the inputs' averaged dihedrals; here
+ * SciPy's default settings), stages 2-3 turn the minimizer into frames and
+ * positions by least squares, and nothing follows: no refinement against
+ * the lengths, no choice whether stage 1 helps (es_embed_solve's changes).
+ * On open meshes stage 1 works on the interior vertices' closure, as on
+ * closed ones. */
+typedef struct es_embed_paper_opts {
+    int history;            /* L-BFGS correction pairs, m (10) */
+    int max_iter;           /* iterations, and evaluations of E (15000); 0: no stage 1 */
+    double factr;           /* stop when E falls by <= factr x DBL_EPSILON x max(|E|, 1)
+                               in an iteration (1e7) ... */
+    double pgtol;           /* ... or when max |dE/dalpha| <= pgtol (1e-5) */
+    es_embed_opts embed;    /* alignment and report settings of stages 2-3
+                               (es_embed_opts_init); its stage-1, refinement, prior and
+                               continuation fields are not used */
+} es_embed_paper_opts;
+
+ES_API void es_embed_paper_opts_init(es_embed_paper_opts *opts);
+
+/* Embed target lengths (E; scale as es_embed_solve) by the published
+ * pipeline from init_alpha (E, the averaged dihedrals), or from the
+ * dihedrals of init_xyz when init_alpha is NULL; the output is aligned as
+ * es_embed_solve aligns it (to init_xyz when given). The report is
+ * es_embed_solve's for stages 2-3 with stage 1's figures put in:
+ * closure_before (E at the start), closure_stage1 (E at the L-BFGS
+ * minimizer: the "error" of the paper's Table 1), dihedral_iters (L-BFGS
+ * iterations), t_dihedral, and t_total for the whole. Errors as
+ * es_embed_solve, and ES_EINVAL for settings out of range. */
+ES_API es_status es_embed_paper_solve(es_ctx *ctx, es_embedder *emb, const double *target,
+                                      double scale, const double *init_alpha,
+                                      const double *init_xyz,
+                                      const es_embed_paper_opts *opts, double *xyz,
+                                      es_embed_report *report);
 
 #ifdef __cplusplus
 }
