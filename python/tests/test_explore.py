@@ -546,6 +546,96 @@ def test_the_page_in_chromium(study, tmp_path):
     assert rc == 0, err
 
 
+# a drag at 60 Hz: the slider set every dt ms from lo to hi in n steps, as input events
+DRAG = """const [key, lo, hi, n, dt] = arguments; const x = window.esExplorer;
+let i = 0; const first = x.state.seq + 1;
+const timer = setInterval(() => {
+  x.setSlider(key, +(lo + (hi - lo) * i / (n - 1)).toFixed(4));
+  if (++i === n) clearInterval(timer);
+}, dt);
+return first;"""
+
+
+def percentiles(xs):
+    """(median, p95) of a list of numbers, p95 the nearest rank."""
+    xs = sorted(xs)
+    return float(np.median(xs)), xs[min(len(xs) - 1, int(round(0.95 * (len(xs) - 1))))]
+
+
+def test_a_warm_drag_in_chromium(study, tmp_path):
+    """The explorer as a user starts it (warm starts, slider accuracy):
+    hovering a row names it; a drag across PC 1 at 60 Hz ends on the newest
+    position; the mesh received realizes the library's lengths of the
+    expression shown (numpy edge lengths: the report's RMS, < 0.5 %), and
+    equals the same positions solved in the same order by an Explorer of
+    its own (to 1e-9 x bbox: the server's warm chain is the page's shown
+    positions, no more, no fewer); then single steps, whose slider-to-mesh
+    times are printed (pytest -s)."""
+    if not os.path.isfile(os.path.join(os.path.dirname(es.__file__), "explore", "web",
+                                       "node_modules", "three", "build", "three.module.js")):
+        pytest.skip("three.js is not installed (tools/setup.sh: npm ci)")
+    srv = Server(study, "--pca", "p")
+    d = None
+    try:
+        d = chromium()
+        d.get(srv.url)
+        wait_for(d, SETTLED, what="the mean's mesh")
+        from selenium.webdriver.common.action_chains import ActionChains
+        from selenium.webdriver.common.by import By
+        dot = d.find_element(By.CSS_SELECTOR, "#scatter circle[data-row='face_s05_happy']")
+        ActionChains(d).move_to_element(dot).perform()
+        wait_for(d, "return document.getElementById('hover').textContent === "
+                    "'face_s05_happy (expression happy)'", 10, "the hovered row's name")
+        first = d.execute_script(DRAG, "pc1", -1.5, 1.5, 31, 16)
+        wait_for(d, f"return window.esExplorer.state.seq >= {first + 30}", 30, "the drag")
+        last = wait_for(d, SETTLED, what="the drag's last mesh")
+        assert last == first + 30
+        wait_for(d, f"return window.esExplorer.state.timings[{last}].tDrawn", 10, "the frame")
+        shape = d.execute_script("const s = window.esExplorer.last; return {expr: s.expr, "
+                                 "init: s.report.init, rms: s.report.rms_ratio, "
+                                 "V: Array.from(s.positions)};")
+        assert shape["expr"] == "mean + 1.5*pc:1" and "last output" in shape["init"]
+        timings = d.execute_script("return window.esExplorer.timings")
+        for i in range(12):                      # single moves, each once the last is drawn
+            d.execute_script("window.esExplorer.setSlider('pc1', arguments[0])", 1.25 - 0.25 * i)
+            wait_for(d, SETTLED, what=f"step {i}")
+        wait_for(d, "const t = window.esExplorer.timings; return t[t.length - 1].tDrawn", 10,
+                 "the last step's frame")
+        steps = d.execute_script("return window.esExplorer.timings")[len(timings):]
+    finally:
+        if d is not None:
+            d.quit()
+        rc, err = srv.stop()
+    assert rc == 0, err
+    V = np.array(shape["V"]).reshape(-1, 3)
+    with es.Store(study) as s:
+        E = s.edges
+        pt = s.point_weights(shape["expr"], pca="p")
+    want = pt.lengths * pt.scale
+    got = np.linalg.norm(V[E[:, 0]] - V[E[:, 1]], axis=1)
+    rms = np.sqrt(np.mean((got - want) ** 2)) / want.mean()
+    assert np.isclose(rms, shape["rms"], rtol=1e-6) and rms < 5e-3
+    # the page's shown positions, replayed in order: the mean (seq 1, the page's
+    # first request) and every drag position that was solved, not superseded
+    solved = [t for t in timings if "tRecv" in t and t["seq"] <= last]
+    assert solved[0]["seq"] == 1 and solved[-1]["seq"] == last
+    ex = Explorer(study, pca="p")
+    try:
+        for t in solved:
+            mine = ex.embed({t["key"]: t["value"]} if t["key"] else {})
+    finally:
+        ex.close()
+    assert np.max(np.abs(mine.V - V)) <= 1e-9 * bbox(V)
+    drag = [t["tDrawn"] - t["tInput"] for t in solved[1:] if "tDrawn" in t]
+    step = [t["tDrawn"] - t["tInput"] for t in steps]
+    server = [1000 * t["server"] for t in steps]
+    print(f"\nslider input -> mesh drawn, {V.shape[0]} vertices, load average "
+          f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs: drag at 60 Hz median %.0f ms, "
+          f"p95 %.0f ms ({len(drag)} of 31 drawn); single steps median %.0f ms, p95 %.0f ms "
+          f"(the server's embedding %.0f ms median)"
+          % (*percentiles(drag), *percentiles(step), percentiles(server)[0]))
+
+
 def test_face_study_with_every_kind_of_slider(tmp_path):
     """Real data when ../shared has it: face-study (9.4K vertices) with a PCA,
     a smile and a model of expression and subject, whose subject

@@ -34,14 +34,6 @@ ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(ROOT, "python"))
 sys.path.insert(0, os.path.join(ROOT, "python", "tests"))
 
-DRAG = """const [key, lo, hi, n, dt] = arguments; const x = window.esExplorer;
-let i = 0; const first = x.state.seq + 1;
-const timer = setInterval(() => {
-  x.setSlider(key, +(lo + (hi - lo) * i / (n - 1)).toFixed(4));
-  if (++i === n) clearInterval(timer);
-}, dt);
-return first;"""
-
 
 def edgespace_exe():
     return os.environ.get("EDGESPACE", os.path.join(ROOT, "build", "tools", "edgespace"))
@@ -93,7 +85,7 @@ def main():
     ap.add_argument("--hi", type=float, default=3.0)
     ap.add_argument("--screenshot", default=None, help="save the page's PNG here at the end")
     a = ap.parse_args()
-    from test_explore import SETTLED, Server, chromium, wait_for
+    from test_explore import DRAG, SETTLED, Server, chromium, wait_for
     tmp = tempfile.mkdtemp(prefix="bench_explore-")
     try:
         store = a.store or face_study(tmp)
