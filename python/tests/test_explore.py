@@ -139,6 +139,33 @@ def test_warm_positions_realize_their_lengths_near_the_cold_ones(study):
     assert np.sqrt(np.mean(np.sum((shape.V - cold_V) ** 2, axis=1))) < 0.01 * bbox(cold_V)
 
 
+def kabsch(P, Q):
+    """P moved rigidly onto Q (least squares, no reflection; numpy's SVD)."""
+    p0, q0 = P.mean(axis=0), Q.mean(axis=0)
+    U, _, Wt = np.linalg.svd((P - p0).T @ (Q - q0))
+    D = np.diag([1.0, 1.0, np.sign(np.linalg.det(U @ Wt))])
+    return (P - p0) @ (U @ D @ Wt) + q0
+
+
+def test_the_heat_maps_are_what_their_names_say(cold, study, tmp_path):
+    """displacement: each vertex's distance from the mean shape, here from
+    `edgespace embed`'s mesh of the mean; deviation: from the prior of the
+    position's row weights, scaled to the output's size and aligned rigidly,
+    in % of its bounding-box diagonal (numpy's Kabsch)."""
+    shape = cold.embed({"pc2": 1.5, "diff:smile": 0.5})
+    mean = cli_embed(study, cold.mean_expr, tmp_path / "mean.ply")
+    want = np.linalg.norm(shape.V - mean, axis=1)
+    assert np.max(np.abs(shape.heat["displacement"] - want)) <= 1e-9 * bbox(mean)
+    _, w = cold._lengths(shape.t)
+    P = cold.session.prior_positions(w)
+    E = cold.store.edges
+    size = lambda X: np.linalg.norm(X[E[:, 0]] - X[E[:, 1]], axis=1).sum()   # noqa: E731
+    P *= size(shape.V) / size(P)
+    dev = 100 * np.linalg.norm(kabsch(shape.V, P) - P, axis=1) / bbox(P)
+    assert np.max(np.abs(shape.heat["deviation"] - dev)) <= 1e-7 * dev.max()
+    assert np.isclose(np.sqrt(np.mean(dev ** 2)), 100 * shape.report["prior_rms"], rtol=1e-9)
+
+
 def test_a_point_that_breaks_the_triangle_inequality_is_flagged(cold):
     shape = cold.embed({"pc1": 3})      # on these faces: 5 faces broken
     r = shape.report
@@ -593,7 +620,8 @@ def test_a_warm_drag_in_chromium(study, tmp_path):
         wait_for(d, f"return window.esExplorer.state.timings[{last}].tDrawn", 10, "the frame")
         shape = d.execute_script("const s = window.esExplorer.last; return {expr: s.expr, "
                                  "init: s.report.init, rms: s.report.rms_ratio, "
-                                 "V: Array.from(s.positions)};")
+                                 "V: Array.from(s.positions), "
+                                 "heat: Array.from(s.heat.displacement.data)};")
         assert shape["expr"] == "mean + 1.5*pc:1" and "last output" in shape["init"]
         timings = d.execute_script("return window.esExplorer.timings")
         for i in range(12):                      # single moves, each once the last is drawn
@@ -626,6 +654,9 @@ def test_a_warm_drag_in_chromium(study, tmp_path):
     finally:
         ex.close()
     assert np.max(np.abs(mine.V - V)) <= 1e-9 * bbox(V)
+    # the heat map travels beside the positions: distances from the mean shape
+    heat = np.linalg.norm(V - ex.mean_V, axis=1)
+    assert np.max(np.abs(np.array(shape["heat"]) - heat)) <= 1e-9 * bbox(V)
     drag = [t["tDrawn"] - t["tInput"] for t in solved[1:] if "tDrawn" in t]
     step = [t["tDrawn"] - t["tInput"] for t in steps]
     server = [1000 * t["server"] for t in steps]
