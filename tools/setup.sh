@@ -40,8 +40,10 @@ packages=(
   r-cran-ape r-cran-ggplot2  # RRPP's imports (with r-cran-matrix), for the optional RRPP
                              # oracle built from source by tools/oracle/install_rrpp.sh
   # edgespace explore's server and the Jupyter widget (python/edgespace/explore,
-  # edgespace/widgets.py), and headless Chromium driving the page in its tests
+  # edgespace/widgets.py; python3-ipywidgets brings the widgets' nbextension), and
+  # headless Chromium driving the page, and the widget in the classic notebook, in tests
   python3-aiohttp python3-ipywidgets chromium chromium-driver python3-selenium
+  jupyter-notebook
 )
 # Debian packages installed only when their command is missing: npm fetches
 # three.js for the explorer's page (an npm from another source, such as the

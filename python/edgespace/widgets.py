@@ -115,7 +115,10 @@ class ExplorerWidget(W.HBox):
         right = W.VBox([self.expr, self.command, self.warning, self.error, self.view,
                         W.HBox([self.heat, self.png_button]),
                         W.HBox([self.azimuth, self.elevation]),
-                        W.HBox([self.name, self.format, self.save_button]), self.status])
+                        W.HBox([self.name, self.format, self.save_button]), self.status],
+                       # as wide as the view: the point's box would fill the notebook's
+                       # width and run past a classic notebook's cell
+                       layout=W.Layout(width=f"{self.size + 40}px"))
         super().__init__([left, right])
         self._thread = threading.Thread(target=self._work, name="edgespace-explore",
                                         daemon=True)

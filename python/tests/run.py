@@ -30,7 +30,8 @@ GROUPS = {
     # executing notebooks-py/*.ipynb with Debian's python3 as the kernel
     "notebooks": {"nbconvert": "jupyter-nbconvert", "ipykernel": "python3-ipykernel"},
     # edgespace explore's server, the Jupyter widget, and the browser that
-    # drives the page in test_explore.py
+    # drives the page in test_explore.py and the widget in a classic notebook
+    # (test_widgets.py)
     "explore": {"aiohttp": "python3-aiohttp", "ipywidgets": "python3-ipywidgets"},
     "browser": {"selenium": "python3-selenium"},
     # oracles: SciPy's fmin_l_bfgs_b, the minimizer of the published pipeline
@@ -38,7 +39,8 @@ GROUPS = {
     "oracle": {"scipy": "python3-scipy"},
 }
 PROGRAMS = {"notebooks": {"jupyter-nbconvert": "jupyter-nbconvert"},
-            "browser": {"chromium": "chromium", "chromedriver": "chromium-driver"}}
+            "browser": {"chromium": "chromium", "chromedriver": "chromium-driver",
+                        "jupyter-notebook": "jupyter-notebook"}}
 # files installed from elsewhere than Debian: three.js, from the npm registry
 # (tools/setup.sh runs npm ci in python/edgespace/explore/web)
 THREE = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "edgespace",

@@ -28,6 +28,7 @@ import edgespace as es
 pytest.importorskip("aiohttp")
 from edgespace.explore import Explorer, RequestError   # noqa: E402 (needs aiohttp)
 
+from browser import chromium, screenshot_dir, wait_for   # noqa: E402
 from conftest import cli_path   # noqa: E402
 
 URL_RE = re.compile(r"^(http://127\.0\.0\.1:(\d+)/\?token=([A-Za-z0-9_-]+))$", re.M)
@@ -435,46 +436,9 @@ def test_concurrent_clients_each_get_their_newest_position(server, cold):
 
 
 # -- the page, in Chromium -----------------------------------------------------------------
-def chromium():
-    """A headless Chromium driven by selenium (python3-selenium,
-    chromium-driver), or a skip naming what is missing."""
-    webdriver = pytest.importorskip("selenium.webdriver")
-    from selenium.webdriver.chrome.service import Service
-    driver = shutil.which("chromedriver")
-    if not driver or not shutil.which("chromium"):
-        pytest.skip("chromium and chromium-driver are not installed (tools/setup.sh)")
-    o = webdriver.ChromeOptions()
-    for a in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage",
-              "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
-              "--window-size=1400,900", "--disable-gpu-sandbox"):
-        o.add_argument(a)
-    o.binary_location = shutil.which("chromium")
-    o.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    return webdriver.Chrome(service=Service(driver), options=o)
-
-
-def wait_for(driver, script, timeout=60, what=""):
-    deadline = time.time() + timeout
-    while time.time() < deadline:
-        v = driver.execute_script(script)
-        if v:
-            return v
-        time.sleep(0.05)
-    errors = driver.execute_script("return window.esExplorer && window.esExplorer.errors")
-    raise AssertionError(f"timed out waiting for {what or script} (errors: {errors})")
-
-
 SETTLED = """const x = window.esExplorer; if (!x || !x.last) return false;
 const t = x.timings; const seq = x.state.seq;
 return x.last.seq === seq || (t.length && t[t.length - 1].error) ? x.last.seq : false;"""
-
-
-def screenshot_dir(tmp_path):
-    d = os.environ.get("EDGESPACE_SCREENSHOTS")
-    if d:
-        os.makedirs(d, exist_ok=True)
-        return d
-    return str(tmp_path)
 
 
 def test_the_page_in_chromium(study, tmp_path):

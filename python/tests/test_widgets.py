@@ -6,8 +6,12 @@ to 1e-9 of the bounding-box diagonal; the PNG signature and size of the
 view; the store and the files a save leaves (the command's reader)."""
 import html
 import os
+import secrets
 import shutil
+import socket
 import subprocess
+import time
+import urllib.request
 
 import numpy as np
 import pytest
@@ -92,3 +96,120 @@ def test_a_row_and_saving_from_the_widget(widget, store_path):
         assert np.array_equal(s.mesh.read_positions(out["path"]), widget.shape.V)
     assert widget._save() is None and "exists" in widget.error.value
     shutil.rmtree(os.path.dirname(out["path"]), ignore_errors=True)
+
+
+class ClassicNotebook:
+    """Debian's classic notebook server (jupyter-notebook, with the widgets'
+    nbextension that python3-ipywidgets brings) on a free loopback port with
+    a random token, its config and runtime files in `folder`, until stop().
+    Its kernels get this process's environment (the library, PYTHONPATH)."""
+
+    def __init__(self, folder):
+        exe = shutil.which("jupyter-notebook")
+        if exe is None:
+            pytest.skip("jupyter-notebook is not installed (tools/setup.sh)")
+        with socket.socket() as s:
+            s.bind(("127.0.0.1", 0))
+            self.port = s.getsockname()[1]
+        self.token = secrets.token_hex(16)
+        env = dict(os.environ)
+        for var, sub in (("JUPYTER_CONFIG_DIR", "cfg"), ("JUPYTER_RUNTIME_DIR", "rt"),
+                         ("JUPYTER_DATA_DIR", "data"), ("IPYTHONDIR", "ipython")):
+            env[var] = str(folder / sub)
+        args = [exe, "--no-browser", "--ip=127.0.0.1", f"--port={self.port}", "--port-retries=0",
+                f"--NotebookApp.token={self.token}", f"--notebook-dir={folder}"]
+        if os.geteuid() == 0:
+            args.append("--allow-root")
+        self.log = open(folder / "notebook.log", "w")
+        self.proc = subprocess.Popen(args, env=env, stdout=self.log, stderr=subprocess.STDOUT)
+        deadline = time.time() + 60
+        while time.time() < deadline and self.proc.poll() is None:
+            try:
+                urllib.request.urlopen(f"{self.url('api/status')}", timeout=5).read()
+                return
+            except OSError:
+                time.sleep(0.3)
+        self.stop()
+        raise AssertionError(f"jupyter-notebook did not answer:\n{(folder / 'notebook.log').read_text()}")
+
+    def url(self, path):
+        return f"http://127.0.0.1:{self.port}/{path}?token={self.token}"
+
+    def stop(self):
+        self.proc.terminate()
+        try:
+            self.proc.wait(30)
+        finally:
+            if self.proc.poll() is None:
+                self.proc.kill()
+                self.proc.wait()
+            self.log.close()
+
+
+def test_the_widget_in_a_classic_notebook_in_chromium(store_path, tmp_path):
+    """The widget in a real front end: Debian's classic notebook in headless
+    Chromium runs a cell that makes it; PageUp on PC 1's slider (a fifth of
+    its range: 1.2 sd) travels to the kernel, the page shows the point and a
+    new view, and the kernel's shape is `edgespace embed --fast` of that
+    point to 1e-9 x bbox."""
+    if not es.has_figures():
+        pytest.skip("the widget's view needs a library with figures (cairo)")
+    from browser import chromium, screenshot_dir, wait_for
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.common.keys import Keys
+    import nbformat
+    with es.Store(store_path, write=True, ctx=es.Context(progress=None)) as s:
+        s.pca("p", ncomp=3)
+    nb = nbformat.v4.new_notebook()
+    nb.cells.append(nbformat.v4.new_code_cell(
+        f"import edgespace.widgets as ew\nw = ew.explore({str(store_path)!r}, pca='p', warm=False)\nw"))
+    nbformat.write(nb, str(tmp_path / "explore.ipynb"))
+    d = chromium()
+    server = ClassicNotebook(tmp_path)
+    try:
+        d.get(server.url("notebooks/explore.ipynb"))
+        wait_for(d, "return window.Jupyter && Jupyter.notebook && Jupyter.notebook.kernel && "
+                    "Jupyter.notebook.kernel.is_connected()", 180, "the kernel")
+        d.execute_script("Jupyter.notebook.execute_all_cells()")
+        try:
+            wait_for(d, "return document.querySelectorAll('.ui-slider-handle').length >= 5 && "
+                        "document.querySelectorAll('.widget-area img').length >= 2", 90,
+                     "the widget drawn in the notebook")
+        except AssertionError as e:
+            d.save_screenshot(os.path.join(screenshot_dir(tmp_path), "widget_notebook.png"))
+            out = d.execute_script("return Array.from(document.querySelectorAll('.output_area'))"
+                                   ".map(e => e.innerText).join('\\n')")
+            log = [x["message"][-300:] for x in d.get_log("browser")]
+            raise AssertionError(f"{e}; the cell's output: {out[-3000:]}; the browser's "
+                                 f"console: {log[-20:]}") from None
+        images = "return Array.from(document.querySelectorAll('.widget-area img')).map(e => e.src)"
+        before = d.execute_script(images)
+        expr = "return Array.from(document.querySelectorAll('.widget-text input')).map(e => e.value)"
+        assert "mean" in d.execute_script(expr)
+        d.find_elements(By.CSS_SELECTOR, ".ui-slider-handle")[0].send_keys(Keys.PAGE_UP)
+        wait_for(d, "return Array.from(document.querySelectorAll('.widget-text input'))"
+                    ".some(e => e.value === 'mean + 1.2*pc:1')", 60, "the point in the page")
+        wait_for(d, f"const s = {images[7:]}; return s.length === {len(before)} && "
+                    f"s.every((x, i) => x !== {before}[i])", 60, "the new view and scatter")
+        d.save_screenshot(os.path.join(screenshot_dir(tmp_path), "widget_notebook.png"))
+        out = tmp_path / "kernel.npy"
+        d.execute_script("const c = Jupyter.notebook.insert_cell_below('code', 0);"
+                         "c.set_text(arguments[0]); c.execute();",
+                         f"import numpy as np\nassert w.wait(60)\n"
+                         f"np.save({str(out)!r}, w.shape.V) if w.shape.expr == 'mean + 1.2*pc:1' "
+                         "else None")
+        wait_for(d, "return Jupyter.notebook.kernel_busy === false && "
+                    "document.querySelectorAll('.input_prompt')[1].textContent.includes('2')",
+                 60, "the second cell")
+    finally:
+        d.quit()
+        server.stop()
+    V = np.load(out)
+    cli = tmp_path / "cli.ply"
+    r = subprocess.run([cli_path(), "embed", str(store_path), "--pca", "p", "--point",
+                        "mean + 1.2*pc:1", "-o", str(cli), "--fast", "--no-store"],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    with es.Store(store_path) as st:
+        want = st.mesh.read_positions(cli)
+    assert np.max(np.abs(V - want)) <= 1e-9 * np.linalg.norm(want.max(axis=0) - want.min(axis=0))

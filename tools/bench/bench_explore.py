@@ -85,7 +85,8 @@ def main():
     ap.add_argument("--hi", type=float, default=3.0)
     ap.add_argument("--screenshot", default=None, help="save the page's PNG here at the end")
     a = ap.parse_args()
-    from test_explore import DRAG, SETTLED, Server, chromium, wait_for
+    from browser import chromium, wait_for
+    from test_explore import DRAG, SETTLED, Server
     tmp = tempfile.mkdtemp(prefix="bench_explore-")
     try:
         store = a.store or face_study(tmp)
