@@ -555,7 +555,8 @@ def percentiles(xs):
 
 def test_a_warm_drag_in_chromium(study, tmp_path):
     """The explorer as a user starts it (warm starts, slider accuracy):
-    hovering a row names it; a drag across PC 1 at 60 Hz ends on the newest
+    hovering a row names it; the copy buttons copy the point and its
+    command; a drag across PC 1 at 60 Hz ends on the newest
     position; the mesh received realizes the library's lengths of the
     expression shown (numpy edge lengths: the report's RMS, < 0.5 %), and
     equals the same positions solved in the same order by an Explorer of
@@ -587,6 +588,18 @@ def test_a_warm_drag_in_chromium(study, tmp_path):
                                  "V: Array.from(s.positions), "
                                  "heat: Array.from(s.heat.displacement.data)};")
         assert shape["expr"] == "mean + 1.5*pc:1" and "last output" in shape["init"]
+        # the copy buttons put the point and its command on the clipboard
+        d.execute_cdp_cmd("Browser.grantPermissions", {
+            "origin": srv.url.split("/?")[0],
+            "permissions": ["clipboardReadWrite", "clipboardSanitizedWrite"]})
+        clip = "navigator.clipboard.readText().then(arguments[0], e => arguments[0]('! ' + e))"
+        for button, want in (("copy-expr", shape["expr"]),
+                             ("copy-cmd", d.find_element(By.ID, "cmd").text)):
+            d.find_element(By.ID, button).click()
+            deadline = time.time() + 10
+            while (got := d.execute_async_script(clip)) != want and time.time() < deadline:
+                time.sleep(0.05)
+            assert got == want, (button, got)
         timings = d.execute_script("return window.esExplorer.timings")
         for i in range(12):                      # single moves, each once the last is drawn
             d.execute_script("window.esExplorer.setSlider('pc1', arguments[0])", 1.25 - 0.25 * i)
