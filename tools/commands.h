@@ -25,6 +25,7 @@ int cmd_ingest_landmarks(int argc, char **argv);
 /* -- embedding, interpolation */
 int cmd_embed(int argc, char **argv);
 int cmd_interp(int argc, char **argv);
+int cmd_explore(int argc, char **argv);
 /* -- plotting, rendering */
 int cmd_render(int argc, char **argv);
 int cmd_plot(int argc, char **argv);

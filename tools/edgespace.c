@@ -39,6 +39,7 @@ static const command commands[] = {
     /* -- embedding, interpolation */
     {"embed", cmd_embed, "realize a point of edge-length space as a mesh, with a quality report"},
     {"interp", cmd_interp, "interpolate/extrapolate stored shapes in edge-length space and embed"},
+    {"explore", cmd_explore, "explore a store by hand in a browser: sliders, scatter, meshes as you drag"},
     /* -- plotting, rendering */
 #if ES_HAVE_FIGURES
     {"render", cmd_render, "draw meshes side by side to PNG/SVG/PDF"},

@@ -39,12 +39,24 @@ packages=(
   r-cran-vegan               # the oracle of edgespace model (tools/oracle/adonis2.R)
   r-cran-ape r-cran-ggplot2  # RRPP's imports (with r-cran-matrix), for the optional RRPP
                              # oracle built from source by tools/oracle/install_rrpp.sh
+  # edgespace explore's server and the Jupyter widget (python/edgespace/explore,
+  # edgespace/widgets.py; python3-ipywidgets brings the widgets' nbextension), and
+  # headless Chromium driving the page, and the widget in the classic notebook, in tests
+  python3-aiohttp python3-ipywidgets chromium chromium-driver python3-selenium
+  jupyter-notebook
 )
+# Debian packages installed only when their command is missing: npm fetches
+# three.js for the explorer's page (an npm from another source, such as the
+# one bundled with NodeSource's nodejs, does as well and is left alone)
+commands=(npm:npm)
 
 install_missing() {
   local missing=()
   for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  for c in "${commands[@]}"; do
+    command -v "${c%%:*}" >/dev/null 2>&1 || missing+=("${c#*:}")
   done
   [ ${#missing[@]} -eq 0 ] && return 0
   echo "setup: installing ${missing[*]}" >&2
@@ -63,6 +75,20 @@ configure_and_build() {
     meson setup "$build_dir" ${MESON_ARGS:-} >/dev/null
   fi
   ninja -C "$build_dir" >&2
+}
+
+# three.js for edgespace explore's page, from the npm registry at the version
+# and checksum python/edgespace/explore/web/package-lock.json pins, into
+# web/node_modules (not committed), which the server serves: the page loads
+# nothing from elsewhere. Skipped when that version is there already.
+install_web() {
+  local web="$here/python/edgespace/explore/web" want have
+  want=$(node -p "require('$web/package-lock.json').packages['node_modules/three'].version")
+  have=$(node -p "try { require('$web/node_modules/three/package.json').version } catch (e) { '' }")
+  if [ "$want" != "$have" ]; then
+    echo "setup: three.js $want for edgespace explore (npm ci)" >&2
+    (cd "$web" && npm ci --ignore-scripts --no-audit --no-fund --loglevel=error >&2)
+  fi
 }
 
 # python/ on Debian's interpreter's path (idempotent; rewritten when the
@@ -86,6 +112,7 @@ install_python() {
 }
 
 install_missing
+install_web
 case "$mode" in
   build) configure_and_build; install_python ;;
   demo)  configure_and_build; install_python; bash tools/main-job.sh "$build_dir" ;;

@@ -89,9 +89,11 @@ class Freed:
         self._ctx = ctx
         self.ptr = ptr
 
-    def __del__(self):
-        if self.ptr is not None and self.ptr != ffi.NULL:
-            lib.es_free(self._ctx.ptr, self.ptr)
+    # ffi.NULL and es_free bound here: at interpreter exit this may run after
+    # the module's globals are cleared
+    def __del__(self, _null=ffi.NULL, _free=lib.es_free):
+        if self.ptr is not None and self.ptr != _null:
+            _free(self._ctx.ptr, self.ptr)
             self.ptr = None
 
 

@@ -27,22 +27,31 @@ class EdgespaceWarning(UserWarning):
     """A warning logged by libedgespace (es__warn)."""
 
 
+def _in_kernel():
+    """True in a Jupyter kernel (an IPython shell with a kernel). Not "is
+    ipykernel imported": ipywidgets imports it in any process."""
+    ip = sys.modules.get("IPython")
+    shell = ip.get_ipython() if ip is not None and hasattr(ip, "get_ipython") else None
+    return getattr(shell, "kernel", None) is not None
+
+
 def _tqdm():
     """tqdm's bar class for where we run: widgets in a Jupyter kernel that has
-    ipywidgets 7 or later (tqdm.notebook's need; Debian 12's 6.0 sends widget
-    messages that nbclient cannot read, and a notebook executed by nbconvert
-    then fails with KeyError 'state'), text on a terminal; None where neither
-    would read well (a kernel without usable widgets, where text bars leave
-    blank lines) or without tqdm."""
+    ipywidgets 7 or later (tqdm.notebook's need: with Debian 12's ipywidgets
+    6 its bars raise AttributeError, and its widget messages are ones nbclient
+    cannot read, so a notebook executed by nbconvert fails with KeyError
+    'state'), text elsewhere; None where neither would read well (a kernel
+    without usable widgets, where text bars leave blank lines) or without
+    tqdm."""
     try:
-        if "ipykernel" in sys.modules:
+        if _in_kernel():
             import ipywidgets
             if int(str(getattr(ipywidgets, "__version__", "0")).split(".")[0]) < 7:
                 return None
             from tqdm.notebook import tqdm
         else:
             from tqdm.std import tqdm
-    except ImportError:
+    except (ImportError, ValueError):
         return None
     return tqdm
 

@@ -105,7 +105,12 @@ try:
 except cffi.CDefError as e:   # a header construct the binding cannot read
     raise LoadError(f"reading the headers in {INCLUDE_DIR}: {e}") from e
 try:
-    lib = ffi.dlopen(LIBRARY_PATH)
+    # RTLD_NODELETE: the library stays mapped after cffi's handle closes at
+    # interpreter exit, when objects that free library memory (ffi.gc, numpy
+    # views of it) may still be collected; without it such a collection
+    # called into unmapped code (a SIGSEGV after the test suite had passed,
+    # once ipywidgets' imports had changed the order of the exit)
+    lib = ffi.dlopen(LIBRARY_PATH, ffi.RTLD_NOW | ffi.RTLD_NODELETE)
 except OSError as e:
     raise LoadError(f"loading {LIBRARY_PATH}: {e}") from e
 

@@ -34,27 +34,69 @@ class StudyEmbedder:
             raise ValueError("the embedding session is closed")
         return self._ptr
 
-    def embed(self, point, pca=None, scale=0.0, warm=True, fast=False, **opts):
-        """Embedding(V, F, report) of a point expression
-        (datasets-spec/point-syntax.md) in the store's frame. warm: from the
-        last point's correction of its prior; fast: es_embed_opts_fast (a
-        slider's accuracy); opts: es_embed_opts fields."""
+    @staticmethod
+    def _opts(fast, opts):
         eo = ffi.new("es_embed_opts *")
         if fast:
             lib.es_embed_opts_fast(eo)
         else:
             lib.es_embed_opts_init(eo)
         set_embed_opts(eo, opts)
+        return eo
+
+    def _result(self, xyz, res):
+        rep = report_dict(res.report)
+        rep["scale"] = float(res.scale)
+        rep["init"] = ffi.string(res.init).decode("utf-8", "replace")
+        return Embedding(xyz, self.faces, rep)
+
+    def solve(self, lengths, scale, weights, warm=True, exact=False, fast=False, **opts):
+        """Embedding(V, F, report) of lengths (E,) at sum `scale` near the
+        prior of row weights (N,) (es_study_embedder_solve): what embed()
+        does after evaluating its expression, for callers that form lengths
+        and weights themselves (a slider: the mean plus multiples of
+        directions evaluated once). exact: the lengths are one real mesh's."""
+        L = A.f64(lengths, (self.store.nedges,), "lengths")
+        w = A.f64(weights, (self.store.nrows,), "weights")
+        eo = self._opts(fast, opts)
+        xyz = np.empty((self.store.nverts, 3))
+        res = ffi.new("es_study_embed_result *")
+        self.ctx.call(lib.es_study_embedder_solve, self.ptr, A.dptr(L), float(scale), A.dptr(w), eo,
+                      1 if warm else 0, 1 if exact else 0, A.dptr(xyz), res)
+        return self._result(xyz, res)
+
+    def vertex_deviation(self):
+        """(V,) each vertex's distance from the prior's realization in the
+        last solve, as a fraction of its bounding-box diagonal
+        (es_embedder_vertex_deviation; a copy), or None before one."""
+        p = lib.es_embedder_vertex_deviation(lib.es_study_embedder_embedder(self.ptr))
+        if p == ffi.NULL:
+            return None
+        return np.array(A.view(p, (self.store.nverts,), self))
+
+    def prior_positions(self, weights):
+        """(V, 3) the prior's realization of row weights (N,) in the store's
+        frame (es_study_prior on the session's rows): for one row weighted 1,
+        that row's mesh aligned into the frame every embedding shares."""
+        w = A.f64(weights, (self.store.nrows,), "weights")
+        xyz = np.empty((self.store.nverts, 3))
+        self.ctx.call(lib.es_study_prior, lib.es_study_embedder_rows(self.ptr), A.dptr(w),
+                      A.dptr(xyz), ffi.NULL, ffi.NULL)
+        return xyz
+
+    def embed(self, point, pca=None, scale=0.0, warm=True, fast=False, **opts):
+        """Embedding(V, F, report) of a point expression
+        (datasets-spec/point-syntax.md) in the store's frame. warm: from the
+        last point's correction of its prior; fast: es_embed_opts_fast (a
+        slider's accuracy); opts: es_embed_opts fields."""
+        eo = self._opts(fast, opts)
         xyz = np.empty((self.store.nverts, 3))
         res = ffi.new("es_study_embed_result *")
         keep = [ffi.new("char[]", str(point).encode()),
                 ffi.new("char[]", str(pca).encode()) if pca is not None else ffi.NULL]
         self.ctx.call(lib.es_study_embedder_point, self.ptr, keep[0], keep[1], float(scale), eo,
                       1 if warm else 0, A.dptr(xyz), res)
-        rep = report_dict(res.report)
-        rep["scale"] = float(res.scale)
-        rep["init"] = ffi.string(res.init).decode("utf-8", "replace")
-        return Embedding(xyz, self.faces, rep)
+        return self._result(xyz, res)
 
     def forget(self):
         """The next warm embedding starts from its own prior."""

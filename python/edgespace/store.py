@@ -240,6 +240,7 @@ class Store:
         if self._ptr is None:
             return
         self._close_sessions()
+        self._mesh = None     # freed now, while its context lives
         try:
             if self.writable:
                 self.commit()
@@ -251,6 +252,7 @@ class Store:
         """Close, discarding uncommitted writes."""
         if self._ptr is not None:
             self._close_sessions()
+            self._mesh = None
             ffi.gc(self._ptr, None)   # no es_store_close at collection
             lib.es_store_abort(self._ptr)
             self._ptr = None
@@ -482,6 +484,17 @@ class Store:
         v, n = ffi.new("int64_t **"), ffi.new("int64_t *")
         self.ctx.call(lib.es_store_get_ints, self.ptr, _s(path), v, n)
         return A.view(v[0], (n[0],), A.Freed(self.ctx, v[0]), "i8")
+
+    def get_strings(self, path):
+        """A stored 1-D string dataset "<kind>/<name>/<dataset>" as a list of str."""
+        v, n = ffi.new("char ***"), ffi.new("int64_t *")
+        self.ctx.call(lib.es_store_get_strings, self.ptr, _s(path), v, n)
+        out = []
+        for i in range(n[0]):
+            out.append(A.string(v[0][i]))
+            lib.es_free(self.ctx.ptr, v[0][i])
+        lib.es_free(self.ctx.ptr, v[0])
+        return out
 
     def get_attr(self, path, key):
         buf = ffi.new("char[]", 4096)

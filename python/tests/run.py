@@ -15,6 +15,7 @@ or goes red, never skips them quietly.
     run.py --check                                  exit 1 unless all are there
 """
 import importlib.util
+import os
 import shutil
 import sys
 
@@ -28,11 +29,23 @@ GROUPS = {
     "optional": {"tqdm": "python3-tqdm", "pandas": "python3-pandas"},
     # executing notebooks-py/*.ipynb with Debian's python3 as the kernel
     "notebooks": {"nbconvert": "jupyter-nbconvert", "ipykernel": "python3-ipykernel"},
+    # edgespace explore's server, the Jupyter widget, and the browser that
+    # drives the page in test_explore.py and the widget in a classic notebook
+    # (test_widgets.py)
+    "explore": {"aiohttp": "python3-aiohttp", "ipywidgets": "python3-ipywidgets"},
+    "browser": {"selenium": "python3-selenium"},
     # oracles: SciPy's fmin_l_bfgs_b, the minimizer of the published pipeline
     # (test_paper_oracle.py; skipped without it, and --check fails)
     "oracle": {"scipy": "python3-scipy"},
 }
-PROGRAMS = {"notebooks": {"jupyter-nbconvert": "jupyter-nbconvert"}}
+PROGRAMS = {"notebooks": {"jupyter-nbconvert": "jupyter-nbconvert"},
+            "browser": {"chromium": "chromium", "chromedriver": "chromium-driver",
+                        "jupyter-notebook": "jupyter-notebook"}}
+# files installed from elsewhere than Debian: three.js, from the npm registry
+# (tools/setup.sh runs npm ci in python/edgespace/explore/web)
+THREE = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "edgespace",
+                     "explore", "web", "node_modules", "three", "build", "three.module.js")
+FILES = {"explore": {THREE: "three.js (npm ci in python/edgespace/explore/web)"}}
 
 
 def missing(groups):
@@ -45,6 +58,9 @@ def missing(groups):
         for prog, pkg in PROGRAMS.get(g, {}).items():
             if shutil.which(prog) is None and pkg not in out:
                 out.append(pkg)
+        for path, what in FILES.get(g, {}).items():
+            if not os.path.exists(path) and what not in out:
+                out.append(what)
     return out
 
 
@@ -52,7 +68,7 @@ def main(argv):
     if argv == ["--check"]:
         lack = missing(GROUPS)
         if lack:
-            print(f"python: {sys.executable} lacks the Debian packages {' '.join(lack)}",
+            print(f"python: {sys.executable} lacks {', '.join(lack)}",
                   file=sys.stderr)
             return 1
         return 0

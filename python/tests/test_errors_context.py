@@ -4,7 +4,9 @@ Every es_status maps to its exception class (also a builtin of the same
 kind) carrying the library's own message (es_ctx_errmsg), checked on real
 failing calls; callbacks reach Python and an exception raised in one comes
 out of the call that ran it; the seed makes synthetic data reproducible."""
+import sys
 import threading
+import types
 import warnings
 
 import numpy as np
@@ -115,6 +117,26 @@ def test_tqdm_progress_when_installed(store_path):
     assert ctx.progress is not None
     with es.Store(store_path, ctx=ctx) as s:
         assert s.pca(ncomp=2).ncomp == 2
+
+
+def test_no_notebook_bars_outside_a_kernel_or_with_old_widgets(monkeypatch):
+    """ipywidgets imports ipykernel in any process: that is no kernel. In a
+    kernel, tqdm.notebook needs ipywidgets >= 7 (Debian 12 ships 6, whose
+    FloatProgress lacks .style): no bars then, rather than an error."""
+    pytest.importorskip("tqdm")
+    from edgespace import _context
+    monkeypatch.setitem(sys.modules, "ipykernel", types.ModuleType("ipykernel"))
+    from tqdm.std import tqdm
+    assert _context._tqdm() is tqdm
+    shell = types.SimpleNamespace(kernel=object())
+    fake_ipython = types.SimpleNamespace(get_ipython=lambda: shell)
+    monkeypatch.setitem(sys.modules, "IPython", fake_ipython)
+    monkeypatch.setitem(sys.modules, "ipywidgets", types.SimpleNamespace(__version__="6.0.0"))
+    assert _context._tqdm() is None
+    pytest.importorskip("tqdm.notebook")
+    monkeypatch.setitem(sys.modules, "ipywidgets", types.SimpleNamespace(__version__="8.1.2"))
+    from tqdm.notebook import tqdm as notebook_tqdm
+    assert _context._tqdm() is notebook_tqdm
 
 
 def test_library_warnings_become_python_warnings(tmp_path, faces_dir, ctx):
