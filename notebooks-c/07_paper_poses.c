@@ -405,13 +405,6 @@ static int report(notebook *nb, study *s)
     return 0;
 }
 
-static double worst(const double *v, int64_t n)
-{
-    double m = 0;
-    for (int64_t i = 0; i < n; i++) m = fmax(m, v[i]);
-    return m;
-}
-
 int main(int argc, char **argv)
 {
     notebook nb;
@@ -432,16 +425,16 @@ int main(int argc, char **argv)
                     "Fig. 6: expression change") &&
         !two_shapes(&nb, &s.arm, &s.fig3, t3, 4, "Fig. 3: the arm") && !report(&nb, &s)) {
         nb_step(&nb, "self-check");
-        nb_check(&nb, "Fig. 4: worst RMS ratio of a frame", worst(s.fig4.rms, s.fig4.nframes),
+        nb_check(&nb, "Fig. 4: worst RMS ratio of a frame", nb_worst(s.fig4.rms, s.fig4.nframes),
                  "<", 0.01);
-        nb_check(&nb, "Fig. 5: worst RMS ratio of a frame", worst(s.fig5.rms, s.fig5.nframes),
+        nb_check(&nb, "Fig. 5: worst RMS ratio of a frame", nb_worst(s.fig5.rms, s.fig5.nframes),
                  "<", 0.01);
-        nb_check(&nb, "Fig. 6: worst RMS ratio of a frame", worst(s.fig6.rms, s.fig6.nframes),
+        nb_check(&nb, "Fig. 6: worst RMS ratio of a frame", nb_worst(s.fig6.rms, s.fig6.nframes),
                  "<", 0.005);
-        nb_check(&nb, "Fig. 3: worst RMS ratio of a frame", worst(s.fig3.rms, s.fig3.nframes),
+        nb_check(&nb, "Fig. 3: worst RMS ratio of a frame", nb_worst(s.fig3.rms, s.fig3.nframes),
                  "<", 0.005);
         nb_check(&nb, "Fig. 4: vertex blend's worst edge / the frames' worst edge",
-                 worst(s.fig4.lin_max, s.fig4.nframes) / worst(s.fig4.max_rel, s.fig4.nframes),
+                 nb_worst(s.fig4.lin_max, s.fig4.nframes) / nb_worst(s.fig4.max_rel, s.fig4.nframes),
                  ">", 1);
         nb_check(&nb, "Fig. 3: vertex lerp's worst edge at t = 0.4-0.6 / the frames'",
                  fmax(s.fig3.lin_max[1], s.fig3.lin_max[2]) /

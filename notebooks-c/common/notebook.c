@@ -28,6 +28,13 @@ double nb_now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+double nb_worst(const double *v, int64_t n)
+{
+    double m = 0;
+    for (int64_t i = 0; i < n; i++) m = fmax(m, v[i]);
+    return m;
+}
+
 static int is_dir(const char *path)
 {
     struct stat st;

@@ -128,4 +128,7 @@ int nb_read_mesh(notebook *nb, const char *dir, const char *file, es_mesh **mesh
 /* Seconds on a monotonic clock. */
 double nb_now(void);
 
+/* The largest of v[0..n-1] and 0 (a worst error over frames or edges). */
+double nb_worst(const double *v, int64_t n);
+
 #endif
