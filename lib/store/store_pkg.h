@@ -127,9 +127,11 @@ unsigned es__h5_raw_addr_size(const es__h5_raw *raw);
 unsigned es__h5_raw_length_size(const es__h5_raw *raw);
 es_ctx *es__h5_raw_ctx(const es__h5_raw *raw);
 const char *es__h5_raw_path(const es__h5_raw *raw);
-/* Each message of an object header: return 0 to go on, 1 to stop (ES_OK),
- * -1 if it is malformed (ES_EFORMAT). ES_ENOTFOUND when no call stopped. */
-typedef int (*es__h5_msg_fn)(void *ud, unsigned type, const uint8_t *msg, uint64_t n);
+/* Each message of an object header (its type, flags and bytes): return 0
+ * to go on, 1 to stop (ES_OK), -1 if it is malformed (ES_EFORMAT).
+ * ES_ENOTFOUND when no call stopped. */
+typedef int (*es__h5_msg_fn)(void *ud, unsigned type, unsigned flags, const uint8_t *msg,
+                             uint64_t n);
 es_status es__h5_raw_messages(es__h5_raw *raw, uint64_t oaddr, es__h5_msg_fn fn, void *ud);
 /* The object header address of an open object (group, dataset, file: its
  * root group). */
@@ -140,11 +142,15 @@ es_status es__h5_object_addr(es_ctx *ctx, hid_t obj, uint64_t *addr);
  * runs out (24 GB for three changed bytes) and B-tree children without
  * bound. A group with links in its header (new style) has nothing to check. */
 es_status es__h5_check_group(es__h5_raw *raw, hid_t group, const char *name);
-/* Check every attribute message of obj (name: for messages) before HDF5
- * decodes them (store_groups.c): libhdf5 1.10 copies an attribute's value
- * at the size its dataspace and datatype claim, past the message if they
- * claim more. */
-es_status es__h5_check_attrs(es__h5_raw *raw, hid_t obj, const char *name);
+/* Check every message of an object header before HDF5 decodes any of it
+ * (store_headers.c): the header at oaddr, of the open object obj, or of
+ * the object `name` under loc (found without decoding its header); name
+ * names it in messages. libhdf5 1.10 decodes what a header says with few
+ * checks (a layout message's version byte changed made H5Dopen divide by
+ * zero); a store object is opened only once its header passed. */
+es_status es__h5_check_header(es__h5_raw *raw, uint64_t oaddr, const char *name);
+es_status es__h5_check_object(es__h5_raw *raw, hid_t obj, const char *name);
+es_status es__h5_check_named(es__h5_raw *raw, hid_t loc, const char *name);
 /* A string attribute, or one integer or real as text, into buf[n],
  * truncated; ES_ENOTFOUND if absent. */
 es_status es__h5_read_attr_text(es_ctx *ctx, es__h5_raw *raw, hid_t obj, const char *key,
