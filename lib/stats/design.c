@@ -166,12 +166,18 @@ static double code_at(const es_design *d, int64_t v, const vcode *vc, int64_t i,
 /* The level a code column names: treatment k -> level k+1, else level k. */
 static int64_t code_level(const vcode *vc, int64_t k) { return vc->coding == 0 ? k + 1 : k; }
 
-static es_status add_term_columns(es_ctx *ctx, es_design *d, const es_formula *f, int64_t j,
-                                  int64_t *q)
+/* Maximum columns of a whole design: 1024 terms (ES_FORMULA_MAX_TERMS) of
+ * many-level factors could make N x 10^8 values, and the fit's QR costs N
+ * q^2 (20,000 columns of 600 rows: 10^11 flops, a few minutes). */
+#define MAX_COLUMNS 20000
+
+/* How term j codes each of its nv variables (vars, vc) and how many
+ * columns that makes (*ncol, bounded). */
+static es_status term_codes(es_ctx *ctx, es_design *d, const es_formula *f, int64_t j,
+                            vcode *vc, int64_t *vars, int64_t *nv_out, int64_t *ncol_out)
 {
     const uint64_t mask = es__formula_term_mask(f, j);
-    vcode vc[64];
-    int64_t vars[64], nv = 0, ncol = 1;
+    int64_t nv = 0, ncol = 1;
     for (int64_t v = 0; v < d->nvars; v++) {
         if (!(mask >> v & 1)) continue;
         vcode *c = &vc[nv];
@@ -189,24 +195,21 @@ static es_status add_term_columns(es_ctx *ctx, es_design *d, const es_formula *f
             c->coding = 0;
             c->ncol = 1;
         }
-        if (!es__mul_i64(ncol, c->ncol, &ncol) || ncol > 100000)
+        if (!es__mul_i64(ncol, c->ncol, &ncol) || ncol > MAX_COLUMNS)
             ES_FAIL(ctx, ES_ERANGE, "model: the term '%s' has too many columns", d->terms[j]);
         nv++;
     }
-    int64_t q0 = *q, n = d->n;
-    double *nx = es__realloc(ctx, d->x, (size_t)(n * (q0 + ncol)) * sizeof *nx);
-    if (!nx) return ES_ENOMEM;
-    d->x = nx;
-    char **nn = es__realloc(ctx, d->colnames, (size_t)(q0 + ncol) * sizeof *nn);
-    if (!nn) return ES_ENOMEM;
-    d->colnames = nn;
-    int64_t *na = es__realloc(ctx, d->assign, (size_t)(q0 + ncol) * sizeof *na);
-    if (!na) return ES_ENOMEM;
-    d->assign = na;
-    int64_t *nl = es__realloc(ctx, d->col_level,
-                              (size_t)((q0 + ncol) * (d->nvars > 0 ? d->nvars : 1)) * sizeof *nl);
-    if (!nl) return ES_ENOMEM;
-    d->col_level = nl;
+    *nv_out = nv;
+    *ncol_out = ncol;
+    return ES_OK;
+}
+
+/* Term j's columns from column q0 on (the arrays hold them all). */
+static es_status fill_term_columns(es_ctx *ctx, es_design *d, const es_formula *f, int64_t j,
+                                   const vcode *vc, const int64_t *vars, int64_t nv,
+                                   int64_t ncol, int64_t q0)
+{
+    const int64_t n = d->n;
     for (int64_t c = 0; c < ncol; c++) {
         /* mixed radix: the first variable varies fastest */
         int64_t k[64], rem = c;
@@ -225,31 +228,62 @@ static es_status add_term_columns(es_ctx *ctx, es_design *d, const es_formula *f
             len += strlen(d->vars[vars[a]]) + 2;
             if (vc[a].factor) len += strlen(d->levels[vars[a]][code_level(&vc[a], k[a])]) + 1;
         }
-        char *s = es__malloc(ctx, len);
+        char *s = es__malloc(ctx, len), *e;
         if (!s) return ES_ENOMEM;
-        s[0] = '\0';
+        e = s;
+        *e = '\0';
         for (int64_t a = 0; a < nv; a++) {
-            if (a) strcat(s, ":");
+            if (a) *e++ = ':';
             if (vc[a].factor) {
                 /* factor(x) names its levels as x=level */
-                const char *lab = d->vars[vars[a]];
                 es_var_kind kind;
                 const char *name = es_formula_var(f, vars[a], &kind);
-                strcat(s, kind == ES_VAR_FACTOR ? name : lab);
-                strcat(s, "=");
-                strcat(s, d->levels[vars[a]][code_level(&vc[a], k[a])]);
+                e = stpcpy(e, kind == ES_VAR_FACTOR ? name : d->vars[vars[a]]);
+                *e++ = '=';
+                e = stpcpy(e, d->levels[vars[a]][code_level(&vc[a], k[a])]);
             } else {
-                strcat(s, d->vars[vars[a]]);
+                e = stpcpy(e, d->vars[vars[a]]);
             }
         }
+        *e = '\0';
         d->colnames[q0 + c] = s;
         d->assign[q0 + c] = j;
         int64_t *lev = d->col_level + (q0 + c) * d->nvars;
         for (int64_t v = 0; v < d->nvars; v++) lev[v] = -1;
         for (int64_t a = 0; a < nv; a++)
             if (vc[a].factor) lev[vars[a]] = code_level(&vc[a], k[a]);
-        *q = q0 + c + 1;
+        d->ncols = q0 + c + 1;
     }
+    return ES_OK;
+}
+
+/* Every term's columns after the intercept: counted (and bounded) first,
+ * so that the arrays are allocated once. */
+static es_status build_columns(es_ctx *ctx, es_design *d, const es_formula *f)
+{
+    vcode vc[64];
+    int64_t vars[64], nv, ncol, total = 1, nvars = d->nvars > 0 ? d->nvars : 1;
+    es_status rc;
+    for (int64_t j = 0; j < d->nterms; j++) {
+        if ((rc = term_codes(ctx, d, f, j, vc, vars, &nv, &ncol)) != ES_OK) return rc;
+        if ((total += ncol) > MAX_COLUMNS)
+            ES_FAIL(ctx, ES_ERANGE, "model: the design has more than %d columns at the term "
+                    "'%s'", MAX_COLUMNS, d->terms[j]);
+    }
+    if (!(d->x = es__alloc_array(ctx, d->n * total, sizeof *d->x)) ||
+        !(d->colnames = es__calloc(ctx, (size_t)total, sizeof *d->colnames)) ||
+        !(d->assign = es__alloc_array(ctx, total, sizeof *d->assign)) ||
+        !(d->col_level = es__alloc_array(ctx, total * nvars, sizeof *d->col_level)))
+        return ES_ENOMEM;
+    for (int64_t i = 0; i < d->n; i++) d->x[i] = 1.0;
+    for (int64_t v = 0; v < d->nvars; v++) d->col_level[v] = -1;
+    if (!(d->colnames[0] = es__strdup(ctx, "intercept"))) return ES_ENOMEM;
+    d->assign[0] = -1;
+    d->ncols = 1;
+    for (int64_t j = 0; j < d->nterms; j++)
+        if ((rc = term_codes(ctx, d, f, j, vc, vars, &nv, &ncol)) != ES_OK ||
+            (rc = fill_term_columns(ctx, d, f, j, vc, vars, nv, ncol, d->ncols)) != ES_OK)
+            return rc;
     return ES_OK;
 }
 
@@ -277,13 +311,9 @@ es_status es_design_build(es_ctx *ctx, const es_formula *f, int64_t n,
     d->values = es__calloc(ctx, (size_t)(n * nv), sizeof *d->values);
     d->terms = es__calloc(ctx, (size_t)nt, sizeof *d->terms);
     d->term_vars = es__calloc(ctx, (size_t)(nt * nv), sizeof *d->term_vars);
-    d->x = es__alloc_array(ctx, n, sizeof *d->x);
-    d->colnames = es__calloc(ctx, 1, sizeof *d->colnames);
-    d->assign = es__alloc_array(ctx, 1, sizeof *d->assign);
     d->term_coding = es__alloc_array(ctx, nt * nv > 0 ? nt * nv : 1, sizeof *d->term_coding);
-    d->col_level = es__alloc_array(ctx, nv > 0 ? nv : 1, sizeof *d->col_level);
-    if (!d->term_coding || !d->col_level || !d->vars || !d->var_factor || !d->nlevels ||
-        !d->levels || !d->codes || !d->values || !d->terms || !d->term_vars || !d->x || !d->colnames || !d->assign) {
+    if (!d->term_coding || !d->vars || !d->var_factor || !d->nlevels || !d->levels ||
+        !d->codes || !d->values || !d->terms || !d->term_vars) {
         rc = ES_ENOMEM;
         goto done;
     }
@@ -314,17 +344,7 @@ es_status es_design_build(es_ctx *ctx, const es_formula *f, int64_t n,
             d->term_vars[j + v * nt] = (int64_t)(es__formula_term_mask(f, j) >> v & 1);
     }
     for (int64_t k = 0; k < nt * nv; k++) d->term_coding[k] = -1;
-    for (int64_t v = 0; v < nv; v++) d->col_level[v] = -1;
-    for (int64_t i = 0; i < n; i++) d->x[i] = 1.0;
-    if (!(d->colnames[0] = es__strdup(ctx, "intercept"))) {
-        rc = ES_ENOMEM;
-        goto done;
-    }
-    d->assign[0] = -1;
-    d->ncols = 1;
-    for (int64_t j = 0; j < nt && rc == ES_OK; j++)
-        rc = add_term_columns(ctx, d, f, j, &d->ncols);
-    if (rc != ES_OK) goto done;
+    if ((rc = build_columns(ctx, d, f)) != ES_OK) goto done;
     *out = d;
     d = NULL;
 done:

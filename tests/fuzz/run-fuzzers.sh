@@ -22,7 +22,7 @@ if [ ! -f "$build_dir/build.ninja" ]; then
 else
   meson configure "$build_dir" -Dfuzz=true >/dev/null
 fi
-targets=(obj ply off num manifest tps lmcsv point store crafted)
+targets=(obj ply off num manifest tps lmcsv point formula store crafted)
 ninja -C "$build_dir" -j2 "${targets[@]/#/tests/fuzz/fuzz_}" >&2
 # only the fuzz targets are built: the rest of the tree needs no clang build
 # a loaded machine stretches the wall clock: the meson timeout (180 s for
