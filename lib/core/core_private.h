@@ -41,8 +41,13 @@ void es__info(es_ctx *ctx, const char *fmt, ...) ES__PRINTF(2, 3);
  * input order) and restore it. */
 void es__ctx_get_log(const es_ctx *ctx, es_log_fn *fn, void **userdata);
 
-/* Progress callback (no-op without one). */
-void es__progress(es_ctx *ctx, const char *what, int64_t done, int64_t total);
+/* Progress callback (no-op without one), then the cancel check: ES_ECANCELED
+ * (recorded, naming `what`) once es_ctx_cancel was called, else ES_OK. A
+ * loop stops on it and returns it; loops of no work worth stopping may
+ * ignore it, since every store write refuses while the request stands. */
+es_status es__progress(es_ctx *ctx, const char *what, int64_t done, int64_t total);
+/* The cancel check alone (ES_OK, or ES_ECANCELED recorded). */
+es_status es__cancelled(es_ctx *ctx, const char *what);
 
 /* Allocation through the context; on failure they record ES_ENOMEM with a
  * message and return NULL. es__calloc checks n * size for overflow. */

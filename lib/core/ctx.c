@@ -8,6 +8,7 @@
 #include "core/core_private.h"
 
 #include <math.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <stdint.h>
@@ -30,6 +31,7 @@ struct es_ctx {
     uint64_t seed;
     es_allocator alloc;
     bool has_alloc;
+    atomic_int cancel;     /* es_ctx_cancel: set from anywhere, read at progress reports */
 };
 
 const char *es_version(void) { return ES_VERSION_STRING; }
@@ -49,6 +51,7 @@ const char *es_strerror(es_status code)
     case ES_EEXIST: return "already exists";
     case ES_EMISMATCH: return "inputs do not correspond";
     case ES_ETOPOLOGY: return "not an oriented 2-manifold";
+    case ES_ECANCELED: return "cancelled";
     }
     return "unknown status";
 }
@@ -165,9 +168,31 @@ void es__info(es_ctx *ctx, const char *fmt, ...)
     va_end(ap);
 }
 
-void es__progress(es_ctx *ctx, const char *what, int64_t done, int64_t total)
+es_status es__progress(es_ctx *ctx, const char *what, int64_t done, int64_t total)
 {
     if (ctx && ctx->progress_fn) ctx->progress_fn(ctx->progress_ud, what, done, total);
+    return es__cancelled(ctx, what);
+}
+
+es_status es__cancelled(es_ctx *ctx, const char *what)
+{
+    if (!ctx || !atomic_load(&ctx->cancel)) return ES_OK;
+    ES_FAIL(ctx, ES_ECANCELED, "cancelled during %s; nothing stored", what);
+}
+
+void es_ctx_cancel(es_ctx *ctx)
+{
+    if (ctx) atomic_store(&ctx->cancel, 1);
+}
+
+void es_ctx_cancel_clear(es_ctx *ctx)
+{
+    if (ctx) atomic_store(&ctx->cancel, 0);
+}
+
+int es_ctx_cancelled(const es_ctx *ctx)
+{
+    return ctx && atomic_load(&((es_ctx *)ctx)->cancel);
 }
 
 void *es__malloc(es_ctx *ctx, size_t size)

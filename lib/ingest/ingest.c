@@ -379,8 +379,10 @@ static void *work(void *arg)
         if ((rc = process_one(w, i, &buf, &cap, &md)))
             record_error(j, i, rc, es_ctx_errmsg(w->ctx));
         atomic_fetch_add(&j->done, 1);
-        if (w->main)
-            es__progress(w->main_ctx, "reading meshes", (int64_t)atomic_load(&j->done), j->ntotal);
+        /* a cancel (es_ctx_cancel) stops every worker after this input */
+        if (w->main && es__progress(w->main_ctx, "reading meshes",
+                                    (int64_t)atomic_load(&j->done), j->ntotal) != ES_OK)
+            record_error(j, i, ES_ECANCELED, es_ctx_errmsg(w->main_ctx));
     }
     es__free(w->ctx, buf);
     return NULL;
@@ -669,6 +671,7 @@ static es_status ingest(es_ctx *ctx, const char *store_path, int64_t n, const in
         }
         j.nnotes = 0;
         rep->bytes_read = j.bytes_read;
+        if (!rc) rc = es__cancelled(ctx, "ingest");
         if (rc || (rc = keep_block(ctx, store_path, &st, &r, in, b0, b1, ncols, colnames, &b,
                                    &k, rep)))
             goto done;

@@ -184,7 +184,7 @@ es_status es_compare_mantel(es_ctx *ctx, int64_t n, const double *d1, const doub
                 for (int64_t i = 0; i < j; i++, t++) cc += r1[t] * col[perm[i]];
             }
             if (cc / denom >= thr) ge++;
-            if ((q & 255) == 0) es__progress(ctx, "mantel", q, permutations);
+            if ((q & 255) == 0 && (rc = es__progress(ctx, "mantel", q, permutations))) goto done;
         }
         es__progress(ctx, "mantel", permutations, permutations);
         if (p) *p = (double)(1 + ge) / (double)(1 + permutations);
@@ -358,7 +358,8 @@ es_status es_compare_groups(es_ctx *ctx, int64_t n, const double *dist, const in
             if (isfinite(f) && fq >= f - 1e-12 * fabs(f)) fge++;
             for (int64_t t = 0; t < g * g; t++)
                 if (pm[t] >= md2[t] * (1 - 1e-12)) cntge[t] += 1;
-            if ((q & 255) == 0) es__progress(ctx, "group permutations", q, permutations);
+            if ((q & 255) == 0 && (rc = es__progress(ctx, "group permutations", q, permutations)))
+                goto done;
         }
         es__progress(ctx, "group permutations", permutations, permutations);
     }

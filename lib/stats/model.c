@@ -295,7 +295,8 @@ static es_status permute_term(es_ctx *ctx, es_model *m, int64_t j, const double 
             m->fperm[(b0 + k) + j * B] = f;
             if (f >= fobs - TIE_EPS * fmax(1.0, fabs(fobs))) count++;
         }
-        es__progress(ctx, "model: permutations", j * B + b0 + nb, m->nterms * B);
+        if ((rc = es__progress(ctx, "model: permutations", j * B + b0 + nb, m->nterms * B)))
+            goto done;
     }
     m->pval[j] = (double)(count + 1) / (double)(B + 1);
 done:

@@ -150,7 +150,7 @@ static es_status pairwise_permute(es_ctx *ctx, const es_model *m, int64_t v,
             for (int64_t x = 0; x < L * L; x++)
                 if (dist[x] >= pw->dist[x] - TIE_EPS * fmax(1.0, pw->dist[x])) count[x]++;
         }
-        es__progress(ctx, "pairwise: permutations", b0 + nb, B);
+        if ((rc = es__progress(ctx, "pairwise: permutations", b0 + nb, B))) goto done;
     }
 done:
     es__perm_clear(ctx, &g);
@@ -338,7 +338,7 @@ es_status es_model_variable_tests(es_ctx *ctx, const es_model *m, const char *te
                     if (fx >= f[x] - TIE_EPS * fmax(1.0, f[x])) count[x]++;
                 }
             }
-            es__progress(ctx, "edge tests: permutations", b0 + nb, B);
+            if ((rc = es__progress(ctx, "edge tests: permutations", b0 + nb, B))) goto done;
         }
         for (int64_t x = 0; x < p; x++)
             if (isfinite(f[x])) pval[x] = (double)(count[x] + 1) / (double)(B + 1);

@@ -256,6 +256,51 @@ void es_store_abort(es_store *store)
     H5E_BEGIN_TRY { release(store, false); } H5E_END_TRY
 }
 
+/* Back to the published store: the working copy is thrown away (as abort
+ * does) and the handle reopens and reloads the file, as open does. */
+static es_status rollback_impl(es_ctx *ctx, es_store *s)
+{
+    hid_t fapl;
+    es_status rc;
+    if (!s->work) return ES_OK;
+    if (s->is_new)
+        ES_FAIL(ctx, ES_EINVAL, "store: '%s' was never committed; abort it instead of rolling "
+                "back", s->path);
+    close_discarded(s->file);
+    s->file = -1;
+    unlink(s->work);
+    es__free(s->ctx, s->work);
+    s->work = NULL;
+    s->broken = false;
+    es__store_free_rows(s);
+    if (stat(s->path, &s->opened) != 0) {
+        s->broken = true;
+        ES_FAIL(ctx, ES_EIO, "store: cannot reopen '%s': %s", s->path, strerror(errno));
+    }
+    fapl = es__h5_file_access();
+    s->file = H5Fopen(s->path, H5F_ACC_RDONLY, fapl);
+    es__h5_close(fapl);
+    if (s->file < 0) {
+        s->broken = true;
+        return es__h5_fail(ctx, ES_EIO, "store: cannot reopen '%s'", s->path);
+    }
+    if ((rc = es__store_load(s)) != ES_OK) {
+        s->broken = true;
+        if (ctx != s->ctx) es__fail(ctx, rc, "%s", es_ctx_errmsg(s->ctx));
+    }
+    return rc;
+}
+
+es_status es_store_rollback(es_ctx *ctx, es_store *store)
+{
+    es_status rc;
+    if (!store) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    H5E_BEGIN_TRY { rc = rollback_impl(ctx, store); } H5E_END_TRY
+    return rc;
+}
+
+int es_store_pending(const es_store *store) { return store && store->work; }
+
 void es_store_close(es_store *store)
 {
     if (!store) return;

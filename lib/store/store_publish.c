@@ -155,6 +155,8 @@ es_status es__store_begin_write(es_store *s)
     if (s->broken)
         ES_FAIL(ctx, ES_EIO, "store: an earlier write to '%s' failed; reopen the store",
                 s->path);
+    /* cancelled work stores nothing (es_ctx_cancel) */
+    if ((rc = es__cancelled(ctx, "a write"))) return rc;
     if (s->work) return ES_OK;
     es__store_clean_stale(s->path);
     if (!(s->work = es__store_temp_name(s))) return ES_ENOMEM;
@@ -195,6 +197,8 @@ es_status es__store_publish(es_ctx *ctx, es_store *s)
     if (s->broken)
         ES_FAIL(ctx, ES_EIO, "store: an earlier write to '%s' failed; nothing committed",
                 s->path);
+    if ((rc = es__cancelled(ctx, "a commit")) || (rc = es__cancelled(s->ctx, "a commit")))
+        return rc;
     if (H5Fflush(s->file, H5F_SCOPE_GLOBAL) < 0) {
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot flush '%s'", s->work);
         goto fail;

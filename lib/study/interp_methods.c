@@ -121,7 +121,7 @@ static es_status geometric(mwalk *w, const double *xa, const double *xb)
         snprintf(params, sizeof params, "method=%s; from=%s; to=%s; t=%.17g",
                  es_morph_method_name(o->method), o->from, o->to, t);
         rc = emit(w, i, heading, len, xyz, &rep, NULL, vc, ve, params);
-        es__progress(ctx, "interp", i + 1, o->steps);
+        if (rc == ES_OK) rc = es__progress(ctx, "interp", i + 1, o->steps);
     }
     es_multiscale_free(ms);
     es_shape_space_free(ss);

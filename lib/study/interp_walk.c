@@ -219,6 +219,8 @@ static es_status walk_frames(walk *wk, double *res)
     if (rc == ES_OK && (rc = es_study_rows_load(ctx, s, wk->mesh, &wk->rows)) != ES_OK) goto done;
     for (int64_t i = 0; rc == ES_OK && i < o->steps; i++) {
         double t = frame_t(o, i);
+        /* the embedder reports its progress; a cancel stops the walk here */
+        if ((rc = es__cancelled(ctx, "interp"))) break;
         lerp_frame(ctx, ne, nr, a, b, sa, sb, wa, wb, t, v, &scale, w);
         rc = embed_frame(wk, i, t, v, scale, w, prior, res);
     }

@@ -106,7 +106,7 @@ es_status es_study_rows_load(es_ctx *ctx, es_store *store, const es_mesh *mesh,
         r->pd[j] = r->alpha + r->ne * j;
         if ((rc = es_store_read_positions(ctx, store, j, x)) == ES_OK)
             rc = es_dihedral_angles(ctx, mesh, x, r->alpha + r->ne * j);
-        es__progress(ctx, "prior: rows", j + 1, r->n);
+        if (rc == ES_OK) rc = es__progress(ctx, "prior: rows", j + 1, r->n);
     }
     if (rc == ES_OK) memcpy(orig0, r->aligned, (size_t)(3 * r->nv) * sizeof *orig0);
     if (rc == ES_OK && r->n > 1) rc = align_rows(ctx, r, orig0);

@@ -45,7 +45,8 @@ typedef enum es_status {
     ES_ENOTFOUND,    /* a named row, group, point or column does not exist */
     ES_EEXIST,       /* the thing to create exists already */
     ES_EMISMATCH,    /* inputs disagree (topology, vertex count, dimension) */
-    ES_ETOPOLOGY     /* a face list is not an oriented 2-manifold */
+    ES_ETOPOLOGY,    /* a face list is not an oriented 2-manifold */
+    ES_ECANCELED     /* the work was cancelled (es_ctx_cancel); nothing was stored */
 } es_status;
 
 typedef enum es_log_level {
@@ -88,6 +89,16 @@ ES_API void es_ctx_set_log(es_ctx *ctx, es_log_fn fn, void *userdata);
 typedef void (*es_progress_fn)(void *userdata, const char *what, int64_t done,
                                int64_t total);
 ES_API void es_ctx_set_progress(es_ctx *ctx, es_progress_fn fn, void *userdata);
+
+/* Ask the work running on ctx to stop: safe from the progress or log
+ * callback, another thread or a signal handler (an atomic flag). Long work
+ * checks it at each progress report and returns ES_ECANCELED; a store write
+ * or commit refuses while it is set, so cancelled work stores nothing. The
+ * request stays until es_ctx_cancel_clear (every call made meanwhile stops
+ * at its first check). */
+ES_API void es_ctx_cancel(es_ctx *ctx);
+ES_API void es_ctx_cancel_clear(es_ctx *ctx);
+ES_API int es_ctx_cancelled(const es_ctx *ctx);
 
 /* Seed for everything random the library does (randomized PCA, permutation
  * tests, synthetic data). Same seed, same results. */

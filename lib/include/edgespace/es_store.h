@@ -94,6 +94,13 @@ ES_API es_status es_store_commit(es_ctx *ctx, es_store *store);
 ES_API void es_store_close(es_store *store);
 /* Close, discarding every uncommitted write. NULL: no-op. */
 ES_API void es_store_abort(es_store *store);
+/* Discard every uncommitted write and go on with the store as it is
+ * published (reloaded, as es_store_open loads it); also clears a failed
+ * write's refusal of further writes. ES_EINVAL for a new store never
+ * committed (abort it). */
+ES_API es_status es_store_rollback(es_ctx *ctx, es_store *store);
+/* 1 if the handle holds uncommitted writes, else 0. */
+ES_API int es_store_pending(const es_store *store);
 
 ES_API int64_t es_store_nrows(const es_store *store);
 ES_API int64_t es_store_nedges(const es_store *store);
