@@ -159,7 +159,7 @@ static void sweep(es_ctx *ctx, const char *path, const unsigned char *base, size
                 memcpy(b, base, n);
                 b[at] = (unsigned char)vals[k];
                 put(path, b, n);
-                snprintf(what, sizeof what, "%s: byte %zu (header + %zu) = %d", o->name, at,
+                snprintf(what, sizeof what, "%.150s: byte %zu (header + %zu) = %d", o->name, at,
                          at - o->addr, vals[k]);
                 fprintf(stderr, "\r");   /* the last line names the byte if libhdf5 crashes */
                 c[open_read(ctx, path, what)]++;
