@@ -80,6 +80,28 @@ typedef struct es__file_replace {
 } es__file_replace;
 es_status es__replace_begin(es_ctx *ctx, const char *path, es__file_replace *w);
 es_status es__replace_end(es_ctx *ctx, es__file_replace *w, es_status rc);
+/* Files that appear together or not at all (the frames of a walk): each
+ * written file's end is staged (closed, its part kept) instead of renamed;
+ * commit renames them all into place, abort removes the parts. A failed
+ * write (rc) is not staged and its part is removed. */
+typedef struct es__file_set {
+    es__file_replace *w;
+    int64_t n, cap;
+} es__file_set;
+es_status es__replace_end_staged(es_ctx *ctx, es__file_replace *w, es_status rc,
+                                 es__file_set *set);
+es_status es__file_set_commit(es_ctx *ctx, es__file_set *set);
+void es__file_set_abort(es_ctx *ctx, es__file_set *set);
+void es__file_set_clear(es_ctx *ctx, es__file_set *set);
+/* The base name of a temporary sibling: base itself, or, when base plus
+ * `extra` bytes of suffix would pass NAME_MAX (255), its first 120 bytes (at
+ * a UTF-8 boundary), '~' and 16 hex digits of its FNV-1a hash: a store or
+ * output named with 230 bytes could not be written. out: NAME_MAX + 1. */
+void es__short_base(const char *base, size_t extra, char *out, size_t n);
+/* Remove the entries of path's folder named prefix, a pid, '.' or '-',
+ * ..., suffix, whose process is gone (a killed writer's part files and
+ * working copies). */
+void es__remove_stale(const char *path, const char *prefix, const char *suffix);
 char *es__strdup(es_ctx *ctx, const char *s);
 
 /* Checked products; false on overflow. */

@@ -12,43 +12,21 @@
  * Every public entry point runs with HDF5's error printing off
  * (H5E_BEGIN_TRY/H5E_END_TRY).
  */
-#define _GNU_SOURCE   /* memfd_create */
 #include "store/store_pkg.h"
 
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
 #include <string.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
-
-/* A working copy that is thrown away (an aborted or failed write) is closed
- * into a memory file. Closing flushes HDF5's caches, and when that write
- * fails too (the disk is full: the very failure being handled) libhdf5
- * 1.10.8 frees the file but keeps its identifier, then crashes at exit
- * closing it again (HDFFV-11052, fixed in 1.10.10). What the flush writes
- * into the memory file is deleted with it. A file size limit (RLIMIT_FSIZE)
- * applies to memory files too, so only that fault still reaches the bug. */
-static void close_discarded(hid_t file)
-{
-#if defined(__linux__) && defined(MFD_CLOEXEC)
-    void *h = NULL;
-    int sink = memfd_create("edgespace-discarded", MFD_CLOEXEC);
-    if (sink >= 0 && H5Fget_vfd_handle(file, H5P_DEFAULT, &h) >= 0 && h)
-        dup2(sink, *(int *)h);
-    if (sink >= 0) close(sink);
-#endif
-    H5Fclose(file);
-}
 
 static void release(es_store *s, bool keep_work)
 {
     if (!s) return;
     es_ctx *ctx = s->ctx;
-    if (s->file >= 0 && s->work && !keep_work) close_discarded(s->file);
-    else if (s->file >= 0) H5Fclose(s->file);
+    if (s->file >= 0) es__h5_file_close(ctx, s->file, !(s->work && !keep_work), s->path);
     s->file = -1;
     if (s->work && !keep_work) unlink(s->work);
     es__store_free_rows(s);
@@ -266,7 +244,7 @@ static es_status rollback_impl(es_ctx *ctx, es_store *s)
     if (s->is_new)
         ES_FAIL(ctx, ES_EINVAL, "store: '%s' was never committed; abort it instead of rolling "
                 "back", s->path);
-    close_discarded(s->file);
+    es__h5_file_close(ctx, s->file, false, s->work);
     s->file = -1;
     unlink(s->work);
     es__free(s->ctx, s->work);

@@ -71,6 +71,12 @@ void es__h5_close(hid_t id);
 hid_t es__h5_str_type(void);
 /* File access: HDF5 1.8-readable format, file locking where supported. */
 hid_t es__h5_file_access(void);
+/* Close a file this process opened, the one way every HDF5 writer closes
+ * (the store, statismo files): keep (flushed, then closed; a failed flush
+ * makes it a discarded file and returns ES_EIO naming path) or discard
+ * (closed into a memory file, so that a full disk cannot crash libhdf5
+ * 1.10.8 at exit). Negative ids are ignored. */
+es_status es__h5_file_close(es_ctx *ctx, hid_t file, bool keep, const char *path);
 /* Open a dataset with a 16 MiB chunk cache, or without any (for appends
  * and block reads, which move whole chunks). */
 hid_t es__h5_open_ds(hid_t loc, const char *name);

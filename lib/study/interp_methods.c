@@ -15,6 +15,7 @@
 #include "study/study_pkg.h"
 #include "edgespace/es_io.h"
 #include "edgespace/es_geom.h"
+#include "meshio/meshio_private.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -27,6 +28,7 @@ typedef struct mwalk {
     const es_mesh *mesh;
     const char *name;
     int64_t ra, rb;
+    es__file_set files;     /* the frames, renamed into place at the end */
 } mwalk;
 
 static double now_s(void)
@@ -53,7 +55,8 @@ static es_status emit(mwalk *w, int64_t i, const char *heading, const double *ta
     int64_t rows[2] = {w->ra, w->rb};
     es_status rc;
     es__study_frame_names(o, w->name, i, fname, sizeof fname, rname, sizeof rname);
-    if ((rc = es_mesh_write(w->ctx, fname, ES_FORMAT_AUTO, w->mesh, xyz, NULL)) != ES_OK)
+    if ((rc = es__mesh_write_staged(w->ctx, fname, ES_FORMAT_AUTO, w->mesh, xyz, &w->files)) !=
+        ES_OK)
         return rc;
     if (o->frame) o->frame(o->userdata, i, o->steps, fname, heading, rep);
     if (!o->command) return ES_OK;
@@ -216,9 +219,9 @@ static es_status end_row(es_ctx *ctx, es_store *s, const es_study_interp_opts *o
 }
 
 es_status es__study_interp_method(es_ctx *ctx, es_store *store, const es_study_interp_opts *o,
-                                  const es_mesh *mesh, const char *name)
+                                  const es_mesh *mesh, const char *name, int was_pending)
 {
-    mwalk w = {ctx, store, o, mesh, name, -1, -1};
+    mwalk w = {ctx, store, o, mesh, name, -1, -1, {0}};
     double *xa = NULL, *xb = NULL;
     es_status rc;
     if (!es_morph_method_name(o->method))
@@ -239,6 +242,5 @@ es_status es__study_interp_method(es_ctx *ctx, es_store *store, const es_study_i
             rc = geometric(&w, xa, xb);
         es__free(ctx, xa);
     }
-    if (rc == ES_OK && o->command) rc = es_store_commit(ctx, store);
-    return rc;
+    return es__study_frames_done(ctx, store, o, rc, was_pending, &w.files);
 }

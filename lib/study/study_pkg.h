@@ -16,6 +16,7 @@ typedef struct es__table_out {
     es__file_replace w;
     FILE *f;
     const char *path;
+    es__file_set *set;   /* non-NULL: the file is staged there, not renamed at end */
 } es__table_out;
 es_status es__table_begin(es_ctx *ctx, const char *path, es__table_out *t);
 /* Finish (rc ES_OK) or abandon (rc != ES_OK: the old file stays); returns
@@ -87,9 +88,17 @@ es_status es__study_store_mesh_result(es_ctx *ctx, es_store *store, const char *
 void es__study_frame_names(const es_study_interp_opts *o, const char *name, int64_t i,
                            char *fname, size_t nf, char *rname, size_t nr);
 
+/* The end of a walk (every interpolation method): with rc ES_OK, the
+ * store committed (with a command), then the staged frame files renamed
+ * into place; otherwise the files discarded and, unless writes were
+ * pending before the walk (was_pending), what it stored rolled back (the
+ * message of rc kept). */
+es_status es__study_frames_done(es_ctx *ctx, es_store *store, const es_study_interp_opts *o,
+                                es_status rc, int was_pending, es__file_set *files);
+
 /* es_study_interp for opts->method other than edge-length, between two rows
  * (interp_methods.c); name: the result name (without the frame suffix). */
 es_status es__study_interp_method(es_ctx *ctx, es_store *store, const es_study_interp_opts *o,
-                                  const es_mesh *mesh, const char *name);
+                                  const es_mesh *mesh, const char *name, int was_pending);
 
 #endif

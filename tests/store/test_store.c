@@ -11,6 +11,7 @@
 #define ES_MODULE_STORE   /* the module's own test: its package header too */
 #include "store/store_pkg.h"
 
+#include <errno.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -621,6 +622,39 @@ int main(void)
         ES_CHECK(access(stale, F_OK) != 0);
         es_store_close(s);
         s = NULL;
+    }
+
+    /* ---- a name too long for ".<name>.tmp-<pid>-<n>" (issue 25: over ~220
+     * bytes could not be written): the working copy's name is shortened ---- */
+    {
+        char name[300], lp[4400], stale_long[4600], sb[300];
+        memset(name, 'l', 240);
+        memcpy(name + 237, ".h5", 4);
+        snprintf(lp, sizeof lp, "%s/%.255s", dir, name);
+        ES_CHECK_OK(ctx, es__store_create_raw(ctx, lp, V, F, faces, E, edges, "", &s));
+        ES_CHECK_OK(ctx, es_store_commit(ctx, s));
+        es_store_close(s);
+        s = NULL;
+        ES_CHECK_OK(ctx, es_store_open(ctx, lp, ES_STORE_WRITE, &s));
+        ES_CHECK_OK(ctx, es_store_result_begin(ctx, s, "mean", "long", &prov));
+        ES_CHECK_OK(ctx, es_store_commit(ctx, s));
+        es_store_close(s);
+        s = NULL;
+        /* and a dead writer's copy under the shortened name is removed */
+        pid_t pid = fork();
+        if (pid == 0) _exit(0);
+        waitpid(pid, NULL, 0);
+        es__short_base(name, 56, sb, sizeof sb);
+        snprintf(stale_long, sizeof stale_long, "%s/.%.200s.tmp-%ld-0", dir, sb, (long)pid);
+        es_test_write_file(stale_long, "junk");
+        ES_CHECK_OK(ctx, es_store_open(ctx, lp, ES_STORE_WRITE, &s));
+        ES_CHECK(s && es_store_has(s, "mean/long"));
+        ES_CHECK_OK(ctx, es_store_result_begin(ctx, s, "mean", "long2", &prov));
+        ES_CHECK(access(stale_long, F_OK) != 0);
+        es_store_close(s);
+        s = NULL;
+        ES_CHECK(es_test_count_entries(dir, ".tmp-") == 0);
+        remove(lp);
     }
 
     /* ---- bad files ---- */
