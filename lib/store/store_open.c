@@ -17,6 +17,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
@@ -32,7 +33,23 @@ static void release(es_store *s, bool keep_work)
     es__store_free_rows(s);
     es__free(ctx, s->work);
     es__free(ctx, s->path);
+    es__free(ctx, s->target);
     es__free(ctx, s);
+}
+
+/* Through a symbolic link writes replace its target (resolved now: the
+ * link is what the user named, the file what changes). */
+static es_status resolve_link(es_store *s)
+{
+    struct stat st;
+    char *real;
+    if (lstat(s->path, &st) != 0 || !S_ISLNK(st.st_mode)) return ES_OK;
+    if (!(real = realpath(s->path, NULL)))
+        ES_FAIL(s->ctx, errno == ENOENT ? ES_ENOTFOUND : ES_EIO, "store: '%s' is a symbolic "
+                "link to a missing file", s->path);
+    s->target = es__strdup(s->ctx, real);
+    free(real);
+    return s->target ? ES_OK : ES_ENOMEM;
 }
 
 static es_status open_impl(es_ctx *ctx, const char *path, es_store_mode mode, es_store **out)
@@ -57,6 +74,7 @@ static es_status open_impl(es_ctx *ctx, const char *path, es_store_mode mode, es
     s->file = -1;
     s->mode = mode;
     if (!(s->path = es__strdup(ctx, path))) { rc = ES_ENOMEM; goto fail; }
+    if (mode != ES_STORE_READ && (rc = resolve_link(s))) goto fail;
     /* Before opening: if another writer replaces the file in between, the
      * first write sees a different identity and refuses (never stale rows). */
     if (stat(path, &s->opened) != 0) {
@@ -131,6 +149,12 @@ static es_status create_impl(es_ctx *ctx, const char *path, int64_t nverts, int6
     }
     if (access(path, F_OK) == 0)
         ES_FAIL(ctx, ES_EEXIST, "store: '%s' exists already", path);
+    {
+        struct stat st;
+        if (lstat(path, &st) == 0)
+            ES_FAIL(ctx, ES_EEXIST, "store: '%s' is a symbolic link to a missing file; "
+                    "name the file itself", path);
+    }
     if (!(s = es__calloc(ctx, 1, sizeof *s))) return ES_ENOMEM;
     s->ctx = ctx;
     s->file = -1;

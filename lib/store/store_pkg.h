@@ -37,6 +37,7 @@ es_status es__store_create_raw(es_ctx *ctx, const char *path, int64_t nverts, in
 struct es_store {
     es_ctx *ctx;
     char *path;            /* the store as named by the user */
+    char *target;          /* path's target when path is a symbolic link, or NULL */
     char *work;            /* working copy (writes) or NULL */
     hid_t file;
     es_store_mode mode;

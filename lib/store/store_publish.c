@@ -46,7 +46,11 @@ void es__store_clean_stale(const char *path)
     es__remove_stale(path, prefix, "");
 }
 
-static const char *target_of(const es_store *s) { return s->path; }
+/* The file the store's writes replace: the path given, or through a
+ * symbolic link its target (a commit renames over the target and keeps the
+ * link; it used to replace the link by a file and leave the target as it
+ * was). */
+static const char *target_of(const es_store *s) { return s->target ? s->target : s->path; }
 
 char *es__store_temp_name(es_store *s)
 {

@@ -624,6 +624,42 @@ int main(void)
         s = NULL;
     }
 
+    /* ---- through a symbolic link: the target is replaced, the link kept
+     * (issue 25: the link became a file and the target never got the
+     * result) ---- */
+    {
+        char sub[4300], real[4400], link[4400];
+        struct stat st;
+        snprintf(sub, sizeof sub, "%s/real", dir);
+        snprintf(real, sizeof real, "%s/store.h5", sub);
+        snprintf(link, sizeof link, "%s/link.h5", dir);
+        ES_CHECK(mkdir(sub, 0755) == 0 || errno == EEXIST);
+        before = es_test_slurp(path, &n0);
+        FILE *f = fopen(real, "wb");
+        ES_CHECK(before && f && fwrite(before, 1, n0, f) == n0);
+        if (f) fclose(f);
+        free(before);
+        ES_CHECK(symlink("real/store.h5", link) == 0);
+        ES_CHECK_OK(ctx, es_store_open(ctx, link, ES_STORE_WRITE, &s));
+        ES_CHECK_OK(ctx, es_store_result_begin(ctx, s, "mean", "via_link", &prov));
+        ES_CHECK_OK(ctx, es_store_commit(ctx, s));
+        ES_CHECK(es_test_count_entries(sub, ".tmp-") == 0 && es_test_count_entries(dir, ".tmp-") == 0);
+        es_store_close(s);
+        s = NULL;
+        ES_CHECK(lstat(link, &st) == 0 && S_ISLNK(st.st_mode));
+        ES_CHECK_OK(ctx, es_store_open(ctx, real, ES_STORE_READ, &s));
+        ES_CHECK(s && es_store_has(s, "mean/via_link"));
+        es_store_close(s);
+        s = NULL;
+        /* a link to nothing is not a store to create or open */
+        remove(real);
+        ES_CHECK_FAILS(ctx, es_store_open(ctx, link, ES_STORE_WRITE, &s), ES_ENOTFOUND, "link.h5");
+        ES_CHECK_FAILS(ctx, es__store_create_raw(ctx, link, V, F, faces, E, edges, "", &s),
+                       ES_EEXIST, "symbolic link to a missing file");
+        remove(link);
+        rmdir(sub);
+    }
+
     /* ---- a name too long for ".<name>.tmp-<pid>-<n>" (issue 25: over ~220
      * bytes could not be written): the working copy's name is shortened ---- */
     {
