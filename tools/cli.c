@@ -60,6 +60,14 @@ es_ctx *cli_ctx_new(const char *verb)
     state.tty = isatty(STDERR_FILENO);
     es_ctx_set_log(ctx, on_log, &state);
     es_ctx_set_progress(ctx, on_progress, &state);
+    /* the memory a command may plan to use (embeddings refuse above it) */
+    const char *limit = getenv("EDGESPACE_MAX_MEMORY");
+    uint64_t bytes;
+    if (limit && *limit) {
+        if (cli_parse_size(limit, &bytes) == 0) es_ctx_set_memory_limit(ctx, bytes);
+        else fprintf(stderr, "edgespace %s: warning: EDGESPACE_MAX_MEMORY='%s' is not a size "
+                     "(like 8G); ignored\n", verb, limit);
+    }
     return ctx;
 }
 
@@ -104,6 +112,26 @@ int cli_parse_i64(const char *s, int64_t *out)
     long long v = strtoll(s, &end, 10);
     if (errno || end == s || *end) return -1;
     *out = v;
+    return 0;
+}
+
+int cli_parse_size(const char *s, uint64_t *out)
+{
+    char *end;
+    double v, unit = 1;
+    errno = 0;
+    v = strtod(s, &end);
+    if (errno || end == s || !isfinite(v) || v <= 0) return -1;
+    switch (*end) {
+    case 'k': case 'K': unit = 1024.0; end++; break;
+    case 'm': case 'M': unit = 1024.0 * 1024; end++; break;
+    case 'g': case 'G': unit = 1024.0 * 1024 * 1024; end++; break;
+    case 't': case 'T': unit = 1024.0 * 1024 * 1024 * 1024; end++; break;
+    default: break;
+    }
+    if ((*end == 'B' || *end == 'b') && end[1] == '\0') end++;
+    if (*end || v * unit >= 1.8e19 || v * unit < 1) return -1;
+    *out = (uint64_t)(v * unit);
     return 0;
 }
 

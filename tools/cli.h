@@ -9,8 +9,9 @@
 enum { CLI_OK = 0, CLI_FAIL = 1, CLI_USAGE = 2 };
 
 /* A context whose warnings print as "edgespace VERB: warning: ..." and whose
- * progress shows as a bar on stderr when stderr is a terminal. NULL if out
- * of memory (after printing why). */
+ * progress shows as a bar on stderr when stderr is a terminal, with the
+ * memory limit of $EDGESPACE_MAX_MEMORY when set. NULL if out of memory
+ * (after printing why). */
 es_ctx *cli_ctx_new(const char *verb);
 
 /* Print "edgespace VERB: <errmsg>" (or the status text) and return CLI_FAIL. */
@@ -28,6 +29,9 @@ char *cli_command_line(int argc, char **argv);
 /* Parse a whole string as int64 / double; 0 on success, -1 otherwise. */
 int cli_parse_i64(const char *s, int64_t *out);
 int cli_parse_double(const char *s, double *out);
+/* A size in bytes: a number with an optional K, M, G or T (powers of 1024)
+ * and B ("8G", "512MB", "1.5e9"); 0 or -1. */
+int cli_parse_size(const char *s, uint64_t *out);
 
 /* Subcommand entry points: argv[0] is the verb. */
 typedef int (*cli_cmd_fn)(int argc, char **argv);

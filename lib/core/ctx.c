@@ -12,6 +12,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <stdint.h>
+#include <sys/resource.h>
+#include <unistd.h>
 #ifdef __linux__
 #include <sys/mman.h>
 #endif
@@ -32,6 +34,7 @@ struct es_ctx {
     es_allocator alloc;
     bool has_alloc;
     atomic_int cancel;     /* es_ctx_cancel: set from anywhere, read at progress reports */
+    uint64_t memory_limit; /* bytes, 0: the machine's */
 };
 
 const char *es_version(void) { return ES_VERSION_STRING; }
@@ -178,6 +181,23 @@ es_status es__cancelled(es_ctx *ctx, const char *what)
 {
     if (!ctx || !atomic_load(&ctx->cancel)) return ES_OK;
     ES_FAIL(ctx, ES_ECANCELED, "cancelled during %s; nothing stored", what);
+}
+
+void es_ctx_set_memory_limit(es_ctx *ctx, uint64_t bytes)
+{
+    if (ctx) ctx->memory_limit = bytes;
+}
+
+uint64_t es_ctx_memory_limit(const es_ctx *ctx)
+{
+    long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGESIZE);
+    uint64_t phys = pages > 0 && size > 0 ? (uint64_t)pages * (uint64_t)size : UINT64_MAX;
+    struct rlimit rl;
+    if (ctx && ctx->memory_limit) return ctx->memory_limit;
+    if (getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY &&
+        (uint64_t)rl.rlim_cur < phys)
+        phys = (uint64_t)rl.rlim_cur;
+    return phys;
 }
 
 void es_ctx_cancel(es_ctx *ctx)

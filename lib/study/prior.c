@@ -86,6 +86,16 @@ es_status es_study_rows_load(es_ctx *ctx, es_store *store, const es_mesh *mesh,
     *out = NULL;
     if (!mesh) ES_FAIL(ctx, ES_EINVAL, "prior: the store has no faces");
     if (es_store_nrows(store) < 1) ES_FAIL(ctx, ES_EINVAL, "prior: the store has no rows");
+    {
+        /* the rows held here beside the embedder that follows: both told
+         * before either is allocated */
+        char what[64];
+        uint64_t n = (uint64_t)es_store_nrows(store), per, bytes;
+        per = 8 * (3 * (uint64_t)es_mesh_nverts(mesh) + (uint64_t)es_mesh_nedges(mesh));
+        if (__builtin_mul_overflow(n, per, &bytes)) bytes = UINT64_MAX;
+        snprintf(what, sizeof what, " for the prior's %llu rows", (unsigned long long)n);
+        if ((rc = es_embed_check_memory(ctx, mesh, bytes, what)) != ES_OK) return rc;
+    }
     if (!(r = es__calloc(ctx, 1, sizeof *r))) return ES_ENOMEM;
     r->ctx = ctx;
     r->n = es_store_nrows(store);

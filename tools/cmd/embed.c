@@ -48,6 +48,8 @@ static const char usage[] =
     "      --paper          the published method's stages only (stage 1 always, no\n"
     "                       refinement), for comparison\n"
     "      --replace        replace a stored result of that name (else refused)\n"
+    "      --max-memory SIZE  refuse a mesh whose embedding needs more (default: the\n"
+    "                       machine's memory, or $EDGESPACE_MAX_MEMORY; e.g. 8G)\n"
     "  -h, --help           show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -62,11 +64,12 @@ int cmd_embed(int argc, char **argv)
         {"help", no_argument, NULL, 'h'},        {"bending", required_argument, NULL, 'B'},
         {"refine-iters", required_argument, NULL, 'R'},
         {"residuals", required_argument, NULL, 'r'}, {"pca", required_argument, NULL, 'c'},
-        {NULL, 0, NULL, 0}};
+        {"max-memory", required_argument, NULL, 'M'}, {NULL, 0, NULL, 0}};
     char namebuf[256], text[1024], *cmd = NULL;
     es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
     int c, store_it = 1;
     int64_t iters;
+    uint64_t max_memory = 0;
     es_ctx *ctx;
     es_store *s = NULL;
     es_study_embed_opts o;
@@ -104,6 +107,10 @@ int cmd_embed(int argc, char **argv)
             o.embed.refine_max_iter = (int)iters;
             break;
         case 'X': wmode = ES_STORE_REPLACE; break;
+        case 'M':
+            if (cli_parse_size(optarg, &max_memory))
+                return cli_usage_error("embed", "--max-memory wants a size such as 8G");
+            break;
         case 'h': fputs(usage, stdout); return CLI_OK;
         default: return cli_usage_error("embed", "bad option");
         }
@@ -120,6 +127,7 @@ int cmd_embed(int argc, char **argv)
         o.name = namebuf;
     }
     if (!(ctx = cli_ctx_new("embed"))) return CLI_FAIL;
+    if (max_memory) es_ctx_set_memory_limit(ctx, max_memory);
     if (store_it) o.command = cmd = cli_command_line(argc, argv);
     const char *name = o.name;
     if (!store_it) o.name = NULL;

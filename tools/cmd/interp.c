@@ -41,6 +41,8 @@ static const char usage[] =
     "                       (default 0.0025; 0: the prior only starts and frames it)\n"
     "      --refine-iters N  refinement iterations per frame (default 12)\n"
     "      --replace         replace a stored result of that name (else refused)\n"
+    "      --max-memory SIZE refuse a mesh whose embedding needs more (default: the\n"
+    "                        machine's memory, or $EDGESPACE_MAX_MEMORY; e.g. 8G)\n"
     "  -m, --method M        edge-length (default: the above), or another paper's\n"
     "                        way between two rows (--from/--to row:ID):\n"
     "                        multiscale (Winkler et al. 2010), shape-space (Wuhrer\n"
@@ -89,12 +91,13 @@ int cmd_interp(int argc, char **argv)
         {"no-store", no_argument, NULL, 'N'},   {"replace", no_argument, NULL, 'X'},
         {"help", no_argument, NULL, 'h'},       {"bending", required_argument, NULL, 'B'},
         {"refine-iters", required_argument, NULL, 'R'}, {"pca", required_argument, NULL, 'c'},
-        {"method", required_argument, NULL, 'm'},
+        {"method", required_argument, NULL, 'm'}, {"max-memory", required_argument, NULL, 'M'},
         {NULL, 0, NULL, 0}};
     es_study_interp_opts o;
     es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
     int c, store_it = 1;
     int64_t iters;
+    uint64_t max_memory = 0;
     es_ctx *ctx;
     es_store *s = NULL;
     es_status rc;
@@ -135,6 +138,10 @@ int cmd_interp(int argc, char **argv)
             o.embed.refine_max_iter = (int)iters;
             break;
         case 'X': wmode = ES_STORE_REPLACE; break;
+        case 'M':
+            if (cli_parse_size(optarg, &max_memory))
+                return cli_usage_error("interp", "--max-memory wants a size such as 8G");
+            break;
         case 'h': fputs(usage, stdout); return CLI_OK;
         default: return cli_usage_error("interp", "bad option");
         }
@@ -151,6 +158,7 @@ int cmd_interp(int argc, char **argv)
         return cli_usage_error("interp", "with several frames, --output must be a pattern "
                                "with one integer conversion, like 'out_%%02d.obj'");
     if (!(ctx = cli_ctx_new("interp"))) return CLI_FAIL;
+    if (max_memory) es_ctx_set_memory_limit(ctx, max_memory);
     if (o.weights && !weights_are_rows(ctx, o.weights)) {
         es_ctx_free(ctx);
         return cli_usage_error("interp", "--weights wants 'w1*row:a + w2*row:b ...' with two "

@@ -100,6 +100,14 @@ ES_API void es_ctx_cancel(es_ctx *ctx);
 ES_API void es_ctx_cancel_clear(es_ctx *ctx);
 ES_API int es_ctx_cancelled(const es_ctx *ctx);
 
+/* The memory work on ctx may plan to use, in bytes: what refuses a job
+ * whose estimated need is larger before it allocates it (an embedding of
+ * 5 million vertices grew past 14 GB and was killed by the kernel). 0 (the
+ * default) means the machine's physical memory, or less under a process
+ * limit (RLIMIT_AS); es_ctx_memory_limit returns the limit in force. */
+ES_API void es_ctx_set_memory_limit(es_ctx *ctx, uint64_t bytes);
+ES_API uint64_t es_ctx_memory_limit(const es_ctx *ctx);
+
 /* Seed for everything random the library does (randomized PCA, permutation
  * tests, synthetic data). Same seed, same results. */
 ES_API void es_ctx_set_seed(es_ctx *ctx, uint64_t seed);
