@@ -167,7 +167,7 @@ static es_status load_columns(es_store *s, es__h5_raw *raw)
     }
     for (int64_t c = 0; c < n; c++) {
         char full[600];
-        if (es__h5_bad_name(names[c]) || strlen(names[c]) > 500) {
+        if (es__h5_bad_name(names[c]) || strlen(names[c]) > ES__MAX_COLUMN_NAME) {
             rc = es__fail(ctx, ES_EFORMAT, "store: '%s': /labels column %lld has the bad name "
                           "'%.40s'", s->path, (long long)c, names[c]);
             goto done;

@@ -28,6 +28,13 @@
 #define ES__FORMAT_VERSION 1
 #define ES__FORMAT_VERSION_KIND 2
 
+/* Label column names are at most this many bytes (checked at open and
+ * append); coordinates at most ES__MAX_COORD in magnitude over an extent of
+ * at least ES__MIN_EXTENT (store_rows.c). */
+#define ES__MAX_COLUMN_NAME 500
+#define ES__MAX_COORD 1e30
+#define ES__MIN_EXTENT 1e-30
+
 /* faces: 3 x nfaces, edges: 2 x nedges (as es_mesh_faces/es_mesh_edges),
  * fingerprint: 16 hex digits (es_mesh_fingerprint) or "". */
 es_status es__store_create_raw(es_ctx *ctx, const char *path, int64_t nverts, int64_t nfaces,

@@ -140,7 +140,10 @@ typedef struct es_store_rows {
  * new to the store are added with "" in the existing rows; store columns
  * not given get "" in the new rows. Fails with ES_EEXIST on an id that is
  * in the store or given twice, ES_EINVAL on a non-finite length or a bad
- * scale; nothing is written then. */
+ * scale, ES_ERANGE on coordinates outside 1e-30..1e30 (extent, magnitude)
+ * or more than ES_STORE_MAX_COLUMNS label columns (names of at most 500
+ * bytes); nothing is written then. */
+#define ES_STORE_MAX_COLUMNS 2000
 ES_API es_status es_store_append(es_ctx *ctx, es_store *store, const es_store_rows *rows);
 
 /* The stored topology (reference positions: those of row 0, or none for an
