@@ -71,6 +71,11 @@ es_ctx *cli_ctx_new(const char *verb)
     return ctx;
 }
 
+FILE *cli_report_stream(const char *csv)
+{
+    return csv && !strcmp(csv, "-") ? stderr : stdout;
+}
+
 int cli_fail(const char *verb, es_ctx *ctx, es_status rc)
 {
     const char *msg = ctx ? es_ctx_errmsg(ctx) : "";
@@ -89,19 +94,50 @@ int cli_usage_error(const char *verb, const char *fmt, ...)
     return CLI_USAGE;
 }
 
+/* An argument as a POSIX shell reads it back: as it is when it holds only
+ * characters no shell treats specially, else in single quotes with each '
+ * written '\'' (a name like "a'; touch PWNED; echo '" was stored as a
+ * command that ran touch when replayed). */
+static size_t shell_quote(char *out, const char *arg)
+{
+    static const char safe[] = "@%+=:,./-_";
+    size_t n = 0;
+    int plain = *arg != '\0';
+    for (const char *p = arg; *p && plain; p++)
+        plain = ((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') ||
+                 (*p >= '0' && *p <= '9') || strchr(safe, *p));
+    if (plain) {
+        if (out) memcpy(out, arg, strlen(arg));
+        return strlen(arg);
+    }
+    if (out) out[n] = '\'';
+    n++;
+    for (const char *p = arg; *p; p++) {
+        if (*p == '\'') {
+            if (out) memcpy(out + n, "'\\''", 4);
+            n += 4;
+        } else {
+            if (out) out[n] = *p;
+            n++;
+        }
+    }
+    if (out) out[n] = '\'';
+    return n + 1;
+}
+
 char *cli_command_line(int argc, char **argv)
 {
-    size_t n = strlen("edgespace") + 1;
-    for (int i = 0; i < argc; i++) n += strlen(argv[i]) + 3;
+    size_t n = strlen("edgespace") + 1, k;
+    for (int i = 0; i < argc; i++) n += shell_quote(NULL, argv[i]) + 1;
     char *s = malloc(n);
     if (!s) return NULL;
     strcpy(s, "edgespace");
+    k = strlen(s);
     for (int i = 0; i < argc; i++) {
-        int quote = strpbrk(argv[i], " \t\"'") != NULL || !*argv[i];
-        strcat(s, quote ? " '" : " ");
-        strcat(s, argv[i]);
-        if (quote) strcat(s, "'");
+        s[k++] = ' ';
+        k += shell_quote(s + k, argv[i]);
     }
+    s[k] = '\0';
     return s;
 }
 

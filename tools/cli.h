@@ -4,6 +4,7 @@
 #define EDGESPACE_TOOLS_CLI_H
 
 #include <edgespace/edgespace.h>
+#include <stdio.h>
 
 /* Exit statuses of every subcommand. */
 enum { CLI_OK = 0, CLI_FAIL = 1, CLI_USAGE = 2 };
@@ -13,6 +14,10 @@ enum { CLI_OK = 0, CLI_FAIL = 1, CLI_USAGE = 2 };
  * memory limit of $EDGESPACE_MAX_MEMORY when set. NULL if out of memory
  * (after printing why). */
 es_ctx *cli_ctx_new(const char *verb);
+
+/* Where a command's report goes: stdout, or stderr when the CSV table is
+ * written to stdout ("-o -"), so that stdout is the CSV alone. */
+FILE *cli_report_stream(const char *csv);
 
 /* Print "edgespace VERB: <errmsg>" (or the status text) and return CLI_FAIL. */
 int cli_fail(const char *verb, es_ctx *ctx, es_status rc);

@@ -138,7 +138,9 @@ es_status es_compare_mantel(es_ctx *ctx, int64_t n, const double *d1, const doub
 {
     es_status rc;
     if ((rc = check_n(ctx, n)) != ES_OK) return rc;
-    if (permutations < 0) ES_FAIL(ctx, ES_EINVAL, "compare: negative permutation count");
+    if (permutations < 0 || permutations > ES_MAX_PERMUTATIONS)
+        ES_FAIL(ctx, ES_EINVAL, "compare: %lld permutations (0 to %d)", (long long)permutations,
+                ES_MAX_PERMUTATIONS);
     int64_t m = n * (n - 1) / 2;
     double *r1 = es__alloc_array(ctx, 2 * m + n * n, sizeof *r1);
     int64_t *perm = es__alloc_array(ctx, n, sizeof *perm);
@@ -305,7 +307,9 @@ es_status es_compare_groups(es_ctx *ctx, int64_t n, const double *dist, const in
     if ((rc = check_n(ctx, n)) != ES_OK) return rc;
     if (g < 2 || g > n) ES_FAIL(ctx, ES_EINVAL, "compare: %lld groups for %lld specimens",
                                 (long long)g, (long long)n);
-    if (permutations < 0) ES_FAIL(ctx, ES_EINVAL, "compare: negative permutation count");
+    if (permutations < 0 || permutations > ES_MAX_PERMUTATIONS)
+        ES_FAIL(ctx, ES_EINVAL, "compare: %lld permutations (0 to %d)", (long long)permutations,
+                ES_MAX_PERMUTATIONS);
     double *d2 = es__alloc_array(ctx, n * n + 4 * g * g, sizeof *d2);
     int64_t *lab = es__alloc_array(ctx, n + g, sizeof *lab);
     if (!d2 || !lab) { es__free(ctx, d2); es__free(ctx, lab); return ES_ENOMEM; }

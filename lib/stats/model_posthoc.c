@@ -265,6 +265,9 @@ es_status es_model_variable_tests(es_ctx *ctx, const es_model *m, const char *te
     const int64_t j = es_model_find_term(m, term);
     if (j < 0) ES_FAIL(ctx, ES_ENOTFOUND, "edge tests: the model has no term '%s'",
                        term ? term : "");
+    if (permutations > ES_MAX_PERMUTATIONS)
+        ES_FAIL(ctx, ES_EINVAL, "edge tests: %lld permutations (0 to %d)",
+                (long long)permutations, ES_MAX_PERMUTATIONS);
     const int64_t B = permutations < 0 ? m->permutations : permutations;
     const int64_t n = m->n, p = m->p, r = m->priv->r, rk = m->rank;
     const double *z = m->priv->pca->scores, *u = m->priv->pca->components;

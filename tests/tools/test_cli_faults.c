@@ -18,7 +18,8 @@
  *     the store is unchanged or complete, never between;
  *   - export to a device (/dev/full) fails with the device's error and
  *     leaves the node a device; a directory is refused;
- *   - a misspelt label column, value or row id names the closest ones. */
+ *   - a misspelt label column, value or row id names the closest ones;
+ *   - the stored command line replays as exactly the arguments given. */
 #include "edgespace/edgespace.h"
 #include "es_test.h"
 #include "es_test_files.h"
@@ -347,6 +348,104 @@ static void test_full_disk_frames(const char *base, size_t nbase)
     remove(src);
 }
 
+/* The stored command line replays as the command that ran (issue 25: a
+ * name "a'; touch PWNED; echo '" was stored so that replaying it ran
+ * touch): a shell reads back exactly the arguments given. */
+static void test_provenance_quoting(es_ctx *ctx, const char *base, size_t nbase)
+{
+    static const char *const name = "a'; touch PWNED; echo '";
+    const char *args[] = {"mean", store, "--by", "grp", "-n", name, NULL};
+    char err[4096], cmd[8192], sh[8400], line[4096], pwned[4300];
+    es_store *s = NULL;
+    int k = 0, ok = 1, used[6] = {0};
+    put_bytes(store, base, nbase);
+    ES_CHECK_MSG(run(args, 0, err, sizeof err) == 0, "mean -n: %s", err);
+    ES_CHECK_OK(ctx, es_store_open(ctx, store, ES_STORE_READ, &s));
+    snprintf(sh, sizeof sh, "mean/%s", name);
+    ES_CHECK_OK(ctx, es_store_get_attr(ctx, s, sh, "command", cmd, sizeof cmd));
+    es_store_close(s);
+    ES_CHECK(!strncmp(cmd, "edgespace ", 10));
+    /* the shell splits the stored line: printf shows each argument */
+    snprintf(sh, sizeof sh, "cd '%s' && printf '%%s\\n' %s", dir, cmd + 10);
+    FILE *p = popen(sh, "r");
+    ES_CHECK(p != NULL);
+    while (p && fgets(line, sizeof line, p)) {
+        /* (getopt moves the store after the options) */
+        int hit = 0;
+        line[strcspn(line, "\n")] = '\0';
+        for (int a = 0; a < 6 && !hit; a++)
+            if (!used[a] && !strcmp(line, args[a])) used[a] = hit = 1;
+        ok &= hit;
+        k++;
+    }
+    if (p) pclose(p);
+    ES_CHECK_MSG(ok && k == 6, "the stored command '%s' read back as %d other arguments", cmd,
+                 k);
+    snprintf(pwned, sizeof pwned, "%s/PWNED", dir);
+    ES_CHECK(access(pwned, F_OK) != 0);
+    put_bytes(store, base, nbase);
+}
+
+/* Inputs refused in one line before any work (issue 25): meshes scaled by
+ * 1e77 or 1e-100 (ingested, they embedded with 17-56 % error and NaN
+ * bending), a manifest of 20,000 label columns (an internal HDF5 error after
+ * 8.6 s); and `-o -` of mean, point and model is the CSV alone on stdout
+ * (the summary goes to stderr). */
+static void test_hostile_inputs(const char *base, size_t nbase)
+{
+    static const char *const scales[2] = {"1e77", "1e-100"};
+    char err[4096], obj[4400], man[4400], st[4400];
+    snprintf(st, sizeof st, "%s/hostile.h5", dir);
+    for (int k = 0; k < 2; k++) {
+        double sc = strtod(scales[k], NULL);
+        FILE *f;
+        snprintf(obj, sizeof obj, "%s/scaled.obj", dir);
+        if (!(f = fopen(obj, "w"))) continue;
+        fprintf(f, "v 0 0 0\nv %.17g 0 0\nv 0 %.17g 0\nv 0 0 %.17g\n", sc, sc, sc);
+        fputs("f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n", f);
+        fclose(f);
+        const char *args[] = {"ingest", st, obj, "-q", NULL};
+        int rc = run(args, 0, err, sizeof err);
+        ES_CHECK_MSG(rc == 1 && strstr(err, "rescale it") && access(st, F_OK) != 0,
+                     "a mesh scaled by %s: exit %d %s", scales[k], rc, err);
+        remove(obj);
+    }
+    {
+        FILE *f;
+        snprintf(man, sizeof man, "%s/wide.csv", dir);
+        if ((f = fopen(man, "w"))) {
+            fputs("file", f);
+            for (int c = 0; c < 20000; c++) fprintf(f, ",c%d", c);
+            for (int k = 0; k < 2; k++) {
+                fprintf(f, "\nm%02d.obj", k);
+                for (int c = 0; c < 20000; c++) fputs(",v", f);
+            }
+            fputc('\n', f);
+            fclose(f);
+        }
+        const char *args[] = {"ingest", st, "--manifest", man, "-q", NULL};
+        int rc = run(args, 0, err, sizeof err);
+        ES_CHECK_MSG(rc == 1 && strstr(err, "20001 label columns; a store holds at most 2000") &&
+                     access(st, F_OK) != 0, "20,000 columns: exit %d %s", rc, err);
+        remove(man);
+    }
+    /* -o -: stdout is the CSV, from its header on */
+    put_bytes(store, base, nbase);
+    static const char *const heads[3] = {"edge,v0,v1,a,b\n", "edge,v0,v1,length\n",
+                                         "term,df,ss,ms,r2,f,p\n"};
+    const char *const cmds[3][10] = {
+        {"mean", store, "--by", "grp", "--no-store", "-o", "-", NULL},
+        {"point", store, "mean", "--csv", "-", NULL},
+        {"model", store, "~ grp", "-p", "9", "--no-store", "-o", "-", NULL}};
+    for (int c = 0; c < 3; c++) {
+        char out[256] = "";
+        int rc = run(cmds[c], 0, err, sizeof err);
+        es_test_read_small(o, out, sizeof out);
+        ES_CHECK_MSG(rc == 0 && !strncmp(out, heads[c], strlen(heads[c])),
+                     "%s -o -: exit %d, stdout starts '%.60s'", cmds[c][0], rc, out);
+    }
+}
+
 /* SIGKILL while a command stores its result: unchanged or complete. */
 static void test_kills(es_ctx *ctx, const char *base, size_t nbase)
 {
@@ -515,6 +614,8 @@ int main(void)
     test_full_disk(base, nbase, manifest);
     test_full_disk_statismo(base, nbase);
     test_full_disk_frames(base, nbase);
+    test_provenance_quoting(ctx, base, nbase);
+    test_hostile_inputs(base, nbase);
     test_kills(ctx, base, nbase);
     test_devices();
     test_misspelt();

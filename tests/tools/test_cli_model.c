@@ -118,7 +118,7 @@ int main(void)
     ES_CHECK(r.status == 2 && strstr(r.err, "go with --result"));
 
     /* the faces, their lengths, and failures on the store */
-    ES_RUN(&r, dir, "synth", "face", "-n", "6", "--noise", "0.002", "-o", faces);
+    ES_RUN(&r, dir, "synth", "face", "-n", "6", "--noise", "0.002", "-o", faces, "--replace");
     ES_CHECK(r.status == 0);
     ES_RUN(&r, dir, "ingest", store, "--manifest", manifest, "-q");
     ES_CHECK(r.status == 0);
@@ -165,6 +165,12 @@ int main(void)
         double sec = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
         ES_CHECK_MSG(sec < 5, "two bounded formulas took %.1f s", sec);
     }
+    /* one cap for every permutation count (issue 25: --edge-permutations and
+     * compare -p took 2^40) */
+    ES_RUN(&r, dir, "model", store, "~ expression", "--edge-permutations", "1099511627776");
+    ES_CHECK_MSG(r.status == 2 && strstr(r.err, "from 0 to 100000000"), "%s", r.err);
+    ES_RUN(&r, dir, "model", store, "~ expression", "-p", "100000001");
+    ES_CHECK_MSG(r.status == 2 && strstr(r.err, "from 0 to 100000000"), "%s", r.err);
     ES_RUN(&r, dir, "model", store, "~ expression", "--block", "subjct");
     ES_CHECK_MSG(r.status == 1 && strstr(r.err, "'subjct'") && strstr(r.err, "did you mean") &&
                  strstr(r.err, "subject"), "%s", r.err);

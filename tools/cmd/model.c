@@ -47,31 +47,31 @@ static const char usage[] =
 
 enum { O_PERMUTE = 256, O_CONTRASTS, O_PAIRWISE, O_EDGES, O_EDGE_PERM, O_SEED, O_NOSTORE };
 
-static int print_table(const es_study_model_result *r)
+static int print_table(FILE *out, const es_study_model_result *r)
 {
     const es_model *m = r->model;
-    printf("%-24s %5s %14s %14s %8s %10s %8s\n", "term", "df", "SS", "MS", "R2", "F", "p");
+    fprintf(out, "%-24s %5s %14s %14s %8s %10s %8s\n", "term", "df", "SS", "MS", "R2", "F", "p");
     for (int64_t j = 0; j < m->nterms; j++) {
-        printf("%-24s %5lld %14.6g %14.6g %8.4f %10.4g ", r->design->terms[j],
-               (long long)m->df[j], m->ss[j], m->ms[j], m->r2[j], m->f[j]);
-        if (isnan(m->pval[j])) printf("%8s\n", m->testable[j] ? "-" : "(block)");
-        else printf("%8.4g\n", m->pval[j]);
+        fprintf(out, "%-24s %5lld %14.6g %14.6g %8.4f %10.4g ", r->design->terms[j],
+                (long long)m->df[j], m->ss[j], m->ms[j], m->r2[j], m->f[j]);
+        if (isnan(m->pval[j])) fprintf(out, "%8s\n", m->testable[j] ? "-" : "(block)");
+        else fprintf(out, "%8.4g\n", m->pval[j]);
     }
-    printf("%-24s %5lld %14.6g %14.6g %8.4f\n", "Residual", (long long)m->df_resid, m->rss,
-           m->rss / (double)m->df_resid, m->rss / m->tss);
-    printf("%-24s %5lld %14.6g\n", "Total", (long long)(m->n - 1), m->tss);
+    fprintf(out, "%-24s %5lld %14.6g %14.6g %8.4f\n", "Residual", (long long)m->df_resid, m->rss,
+            m->rss / (double)m->df_resid, m->rss / m->tss);
+    fprintf(out, "%-24s %5lld %14.6g\n", "Total", (long long)(m->n - 1), m->tss);
     if (r->pairwise) {
         const es_model_pairwise *pw = r->pairwise;
-        printf("pairwise distances of LS means (p):\n");
+        fprintf(out, "pairwise distances of LS means (p):\n");
         for (int64_t a = 0; a < pw->nlevels; a++)
             for (int64_t b = a + 1; b < pw->nlevels; b++)
-                printf("  %-16s %-16s %12.6g  (p %.4g)\n", pw->levels[a], pw->levels[b],
-                       pw->dist[a + b * pw->nlevels], pw->pval[a + b * pw->nlevels]);
+                fprintf(out, "  %-16s %-16s %12.6g  (p %.4g)\n", pw->levels[a], pw->levels[b],
+                        pw->dist[a + b * pw->nlevels], pw->pval[a + b * pw->nlevels]);
     }
     if (r->edge_q) {
         int64_t n = 0, E = m->p;
         for (int64_t e = 0; e < E; e++) n += r->edge_q[e] < 0.05;
-        printf("edges with FDR q < 0.05: %lld of %lld\n", (long long)n, (long long)E);
+        fprintf(out, "edges with FDR q < 0.05: %lld of %lld\n", (long long)n, (long long)E);
     }
     return 0;
 }
@@ -115,8 +115,10 @@ int cmd_model(int argc, char **argv)
             else return cli_usage_error("model", "--permute is rrpp or raw, not '%s'", optarg);
             break;
         case 'p':
-            if (cli_parse_i64(optarg, &o.permutations) || o.permutations < 0)
-                return cli_usage_error("model", "--permutations needs a count >= 0");
+            if (cli_parse_i64(optarg, &o.permutations) || o.permutations < 0 ||
+                o.permutations > ES_MAX_PERMUTATIONS)
+                return cli_usage_error("model", "--permutations needs a count from 0 to %d",
+                                       ES_MAX_PERMUTATIONS);
             break;
         case O_CONTRASTS:
             if (!strcmp(optarg, "treatment")) o.contrasts = ES_CONTRASTS_TREATMENT;
@@ -126,8 +128,10 @@ int cmd_model(int argc, char **argv)
         case O_PAIRWISE: o.pairwise = optarg; break;
         case O_EDGES: o.edge_term = optarg; break;
         case O_EDGE_PERM:
-            if (cli_parse_i64(optarg, &o.edge_permutations) || o.edge_permutations < 0)
-                return cli_usage_error("model", "--edge-permutations needs a count >= 0");
+            if (cli_parse_i64(optarg, &o.edge_permutations) || o.edge_permutations < 0 ||
+                o.edge_permutations > ES_MAX_PERMUTATIONS)
+                return cli_usage_error("model", "--edge-permutations needs a count from 0 to "
+                                       "%d", ES_MAX_PERMUTATIONS);
             break;
         case O_SEED:
             if (cli_parse_i64(optarg, &seed) || seed < 1)
@@ -163,15 +167,16 @@ int cmd_model(int argc, char **argv)
         cli_fail("model", ctx, rc);
         goto done;
     }
-    print_table(r);
-    if (o.name) printf("stored as /analysis/model/%s\n", o.name);
+    FILE *out = cli_report_stream(csv);   /* "-o -": stdout is the CSV alone */
+    print_table(out, r);
+    if (o.name) fprintf(out, "stored as /analysis/model/%s\n", o.name);
     ret = CLI_OK;
     if (csv && (rc = es_study_write_model_table(ctx, r, csv)) != ES_OK)
         ret = cli_fail("model", ctx, rc);
 #if ES_HAVE_FIGURES
     if (ret == CLI_OK && figure) {
         if ((rc = es_figure_edge_tests(ctx, st, r, figure)) != ES_OK) ret = cli_fail("model", ctx, rc);
-        else printf("figure: %s\n", figure);
+        else fprintf(out, "figure: %s\n", figure);
     }
 #endif
 done:

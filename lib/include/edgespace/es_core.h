@@ -64,6 +64,10 @@ typedef struct es_mat {
 } es_mat;
 #define ES_AT(m, i, j) ((m).data[(i) + (int64_t)(j) * (m).ld])
 
+/* The most permutations any permutation test takes (models, per-edge tests,
+ * Mantel and group tests): 10^8, one cap for all of them. */
+#define ES_MAX_PERMUTATIONS 100000000
+
 /* Version string of the library, e.g. "0.1.0". Static. */
 ES_API const char *es_version(void);
 
@@ -144,8 +148,11 @@ ES_API uint64_t es_rng_below(es_rng *rng, uint64_t n);
 ES_API es_status es_make_dirs(es_ctx *ctx, const char *dir);
 
 /* One CSV field of free text (ids, labels, names) to f, quoted the RFC 4180
- * way when it holds a comma, quote or line break; "" for NULL. Every CSV
- * the library and the command write goes through it. */
+ * way when it holds a comma, quote or line break; "" for NULL. A field a
+ * spreadsheet would run as a formula (starting with = + - @, a tab or a
+ * carriage return, and not a number) is quoted with a leading apostrophe
+ * ("'=cmd|..."), as OWASP advises against CSV injection. Every CSV the
+ * library and the command write goes through it. */
 ES_API void es_csv_write_field(FILE *f, const char *s);
 
 #ifdef __cplusplus
