@@ -117,6 +117,10 @@ static const char *check_dtype(const hdr *h, const uint8_t *m, uint64_t n, int d
         const char *why;
         if ((b0 & 0x0f) != 1 || (b0 >> 4) > 2 || b1 > 1 || b2 || depth > 0)
             return "a variable-length datatype that is not a string";
+        /* its size is the descriptor's (length, collection address, index):
+         * libhdf5 1.10 copies an attribute's value at the size written here
+         * (72 for 16 read past the message: found by the store fuzzer) */
+        if (size != 8u + h->sa) return "a variable-length string of a wrong size";
         if ((why = check_dtype(h, m + 8, n - 8, depth + 1, &bu, &be))) return why;
         if ((m[8] & 0x0f) != 0 || be != 1) return "a variable-length string not of bytes";
         *used = 8 + bu;
