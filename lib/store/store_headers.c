@@ -18,7 +18,11 @@
  */
 #include "store/store_pkg.h"
 
+#include <errno.h>
+#include <fcntl.h>
 #include <stdio.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 enum {
     MAX_RANK = 32,            /* H5S_MAX_RANK */
@@ -29,6 +33,7 @@ enum {
 typedef struct hdr {
     es__h5_raw *r;
     unsigned sa, ss;
+    int superblock_ext;       /* the superblock extension's header: its own messages */
     const char *why;          /* the first problem (static text) */
     char whybuf[160];
     int nspace, ntype, nlayout, nfill, npline, ngroup, nstab, nlinfo;
@@ -488,6 +493,11 @@ static int check_msg(void *ud, unsigned type, unsigned flags, const uint8_t *m, 
                    ? 0
                    : bad(h, "a symbol table outside the file");
     case 0x07: return bad(h, "data in external files, which edgespace does not read");
+    case 0x13:                                                    /* B-tree 'K' values */
+        return h->superblock_ext && n >= 7 && m[0] == 0 ? 0 : bad(h, "a misplaced B-tree K message");
+    case 0x17:                                                    /* file space info */
+        return h->superblock_ext && n >= 2 && m[0] <= 1 ? 0
+                                                         : bad(h, "a misplaced file space message");
     default:
         snprintf(h->whybuf, sizeof h->whybuf, "a message of type %u, which edgespace does not "
                  "read", type);
@@ -532,13 +542,14 @@ static const char *check_whole(hdr *h)
     return NULL;
 }
 
-es_status es__h5_check_header(es__h5_raw *raw, uint64_t oaddr, const char *name)
+static es_status check_header(es__h5_raw *raw, uint64_t oaddr, const char *name, int ext)
 {
     es_ctx *ctx = es__h5_raw_ctx(raw);
     hdr h;
     es_status rc;
     const char *why;
     memset(&h, 0, sizeof h);
+    h.superblock_ext = ext;
     h.r = raw;
     h.sa = es__h5_raw_addr_size(raw);
     h.ss = es__h5_raw_length_size(raw);
@@ -555,6 +566,78 @@ es_status es__h5_check_header(es__h5_raw *raw, uint64_t oaddr, const char *name)
         ES_FAIL(ctx, ES_EFORMAT, "store: '%s' is corrupt: %s has %s (object header at %llu)",
                 es__h5_raw_path(raw), name, why, (unsigned long long)oaddr);
     return ES_OK;
+}
+
+es_status es__h5_check_header(es__h5_raw *raw, uint64_t oaddr, const char *name)
+{
+    return check_header(raw, oaddr, name, 0);
+}
+
+/* ---- the superblock (III.A.1), read before HDF5 opens the file ------------------ */
+
+static es_status sb_fail(es_ctx *ctx, const char *path, const char *why)
+{
+    ES_FAIL(ctx, ES_EFORMAT, "store: '%s' is corrupt: %s", path, why);
+}
+
+es_status es__h5_check_file(es_ctx *ctx, const char *path)
+{
+    static const uint8_t sig[8] = {0x89, 'H', 'D', 'F', '\r', '\n', 0x1a, '\n'};
+    uint8_t b[96];
+    uint64_t at = 0, size, root, ext = UINT64_MAX;
+    unsigned version, sa, ss, p;
+    es__h5_raw *raw = NULL;
+    es_status rc = ES_OK;
+    struct stat st;
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0 || fstat(fd, &st) != 0) {
+        rc = es__fail(ctx, ES_EIO, "store: cannot read '%s': %s", path, strerror(errno));
+        goto done;
+    }
+    size = (uint64_t)st.st_size;
+    /* the signature at 0, 512, 1024, 2048, ... (a user block before it) */
+    for (;; at = at ? 2 * at : 512) {
+        if (at + sizeof b > size) {
+            rc = sb_fail(ctx, path, "no HDF5 superblock");
+            goto done;
+        }
+        if (pread(fd, b, sizeof b, (off_t)at) != (ssize_t)sizeof b) {
+            rc = es__fail(ctx, ES_EIO, "store: cannot read '%s': %s", path, strerror(errno));
+            goto done;
+        }
+        if (!memcmp(b, sig, 8)) break;
+    }
+    version = b[8];
+    if (version <= 1) {
+        sa = b[13];
+        ss = b[14];
+        p = version == 0 ? 24 : 28;          /* base, free space, end of file, driver, */
+        if (sa != 4 && sa != 8) {             /* then the root's symbol table entry */
+            rc = sb_fail(ctx, path, "a superblock of an unusual address size");
+            goto done;
+        }
+        root = le(b + p + 5 * sa, sa);
+    } else if (version == 2 || version == 3) {
+        sa = b[9];
+        ss = b[10];
+        if (sa != 4 && sa != 8) {
+            rc = sb_fail(ctx, path, "a superblock of an unusual address size");
+            goto done;
+        }
+        ext = le(b + 12 + sa, sa);
+        root = le(b + 12 + 3 * sa, sa);
+    } else {
+        rc = sb_fail(ctx, path, "a superblock of an unknown version");
+        goto done;
+    }
+    if ((rc = es__h5_raw_open_fd(ctx, fd, path, at, sa, ss, &raw)) != ES_OK) goto done;
+    rc = check_header(raw, root, "the root group", 0);
+    if (rc == ES_OK && ext != UINT64_MAX && !(sa == 4 && ext == 0xffffffffu))
+        rc = check_header(raw, ext, "the superblock extension", 1);
+done:
+    es__h5_raw_close(raw);
+    if (fd >= 0) close(fd);
+    return rc;
 }
 
 es_status es__h5_check_object(es__h5_raw *raw, hid_t obj, const char *name)

@@ -69,6 +69,8 @@ static es_status open_impl(es_ctx *ctx, const char *path, es_store_mode mode, es
         if (is < 0) return es__h5_fail(ctx, ES_EIO, "store: cannot read '%s'", path);
         ES_FAIL(ctx, ES_EFORMAT, "store: '%s' is not an HDF5 file", path);
     }
+    /* what HDF5 decodes while opening (the root group's header) */
+    if ((rc = es__h5_check_file(ctx, path)) != ES_OK) return rc;
     if (!(s = es__calloc(ctx, 1, sizeof *s))) return ES_ENOMEM;
     s->ctx = ctx;
     s->file = -1;

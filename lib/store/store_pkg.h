@@ -117,6 +117,11 @@ es_status es__h5_read_attr_i64(es_ctx *ctx, hid_t obj, const char *objname, cons
  * names the store in messages (borrowed). */
 typedef struct es__h5_raw es__h5_raw;
 es_status es__h5_raw_open(es_ctx *ctx, hid_t obj, const char *path, es__h5_raw **out);
+/* A raw reader of a file HDF5 has not opened: fd (the caller's, closed by
+ * the caller after es__h5_raw_close), the superblock's base address and
+ * sizes of addresses and lengths. */
+es_status es__h5_raw_open_fd(es_ctx *ctx, int fd, const char *path, uint64_t base, unsigned sa,
+                             unsigned ss, es__h5_raw **out);
 void es__h5_raw_close(es__h5_raw *raw);
 /* A whole 1-D string dataset (variable or fixed length) of exactly n rows
  * into out[0..n) (allocated through ctx; the caller frees what is non-NULL,
@@ -165,6 +170,11 @@ es_status es__h5_check_group(es__h5_raw *raw, hid_t group, const char *name);
 es_status es__h5_check_header(es__h5_raw *raw, uint64_t oaddr, const char *name);
 es_status es__h5_check_object(es__h5_raw *raw, hid_t obj, const char *name);
 es_status es__h5_check_named(es__h5_raw *raw, hid_t loc, const char *name);
+/* Before HDF5 opens path at all: its superblock (versions 0 to 2) and the
+ * headers HDF5 decodes while opening (the root group's, a version 2
+ * superblock's extension), read raw (libhdf5 1.10 allocates what the root
+ * header's chunks claim, 2 GB and more, before it refuses them). */
+es_status es__h5_check_file(es_ctx *ctx, const char *path);
 /* A string attribute, or one integer or real as text, into buf[n],
  * truncated; ES_ENOTFOUND if absent. */
 es_status es__h5_read_attr_text(es_ctx *ctx, es__h5_raw *raw, hid_t obj, const char *key,

@@ -112,6 +112,29 @@ done:
     return ES_OK;
 }
 
+es_status es__h5_raw_open_fd(es_ctx *ctx, int fd, const char *path, uint64_t base, unsigned sa,
+                             unsigned ss, es__h5_raw **out)
+{
+    es__h5_raw *r;
+    struct stat st;
+    *out = NULL;
+    if (fstat(fd, &st) != 0)
+        ES_FAIL(ctx, ES_EIO, "store: cannot read '%s': %s", path, strerror(errno));
+    if ((sa != 4 && sa != 8) || (ss != 4 && ss != 8))
+        ES_FAIL(ctx, ES_EFORMAT, "store: '%s': %u-byte addresses and %u-byte lengths (edgespace "
+                "reads 4 or 8)", path, sa, ss);
+    if (!(r = es__calloc(ctx, 1, sizeof *r))) return ES_ENOMEM;
+    r->ctx = ctx;
+    r->path = path;
+    r->fd = fd;
+    r->sa = sa;
+    r->ss = ss;
+    r->base = base;
+    r->eof = (uint64_t)st.st_size;
+    *out = r;
+    return ES_OK;
+}
+
 unsigned es__h5_raw_vlen_size(const es__h5_raw *r) { return 8 + r->sa; }
 
 es_status es__h5_object_addr(es_ctx *ctx, hid_t obj, uint64_t *addr)
