@@ -63,7 +63,9 @@ static es_status load_heap(stab *t)
     t->dsize = es__h5_le(pre + 8, ss);
     free_at = es__h5_le(pre + 8 + ss, ss);
     data_at = es__h5_le(pre + 8 + 2 * ss, sa);
-    if (t->dsize == 0 || t->dsize > ((uint64_t)1 << 32))
+    /* (against the file before it is allocated: a claim of 1.2 GB cost 38 s
+     * under ASan, found by the store fuzzer) */
+    if (t->dsize == 0 || t->dsize > ((uint64_t)1 << 32) || t->dsize > es__h5_raw_file_size(t->r))
         return corrupt(t, "a local heap of a wrong size", t->heap);
     if (!(t->heapdata = es__malloc(ctx, (size_t)t->dsize + 1))) return ES_ENOMEM;
     if ((rc = es__h5_raw_read(t->r, data_at, t->dsize, t->heapdata, "a local heap")))
