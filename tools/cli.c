@@ -10,10 +10,19 @@
 #include <time.h>
 #include <unistd.h>
 
+/* A progress stream ("interp: frames", "embedding"): when it started, when
+ * it last wrote a log line, and the tenth it had reached then. */
+typedef struct cli_stream {
+    char what[64];
+    double start, last_line;
+    int64_t tenth;
+} cli_stream;
+
 typedef struct cli_state {
     const char *verb;
     int tty;
     double last_draw;
+    cli_stream streams[4];
 } cli_state;
 
 static cli_state state;
@@ -32,19 +41,60 @@ static double now_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* A one-line bar redrawn at most ten times a second; quiet when stderr is
- * not a terminal so logs and pipes stay clean. */
+/* The stream of this name, made (or the oldest reused) when done is 0. */
+static cli_stream *stream_of(cli_state *st, const char *what, int64_t done, double t)
+{
+    cli_stream *s = NULL, *oldest = &st->streams[0];
+    for (int i = 0; i < 4; i++) {
+        if (!strncmp(st->streams[i].what, what, sizeof st->streams[i].what - 1)) s = &st->streams[i];
+        if (st->streams[i].start < oldest->start) oldest = &st->streams[i];
+    }
+    if (!s || done == 0) {
+        if (!s) s = oldest;
+        snprintf(s->what, sizeof s->what, "%s", what);
+        s->start = s->last_line = t;
+        s->tenth = 0;
+    }
+    return s;
+}
+
+/* Without a terminal (a log, a pipe): one line per tenth of the work or per
+ * 5 s, whichever comes first, and one at the end, for work that has run a
+ * second or more; a short embedding stays quiet. */
+static void log_progress(cli_state *st, const char *what, int64_t done, int64_t total, double t)
+{
+    cli_stream *s = stream_of(st, what, done, t);
+    int64_t tenth = total > 0 ? 10 * done / total : 10;
+    if (t - s->start < 1.0) {
+        s->tenth = tenth;
+        return;
+    }
+    if (done >= total || tenth > s->tenth || t - s->last_line >= 5.0) {
+        fprintf(stderr, "edgespace %s: %s %lld of %lld (%.0f %%, %.1f s)\n", st->verb, what,
+                (long long)done, (long long)total, total > 0 ? 100.0 * done / total : 100.0,
+                t - s->start);
+        fflush(stderr);
+        s->last_line = t;
+        s->tenth = tenth;
+    }
+}
+
+/* A one-line bar ("interp: frames [###...] 3 of 21") redrawn at most ten
+ * times a second on a terminal; log lines otherwise (log_progress). */
 static void on_progress(void *ud, const char *what, int64_t done, int64_t total)
 {
     cli_state *st = ud;
     double t = now_seconds();
-    if (!st->tty) return;
+    if (!st->tty) {
+        log_progress(st, what, done, total, t);
+        return;
+    }
     if (done < total && t - st->last_draw < 0.1) return;
     st->last_draw = t;
     int width = 30, filled = total > 0 ? (int)(width * done / total) : width;
     fprintf(stderr, "\r%-24.24s [", what);
     for (int i = 0; i < width; i++) fputc(i < filled ? '#' : '.', stderr);
-    fprintf(stderr, "] %lld/%lld", (long long)done, (long long)total);
+    fprintf(stderr, "] %lld of %lld", (long long)done, (long long)total);
     if (done >= total) fputs("\r\033[K", stderr);
     fflush(stderr);
 }
@@ -179,4 +229,43 @@ int cli_parse_double(const char *s, double *out)
     if (errno || end == s || *end || !isfinite(v)) return -1;
     *out = v;
     return 0;
+}
+
+int cli_embed_option(const char *verb, int c, const char *arg, es_embed_opts *o)
+{
+    int64_t n;
+    double w;
+    switch (c) {
+    case 0x101:
+        if (cli_parse_double(arg, &w) || !(w >= 0))
+            return cli_usage_error(verb, "--bending wants a weight >= 0");
+        o->prior_mu = w;
+        return 0;
+    case 0x102:
+        if (cli_parse_i64(arg, &n) || n < 0 || n > 100000)
+            return cli_usage_error(verb, "--refine-iters wants a count >= 0");
+        o->refine_max_iter = (int)n;
+        return 0;
+    case 0x103:
+        if (cli_parse_i64(arg, &n) || n < 0 || n > 1000000)
+            return cli_usage_error(verb, "--iters wants a count >= 0");
+        o->lg_max_iter = (int)n;
+        return 0;
+    case 0x104: {
+        es_embed_opts f;
+        es_embed_opts_fast(&f);
+        o->lg_polish = f.lg_polish;
+        o->lg_max_iter = f.lg_max_iter;
+        o->lg_rms_tol = f.lg_rms_tol;
+        o->lg_max_tol = f.lg_max_tol;
+        return 0;
+    }
+    case 0x105:
+        if (!strcmp(arg, "auto")) o->solver = ES_EMBED_SOLVER_AUTO;
+        else if (!strcmp(arg, "lm")) o->solver = ES_EMBED_SOLVER_LM;
+        else return cli_usage_error(verb, "--solver wants auto or lm (got '%s')", arg);
+        return 0;
+    default:
+        return -1;
+    }
 }

@@ -38,6 +38,30 @@ int cli_parse_double(const char *s, double *out);
  * and B ("8G", "512MB", "1.5e9"); 0 or -1. */
 int cli_parse_size(const char *s, uint64_t *out);
 
+/* The embedding options embed, interp and variation share, as getopt codes
+ * (CLI_EMBED_LONGOPTS in their option tables):
+ *   --bending W  --refine-iters N  --iters N  --fast  --solver NAME
+ * cli_embed_option applies code c with argument arg to o: 0 if it was one
+ * of them, CLI_USAGE after printing why the value is wrong, -1 if c is not
+ * an embedding option. CLI_EMBED_HELP is their help text. */
+#define CLI_EMBED_LONGOPTS \
+    {"bending", required_argument, NULL, 0x101}, {"refine-iters", required_argument, NULL, 0x102}, \
+    {"iters", required_argument, NULL, 0x103}, {"fast", no_argument, NULL, 0x104}, \
+    {"solver", required_argument, NULL, 0x105}
+#define CLI_EMBED_HELP \
+    "      --iters N        local-global iterations at most (default 40; the solver:\n" \
+    "                       lib/embed/local_global.c)\n" \
+    "      --refine-iters N Levenberg-Marquardt iterations that finish where the\n" \
+    "                       local-global ones did not reach RMS 0.05 % / max 1 %\n" \
+    "                       (default 12; 0: none)\n" \
+    "      --fast           a slider's accuracy: local-global alone, RMS 0.1 % / max\n" \
+    "                       2 %, at most 30 iterations\n" \
+    "      --solver NAME    auto (the above) or lm (Levenberg-Marquardt from the prior,\n" \
+    "                       the solver before: a 3V x 3V factorization per iteration)\n" \
+    "      --bending W      weight of the prior's bending term in the Levenberg-\n" \
+    "                       Marquardt iterations (default 0.0025)\n"
+int cli_embed_option(const char *verb, int c, const char *arg, es_embed_opts *o);
+
 /* Subcommand entry points: argv[0] is the verb. */
 typedef int (*cli_cmd_fn)(int argc, char **argv);
 

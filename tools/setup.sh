@@ -33,9 +33,12 @@ packages=(
   # python/tests/run.py --check verifies them below)
   python3-cffi python3-numpy python3-pytest python3-h5py python3-tqdm python3-pandas
   jupyter-nbconvert python3-ipykernel
+  python3-scipy              # the published pipeline's oracle (fmin_l_bfgs_b)
   # R, for the tests that run datasets-spec/store-format.md's R snippets
   r-cran-hdf5r r-bioc-rhdf5
   r-cran-vegan               # the oracle of edgespace model (tools/oracle/adonis2.R)
+  r-cran-ape r-cran-ggplot2  # RRPP's imports (with r-cran-matrix), for the optional RRPP
+                             # oracle built from source by tools/oracle/install_rrpp.sh
 )
 
 install_missing() {

@@ -21,6 +21,27 @@
 
 #include <cholmod.h>
 
+/* ---- limited-memory BFGS (lbfgs.c) -------------------------------------- */
+
+/* The two-loop recursion of L-BFGS (Nocedal 1980) with a caller's initial
+ * inverse Hessian: the m latest pairs s = x+ - x, y = g+ - g. */
+#define ES__LBFGS_MAX 16
+typedef struct es__lbfgs {
+    int64_t n;
+    int m, count, head;
+    double *mem, *s, *y, rho[ES__LBFGS_MAX], alpha[ES__LBFGS_MAX];
+} es__lbfgs;
+es_status es__lbfgs_init(es_ctx *ctx, es__lbfgs *lb, int64_t n, int m);
+void es__lbfgs_free(es_ctx *ctx, es__lbfgs *lb);
+void es__lbfgs_reset(es__lbfgs *lb);
+/* First loop: q = g reduced by the pairs, in place. */
+void es__lbfgs_first(es__lbfgs *lb, double *q);
+/* Second loop: d = H0 q (given) corrected by the pairs, in place. */
+void es__lbfgs_second(es__lbfgs *lb, double *d);
+/* Keep the pair (x+ - x, g+ - g) if its curvature is positive. */
+void es__lbfgs_push(es__lbfgs *lb, const double *x0, const double *x1, const double *g0,
+                    const double *g1);
+
 /* ---- the embedder (embedder.c) ------------------------------------------ */
 
 /* Everything here is sized and, for the sparse matrices, patterned and
@@ -66,7 +87,21 @@ struct es_embedder {
     double *omega, *prior_alpha, *vdev;   /* E, E, V (vdev: distance from the prior) */
     int have_deviation;
     int64_t nfactor;        /* numeric factorizations in the last solve */
+    /* the local-global solve (local_global.c), made on its first use: the
+     * weighted Laplacian A1 in H1's pattern and its factor F1 (H1's order),
+     * the edge weights, the rest triangles of the current target, and work */
+    cholmod_sparse *A1;
+    cholmod_factor *F1;
+    cholmod_dense *LB, *LX, *LY, *LE;
+    double *lg_w, *lg_rest, *lg_work, lg_eps;
+    es__lbfgs lg_hist;
 };
+
+/* What es__embedder_need makes on first use (embedder.c). */
+#define ES__NEED_H3 1u          /* H3, its analysis and B3: stages 2 and 4 */
+#define ES__NEED_CLOSURE 2u     /* HA, its analysis and BA: stage 1 */
+#define ES__NEED_POSITIONS 4u   /* the position Laplacian's factor and B1: stage 3 */
+es_status es__embedder_need(es_embedder *emb, unsigned what);
 
 /* Slot in H3->x of H[3a + p, 3b + q], (a, b) = edge e's vertices (a < b),
  * and of H[3v + r, 3v + c] (either triangle). */
@@ -206,6 +241,45 @@ es__refine_opts es__refine_opts_from(const es_embed_opts *o);
  * *iters grows by the iterations run. */
 es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz, es__bend_prior *bp,
                            const es__refine_opts *ro, int64_t *iters);
+
+/* ---- the local-global solve (local_global.c) ---------------------------- */
+
+/* When it stops: the edge lengths meet both tolerances (0: that rule off),
+ * the energy falls by less than rtol of itself per iteration over the last
+ * five, or after max_iter iterations. */
+typedef struct es__lg_opts {
+    int max_iter, history;
+    double rms_tol, max_tol, rtol;
+    int verbose;
+} es__lg_opts;
+
+typedef struct es__lg_result {
+    int64_t iters;
+    int met;               /* 1: stopped because the tolerances were met */
+    double energy, rms, max;
+} es__lg_result;
+
+/* Positions xyz (3 x V, in place: the start) whose every face is as near
+ * congruent to the triangle of its target lengths L (E) as local-global
+ * iterations get in the rules of o. */
+es_status es__lg_solve(es_embedder *emb, const double *L, double *xyz, const es__lg_opts *o,
+                       es__lg_result *res);
+
+/* RMS ratio and max relative error of positions against lengths L, as
+ * es_embed_length_error measures them (normalize 0) without its
+ * allocation and percentile (solve.c). */
+void es__length_fit(const es_embedder *emb, const double *xyz, const double *L, double *rms,
+                    double *mx);
+
+/* ---- lengths that form triangles (lengths_project.c) -------------------- */
+
+/* The lengths nearest to L (E; relative least squares) whose every face
+ * satisfies the triangle inequality with margin: the longest edge at most
+ * (1 - margin) times the sum of the other two. Writes them to out (may be
+ * L); returns the number of lengths changed, and the RMS and largest
+ * relative change. */
+int64_t es__lengths_project(es_embedder *emb, const double *L, double margin, double *out,
+                            double *rms_change, double *max_change);
 
 /* What a prior solve asks of the driver (solve.c) beyond es_embed_solve. */
 typedef struct es__solve_ext {

@@ -243,38 +243,115 @@ static cholmod_factor *analyze_with(es_embedder *emb, cholmod_sparse *A, int ord
  * flops per factorization than AMD, which orders smaller meshes in less
  * time than they would gain). The order includes CHOLMOD's postorder of
  * the vertex elimination tree; H3 is then built in that order and analysed
- * as it is (perm_block_pattern). */
-static es_status analyze(es_embedder *emb)
+ * as it is (perm_block_pattern). A caller that kept the order of an
+ * earlier embedder of the same topology (es_embedder_ordering) passes it
+ * back, and the ordering is not computed again. */
+static es_status analyze_vertex_graph(es_embedder *emb, const int64_t *order)
 {
     int64_t nv = emb->nv;
-    emb->L1 = analyze_with(emb, emb->H1, nv >= 10000 ? CHOLMOD_METIS : CHOLMOD_AMD, 1);
-    if (!emb->L1) goto cm_fail;
-    memcpy(emb->perm, emb->L1->Perm, (size_t)nv * sizeof *emb->perm);
-    for (int64_t j = 0; j < nv; j++) emb->pinv[emb->perm[j]] = j;
-    if (!(emb->H3 = perm_block_pattern(emb))) goto cm_fail;
-    emb->L3 = analyze_with(emb, emb->H3, CHOLMOD_NATURAL, 0);
-    if (!emb->L3) goto cm_fail;
-    /* a supernodal factor's values, allocated now with huge pages (their
-     * first touch was ~3x the cost of a later factorization). Only a
-     * supernodal symbolic factor may be converted here: asking for
-     * to_super on a simplicial one (small meshes) gave a factor whose
-     * solves were wrong (residual 3 on the oracle's hemi2 frames). */
-    if (emb->L3->is_super) {
-        if (!cholmod_l_change_factor(CHOLMOD_REAL, 1, 1, 1, 1, emb->L3, &emb->cm)) goto cm_fail;
-        es__advise_huge(emb->L3->x, emb->L3->xsize * sizeof(double));
+    if (order) {
+        cholmod_common *cm = &emb->cm;
+        int nmethods = cm->nmethods, ord = cm->method[0].ordering, post = cm->postorder;
+        cm->nmethods = 1;
+        cm->method[0].ordering = CHOLMOD_GIVEN;
+        cm->postorder = 0;   /* the order given is already postordered */
+        emb->L1 = cholmod_l_analyze_p(emb->H1, (int64_t *)order, NULL, 0, cm);
+        cm->nmethods = nmethods;
+        cm->method[0].ordering = ord;
+        cm->postorder = post;
+    } else {
+        emb->L1 = analyze_with(emb, emb->H1, nv >= 10000 ? CHOLMOD_METIS : CHOLMOD_AMD, 1);
     }
-    if (emb->nvar > 0) {
-        es_status rc = closure_pattern(emb);
-        if (rc != ES_OK) return rc;
-        emb->LA = analyze_with(emb, emb->HA, -1, 1);
-        if (!emb->LA) goto cm_fail;
-    }
-    return ES_OK;
-cm_fail: {
+    if (!emb->L1) {
         es_status rc = es__cm_check(emb, "analyze");
         return rc != ES_OK ? rc : es__fail(emb->ctx, ES_ENOMEM, "embed: CHOLMOD out of memory "
                                                                 "in analyze");
     }
+    memcpy(emb->perm, emb->L1->Perm, (size_t)nv * sizeof *emb->perm);
+    for (int64_t j = 0; j < nv; j++) emb->pinv[emb->perm[j]] = j;
+    return ES_OK;
+}
+
+static es_status cm_fail(es_embedder *emb, const char *what)
+{
+    es_status rc = es__cm_check(emb, what);
+    return rc != ES_OK ? rc : es__fail(emb->ctx, ES_ENOMEM, "embed: CHOLMOD out of memory in %s",
+                                       what);
+}
+
+/* H3 (stages 2 and 4): its pattern in the vertex order, its analysis and
+ * the factor's values (allocated now with huge pages: their first touch
+ * was ~3x the cost of a later factorization). Only a supernodal symbolic
+ * factor may be converted here: asking for to_super on a simplicial one
+ * (small meshes) gave a factor whose solves were wrong (residual 3 on the
+ * oracle's hemi2 frames). */
+static es_status build_h3(es_embedder *emb)
+{
+    if (!(emb->H3 = perm_block_pattern(emb))) return cm_fail(emb, "pattern");
+    emb->L3 = analyze_with(emb, emb->H3, CHOLMOD_NATURAL, 0);
+    if (!emb->L3) return cm_fail(emb, "analyze");
+    if (emb->L3->is_super) {
+        if (!cholmod_l_change_factor(CHOLMOD_REAL, 1, 1, 1, 1, emb->L3, &emb->cm))
+            return cm_fail(emb, "analyze");
+        es__advise_huge(emb->L3->x, emb->L3->xsize * sizeof(double));
+    }
+    emb->B3 = cholmod_l_allocate_dense((size_t)(3 * emb->nv), 3, (size_t)(3 * emb->nv),
+                                       CHOLMOD_REAL, &emb->cm);
+    return emb->B3 ? ES_OK : cm_fail(emb, "allocate");
+}
+
+/* HA (stage 1): the closure Gauss-Newton pattern and its analysis. */
+static es_status build_closure(es_embedder *emb)
+{
+    es_status rc;
+    if (emb->nvar == 0) return ES_OK;
+    if ((rc = closure_pattern(emb)) != ES_OK) return rc;
+    emb->LA = analyze_with(emb, emb->HA, -1, 1);
+    if (!emb->LA) return cm_fail(emb, "analyze");
+    emb->BA = cholmod_l_allocate_dense((size_t)emb->nvar, 1, (size_t)emb->nvar, CHOLMOD_REAL,
+                                       &emb->cm);
+    return emb->BA ? ES_OK : cm_fail(emb, "allocate");
+}
+
+/* The position Laplacian of stage 3 (both directed copies of every edge,
+ * the lowest vertex of each component pinned) depends on the topology
+ * only: factorized once, on first use. */
+static es_status factor_positions(es_embedder *emb)
+{
+    double *x = emb->H1->x;
+    memset(x, 0, emb->H1->nzmax * sizeof(double));
+    for (int64_t e = 0; e < emb->ne; e++) {
+        int64_t a = emb->edges[2 * e], b = emb->edges[2 * e + 1];
+        if (!emb->pinned[a] && !emb->pinned[b]) x[es__pos_off(emb->H1, 1, emb->rank, e, b, 0, 0)] = -2.0;
+        if (!emb->pinned[a]) x[es__pos_diag(emb->H1, 1, emb->nlow, a, 0, 0)] += 2.0;
+        if (!emb->pinned[b]) x[es__pos_diag(emb->H1, 1, emb->nlow, b, 0, 0)] += 2.0;
+    }
+    for (int64_t v = 0; v < emb->nv; v++)
+        if (emb->pinned[v] || emb->off[v + 1] == emb->off[v])
+            x[es__pos_diag(emb->H1, 1, emb->nlow, v, 0, 0)] = 1.0;
+    emb->cm.status = CHOLMOD_OK;
+    if (!es__factorize(emb, emb->H1, emb->L1) || emb->cm.status != CHOLMOD_OK) {
+        es_status rc = es__cm_check(emb, "factorize (positions)");
+        return rc != ES_OK ? rc : es__fail(emb->ctx, ES_ENUMERIC, "embed: position Laplacian is singular");
+    }
+    emb->B1 = cholmod_l_allocate_dense((size_t)emb->nv, 3, (size_t)emb->nv, CHOLMOD_REAL,
+                                       &emb->cm);
+    return emb->B1 ? ES_OK : cm_fail(emb, "allocate");
+}
+
+/* What a stage needs, made on its first use: a solve from a prior's
+ * positions (local_global.c) needs none of the three, so an embedder that
+ * serves only those is made in a fraction of the time. */
+es_status es__embedder_need(es_embedder *emb, unsigned what)
+{
+    es_status rc;
+    if ((what & ES__NEED_H3) && !emb->H3 && (rc = build_h3(emb)) != ES_OK) return rc;
+    if ((what & ES__NEED_CLOSURE) && emb->nvar > 0 && !emb->HA &&
+        (rc = build_closure(emb)) != ES_OK)
+        return rc;
+    if ((what & ES__NEED_POSITIONS) && !emb->B1 && (rc = factor_positions(emb)) != ES_OK)
+        return rc;
+    return ES_OK;
 }
 
 /* ---- construction ----------------------------------------------------- */
@@ -326,6 +403,12 @@ static es_status alloc_work(es_embedder *emb)
 }
 
 es_status es_embedder_new(es_ctx *ctx, const es_mesh *mesh, es_embedder **out)
+{
+    return es_embedder_new_ordered(ctx, mesh, NULL, out);
+}
+
+es_status es_embedder_new_ordered(es_ctx *ctx, const es_mesh *mesh, const int64_t *order,
+                                  es_embedder **out)
 {
     es_embedder *emb;
     es_status rc;
@@ -415,49 +498,33 @@ es_status es_embedder_new(es_ctx *ctx, const es_mesh *mesh, es_embedder **out)
         emb->var[e] = (!emb->eb[e] && (!emb->vb[a] || !emb->vb[b])) ? emb->nvar++ : -1;
     }
 
-    /* patterns and symbolic analyses: once per topology */
+    /* the order is checked before CHOLMOD sees it: a permutation of the
+     * vertices (a stale or foreign cache must not reach the analysis) */
+    if (order) {
+        if (!(cnt = es__calloc(ctx, (size_t)emb->nv + 1, sizeof *cnt))) {
+            rc = ES_ENOMEM;
+            goto fail;
+        }
+        for (int64_t j = 0; j < emb->nv; j++) {
+            if (order[j] < 0 || order[j] >= emb->nv || cnt[order[j]]++) {
+                rc = es__fail(ctx, ES_EINVAL, "embed: the vertex order given is not a "
+                              "permutation of the %lld vertices", (long long)emb->nv);
+                goto fail;
+            }
+        }
+        es__free(ctx, cnt);
+        cnt = NULL;
+    }
+
+    /* the vertex graph and its order: once per topology; the other
+     * matrices are made on first use (es__embedder_need) */
     emb->H1 = block_pattern(emb, 1);
     if (!emb->H1) {
         rc = es__cm_check(emb, "pattern");
         if (rc == ES_OK) rc = ES_ENOMEM;
         goto fail;
     }
-    if ((rc = analyze(emb)) != ES_OK) goto fail;
-    if (emb->nvar > 0)
-        emb->BA = cholmod_l_allocate_dense((size_t)emb->nvar, 1, (size_t)emb->nvar, CHOLMOD_REAL,
-                                           &emb->cm);
-    emb->B3 = cholmod_l_allocate_dense((size_t)(3 * emb->nv), 3, (size_t)(3 * emb->nv),
-                                       CHOLMOD_REAL, &emb->cm);
-    emb->B1 = cholmod_l_allocate_dense((size_t)emb->nv, 3, (size_t)emb->nv, CHOLMOD_REAL,
-                                       &emb->cm);
-    if (!emb->B3 || !emb->B1 || (emb->nvar > 0 && !emb->BA)) {
-        rc = ES_ENOMEM;
-        es__fail(ctx, rc, "embed: CHOLMOD out of memory");
-        goto fail;
-    }
-
-    /* The position Laplacian (both directed copies of every edge, the
-     * lowest vertex of each component pinned) depends on the topology
-     * only: factorize it now, once. */
-    {
-        double *x = emb->H1->x;
-        for (int64_t e = 0; e < emb->ne; e++) {
-            int64_t a = emb->edges[2 * e], b = emb->edges[2 * e + 1];
-            if (!emb->pinned[a] && !emb->pinned[b]) x[es__pos_off(emb->H1, 1, emb->rank, e, b, 0, 0)] = -2.0;
-            if (!emb->pinned[a]) x[es__pos_diag(emb->H1, 1, emb->nlow, a, 0, 0)] += 2.0;
-            if (!emb->pinned[b]) x[es__pos_diag(emb->H1, 1, emb->nlow, b, 0, 0)] += 2.0;
-        }
-        for (int64_t v = 0; v < emb->nv; v++)
-            if (emb->pinned[v] || emb->off[v + 1] == emb->off[v])
-                x[es__pos_diag(emb->H1, 1, emb->nlow, v, 0, 0)] = 1.0;
-        if (!es__factorize(emb, emb->H1, emb->L1) ||
-            emb->cm.status != CHOLMOD_OK) {
-            rc = es__cm_check(emb, "factorize (positions)");
-            if (rc == ES_OK)
-                rc = es__fail(ctx, ES_ENUMERIC, "embed: position Laplacian is singular");
-            goto fail;
-        }
-    }
+    if ((rc = analyze_vertex_graph(emb, order)) != ES_OK) goto fail;
     *out = emb;
     return ES_OK;
 fail:
@@ -484,6 +551,12 @@ void es_embedder_free(es_embedder *emb)
         cholmod_l_free_dense(&emb->B3, &emb->cm);
         cholmod_l_free_dense(&emb->B1, &emb->cm);
         cholmod_l_free_dense(&emb->BA, &emb->cm);
+        cholmod_l_free_sparse(&emb->A1, &emb->cm);
+        cholmod_l_free_factor(&emb->F1, &emb->cm);
+        cholmod_l_free_dense(&emb->LB, &emb->cm);
+        cholmod_l_free_dense(&emb->LX, &emb->cm);
+        cholmod_l_free_dense(&emb->LY, &emb->cm);
+        cholmod_l_free_dense(&emb->LE, &emb->cm);
         cholmod_l_finish(&emb->cm);
     }
     void *bufs[] = {emb->slot_corner, emb->edge_slot, emb->pinned, emb->vweight, emb->rank,
@@ -493,12 +566,16 @@ void es_embedder_free(es_embedder *emb)
                     emb->res, emb->grad, emb->diag, emb->pcg,
                     emb->jw, emb->fanwork, emb->fanr, emb->fanth, emb->fanal, emb->vclos,
                     emb->verr, emb->flap, emb->omega, emb->prior_alpha, emb->vdev,
-                    emb->perm, emb->pinv, emb->eslot, emb->eswap, emb->vslot};
+                    emb->perm, emb->pinv, emb->eslot, emb->eswap, emb->vslot,
+                    emb->lg_w, emb->lg_rest, emb->lg_work};
     for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++) es__free(ctx, bufs[i]);
+    es__lbfgs_free(ctx, &emb->lg_hist);
     es__free(ctx, emb);
 }
 
 const es_mesh *es_embedder_mesh(const es_embedder *emb) { return emb ? emb->mesh : NULL; }
+
+const int64_t *es_embedder_ordering(const es_embedder *emb) { return emb ? emb->perm : NULL; }
 
 
 const double *es_embedder_vertex_closure(const es_embedder *emb)

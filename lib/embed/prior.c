@@ -19,9 +19,22 @@
 #include <math.h>
 #include <string.h>
 
-es_status es_embed_prior_from_rows(es_ctx *ctx, int64_t nverts, int64_t nedges, int64_t n,
-                                   const double *const *aligned, const double *const *alpha_rows,
-                                   const double *w, double *xyz, double *alpha, double *sd)
+/* d - c wrapped to [-pi, pi) for d, c in [-pi, pi]: one correction does
+ * (remainder() cost as much as the rest of the loop). */
+static double wrap_diff(double d, double c)
+{
+    double x = d - c;
+    if (x >= M_PI) x -= 2.0 * M_PI;
+    else if (x < -M_PI) x += 2.0 * M_PI;
+    return x;
+}
+
+es_status es_embed_prior_from_rows_sc(es_ctx *ctx, int64_t nverts, int64_t nedges, int64_t n,
+                                      const double *const *aligned,
+                                      const double *const *alpha_rows,
+                                      const double *const *cos_rows,
+                                      const double *const *sin_rows, const double *w,
+                                      double *xyz, double *alpha, double *sd)
 {
     if (n < 1 || !w) ES_FAIL(ctx, ES_EINVAL, "prior: need at least one row and its weight");
     for (int64_t k = 0; k < n; k++)
@@ -40,25 +53,65 @@ es_status es_embed_prior_from_rows(es_ctx *ctx, int64_t nverts, int64_t nedges, 
         wa += fabs(w[k]);
         if (fabs(w[k]) > fabs(w[big])) big = k;
     }
-    for (int64_t e = 0; e < nedges; e++) {
-        double cs = 0, sn = 0, c, a = 0, v = 0;
-        for (int64_t k = 0; k < n; k++)
-            if (w[k] != 0) {
-                cs += fabs(w[k]) * cos(alpha_rows[k][e]);
-                sn += fabs(w[k]) * sin(alpha_rows[k][e]);
+    /* row by row (each row's arrays read once, in order) into per-edge sums;
+     * xyz's buffer is not needed here, alpha and sd hold the sums */
+    double *cs = alpha ? alpha : sd, *sn = alpha && sd ? sd : NULL;
+    double *tmp = NULL;
+    if (!sn && !(sn = tmp = es__alloc_array(ctx, nedges, sizeof *sn))) return ES_ENOMEM;
+    memset(cs, 0, (size_t)nedges * sizeof *cs);
+    memset(sn, 0, (size_t)nedges * sizeof *sn);
+    for (int64_t k = 0; k < n; k++) {
+        double a = fabs(w[k]);
+        if (a == 0) continue;
+        if (cos_rows && sin_rows) {
+            for (int64_t e = 0; e < nedges; e++) {
+                cs[e] += a * cos_rows[k][e];
+                sn[e] += a * sin_rows[k][e];
             }
-        /* the circular mean; rows that cancel out fall back to the heaviest */
-        c = cs * cs + sn * sn > 1e-24 ? atan2(sn, cs) : alpha_rows[big][e];
-        for (int64_t k = 0; k < n; k++)
-            if (w[k] != 0) {
-                double d = remainder(alpha_rows[k][e] - c, 2.0 * M_PI);
-                a += w[k] * d;
-                v += fabs(w[k]) * d * d;
+        } else {
+            for (int64_t e = 0; e < nedges; e++) {
+                cs[e] += a * cos(alpha_rows[k][e]);
+                sn[e] += a * sin(alpha_rows[k][e]);
             }
-        if (alpha) alpha[e] = c + a;
-        if (sd) sd[e] = wa > 0 ? sqrt(v / wa) : 0;
+        }
     }
+    /* the circular mean; rows that cancel out fall back to the heaviest */
+    for (int64_t e = 0; e < nedges; e++)
+        cs[e] = cs[e] * cs[e] + sn[e] * sn[e] > 1e-24 ? atan2(sn[e], cs[e]) : alpha_rows[big][e];
+    double *c = cs, *acc = sn;   /* c: the mean; acc: sum w d, then sd */
+    double *var = NULL;
+    if (sd && !(var = es__alloc_array(ctx, nedges, sizeof *var))) {
+        es__free(ctx, tmp);
+        return ES_ENOMEM;
+    }
+    memset(acc, 0, (size_t)nedges * sizeof *acc);
+    if (var) memset(var, 0, (size_t)nedges * sizeof *var);
+    for (int64_t k = 0; k < n; k++) {
+        if (w[k] == 0) continue;
+        double a = fabs(w[k]);
+        const double *ak = alpha_rows[k];
+        for (int64_t e = 0; e < nedges; e++) {
+            double d = wrap_diff(ak[e], c[e]);
+            acc[e] += w[k] * d;
+            if (var) var[e] += a * d * d;
+        }
+    }
+    for (int64_t e = 0; e < nedges; e++) {
+        double mean = c[e] + acc[e];
+        if (sd) sd[e] = wa > 0 ? sqrt(var[e] / wa) : 0;
+        if (alpha) alpha[e] = mean;
+    }
+    es__free(ctx, var);
+    es__free(ctx, tmp);
     return ES_OK;
+}
+
+es_status es_embed_prior_from_rows(es_ctx *ctx, int64_t nverts, int64_t nedges, int64_t n,
+                                   const double *const *aligned, const double *const *alpha_rows,
+                                   const double *w, double *xyz, double *alpha, double *sd)
+{
+    return es_embed_prior_from_rows_sc(ctx, nverts, nedges, n, aligned, alpha_rows, NULL, NULL,
+                                       w, xyz, alpha, sd);
 }
 
 /* Work of the prior, made on the first prior solve of an embedder. */

@@ -42,6 +42,8 @@ double es__closure_eval(es_embedder *emb, const double *alpha, int with_jac, dou
 es_status es__stage_dihedrals(es_embedder *emb, const es_embed_opts *o, int max_iter,
                               double *alpha, double *e_out, int64_t *iters, double *lambda_io)
 {
+    es_status need = es__embedder_need(emb, ES__NEED_CLOSURE);
+    if (need != ES_OK) return need;
     int64_t n = emb->nvar, it = 0;
     double *x = emb->HA ? emb->HA->x : NULL, *g = emb->grad, lambda = *lambda_io, e;
     int have_factor = 0;

@@ -46,6 +46,8 @@ static void compute_fan_frames(es_embedder *emb, const double *alpha)
 
 es_status es__stage_frames(es_embedder *emb, const double *alpha)
 {
+    es_status need = es__embedder_need(emb, ES__NEED_H3);
+    if (need != ES_OK) return need;
     double *x = emb->H3->x, *b = emb->pcg;   /* 3 right-hand sides in vertex order */
     int64_t n3 = 3 * emb->nv;
     int st;
@@ -105,6 +107,8 @@ es_status es__stage_frames(es_embedder *emb, const double *alpha)
 
 es_status es__stage_positions(es_embedder *emb, const double *len, double *xyz)
 {
+    es_status need = es__embedder_need(emb, ES__NEED_POSITIONS);
+    if (need != ES_OK) return need;
     double *b = emb->B1->x;
     int64_t nv = emb->nv;
     memset(b, 0, (size_t)(3 * nv) * sizeof(double));

@@ -150,6 +150,8 @@ static void set_diagonal(es_embedder *emb, const double *dg, double mean, double
 es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz, es__bend_prior *bp,
                            const es__refine_opts *ro, int64_t *iters)
 {
+    es_status need = es__embedder_need(emb, ES__NEED_H3);
+    if (need != ES_OK) return need;
     double hist[4] = {0, 0, 0, 0}, c_prev = 0;
     int64_t nv = emb->nv, n3 = 3 * nv, ne = emb->ne;
     double *x = emb->H3->x, *g = emb->grad, *dg = emb->diag;

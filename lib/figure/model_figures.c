@@ -96,18 +96,17 @@ void es_figure_variation_opts_init(es_figure_variation_opts *o)
     es_embed_opts_init(&o->embed);
 }
 
-static es_status embed_point(es_ctx *ctx, es_store *store, const es_figure_variation_opts *o,
-                             const char *point, double *xyz, es_embed_report *rep)
+/* One point near its prior in the session (es_study_embed's default),
+ * warm from the last: mean, then - and + along each axis. */
+static es_status embed_point(es_ctx *ctx, es_study_embedder *se, const es_figure_variation_opts *o,
+                             const char *point, double *xyz, es_embed_report *rep, int64_t *done,
+                             int64_t total)
 {
-    es_study_embed_opts eo;
     es_study_embed_result res;
-    es_study_embed_opts_init(&eo);
-    eo.point = point;
-    eo.pca_name = o->pca_name;
-    eo.embed = o->embed;
-    es_status rc = es_study_embed(ctx, store, &eo, xyz, &res);
+    es_status rc = es_study_embedder_point(ctx, se, point, o->pca_name, 0, &o->embed, 1, xyz, &res);
     if (rc != ES_OK) return es__fail(ctx, rc, "variation: %s: %s", point, es_ctx_errmsg(ctx));
     if (rep) *rep = res.report;
+    es__progress(ctx, "variation: embedding", ++*done, total);
     return ES_OK;
 }
 
@@ -158,8 +157,14 @@ es_status es_figure_variation(es_ctx *ctx, es_store *store, const es_figure_vari
     memset(&r, 0, sizeof r);
     r.naxes = naxes;
     es_mesh *mesh = NULL;
-    es_status rc = es_store_mesh(ctx, store, &mesh);
-    if (rc != ES_OK) return rc;
+    es_study_embedder *se = NULL;
+    int64_t done = 0, total = 1 + 2 * naxes;
+    es_status rc = es_study_embedder_open(ctx, store, 1, &se);
+    if (rc == ES_OK) rc = es_store_mesh(ctx, store, &mesh);
+    if (rc != ES_OK) {
+        es_study_embedder_free(se);
+        return rc;
+    }
     const int64_t nv = es_mesh_nverts(mesh), npanel = 4 * naxes;
     double *xyz = es__alloc_array(ctx, 3 * nv * (1 + 2 * naxes), sizeof *xyz);
     double *disp = es__alloc_array(ctx, nv * naxes, sizeof *disp);
@@ -169,7 +174,7 @@ es_status es_figure_variation(es_ctx *ctx, es_store *store, const es_figure_vari
         rc = ES_ENOMEM;
         goto done;
     }
-    if ((rc = embed_point(ctx, store, &o, "mean", xyz, &r.mean)) != ES_OK) goto done;
+    if ((rc = embed_point(ctx, se, &o, "mean", xyz, &r.mean, &done, total)) != ES_OK) goto done;
     for (int64_t a = 0; a < naxes && rc == ES_OK; a++) {
         char lo[512], hi[512], what[128];
         if (o.coef) {
@@ -186,8 +191,8 @@ es_status es_figure_variation(es_ctx *ctx, es_store *store, const es_figure_vari
             snprintf(what, sizeof what, "PC%lld", (long long)pcs[a]);
         }
         double *xm = xyz + 3 * nv * (1 + 2 * a), *xp = xm + 3 * nv;
-        if ((rc = embed_point(ctx, store, &o, lo, xm, &r.minus[a])) != ES_OK ||
-            (rc = embed_point(ctx, store, &o, hi, xp, &r.plus[a])) != ES_OK ||
+        if ((rc = embed_point(ctx, se, &o, lo, xm, &r.minus[a], &done, total)) != ES_OK ||
+            (rc = embed_point(ctx, se, &o, hi, xp, &r.plus[a], &done, total)) != ES_OK ||
             (rc = displacement(ctx, nv, xm, xp, disp + a * nv, &r.max_displacement[a])) != ES_OK)
             break;
         const char *unit = o.coef ? "" : " sd";
@@ -226,6 +231,7 @@ es_status es_figure_variation(es_ctx *ctx, es_store *store, const es_figure_vari
     rc = es_render(ctx, &spec, out_path, &r.render);
 done:
     if (rep) *rep = r;
+    es_study_embedder_free(se);
     es_mesh_free(mesh);
     es__free(ctx, xyz);
     es__free(ctx, disp);

@@ -277,6 +277,7 @@ es_status es_plot_lines(es_ctx *ctx, const es_lines_spec *spec, const char *path
     const es_plot_frame *f = &spec->frame;
     double fs = f->font_size;
     const char **names = NULL;
+    int *styles = NULL;
 
     info_clear(&info);
     if (info_out) *info_out = info;
@@ -307,8 +308,17 @@ es_status es_plot_lines(es_ctx *ctx, const es_lines_spec *spec, const char *path
         y0 = spec->logy ? 1 : 0, y1 = spec->logy ? 10 : 1;
     }
     names = es__alloc_array(ctx, spec->nseries > 0 ? spec->nseries : 1, sizeof *names);
-    if (!names) return ES_ENOMEM;
-    for (int64_t s = 0; s < spec->nseries; s++) names[s] = spec->series[s].name;
+    styles = es__alloc_array(ctx, spec->nseries > 0 ? spec->nseries : 1, sizeof *styles);
+    if (!names || !styles) {
+        es__free(ctx, names);
+        es__free(ctx, styles);
+        return ES_ENOMEM;
+    }
+    for (int64_t s = 0; s < spec->nseries; s++) {
+        names[s] = spec->series[s].name;
+        /* legend keys: a dot for a scatter, a line segment for a curve */
+        styles[s] = !(spec->points_only && spec->points_only[s]);
+    }
 
     if ((rc = es__canvas_open(ctx, path, f->width, f->height, &cv)) != ES_OK) goto done;
     cairo_t *cr = cv.cr;
@@ -340,9 +350,10 @@ es_status es_plot_lines(es_ctx *ctx, const es_lines_spec *spec, const char *path
         double rgb[3], px, py;
         es_palette_rgb(s, rgb);
         cairo_set_source_rgb(cr, rgb[0], rgb[1], rgb[2]);
+        int dots = spec->points_only && spec->points_only[s];
         cairo_new_path(cr);
         int64_t run = 0;   /* segments in the path being built */
-        for (int64_t i = 0; i < se->n; i++) {
+        for (int64_t i = 0; !dots && i < se->n; i++) {
             if (!isfinite(se->x[i]) || !isfinite(se->y[i]) || (spec->logy && se->y[i] <= 0)) {
                 cairo_stroke(cr); /* a gap, not a jump across missing values */
                 run = 0;
@@ -364,7 +375,7 @@ es_status es_plot_lines(es_ctx *ctx, const es_lines_spec *spec, const char *path
             }
         }
         cairo_stroke(cr);
-        if (spec->markers) {
+        if (spec->markers || dots) {
             for (int64_t i = 0; i < se->n; i++) {
                 if (!isfinite(se->x[i]) || !isfinite(se->y[i]) || (spec->logy && se->y[i] <= 0))
                     continue;
@@ -376,10 +387,12 @@ es_status es_plot_lines(es_ctx *ctx, const es_lines_spec *spec, const char *path
         }
     }
     cairo_restore(cr);
-    if (any_name) es__draw_legend(cr, info.right + fs, info.top, NULL, names, spec->nseries, 1, NULL, fs);
+    if (any_name) es__draw_legend(cr, info.right + fs, info.top, NULL, names, spec->nseries, 1,
+                                  styles, fs);
     rc = es__canvas_close(ctx, &cv);
 done:
     es__free(ctx, names);
+    es__free(ctx, styles);
     if (info_out) *info_out = info;
     return rc;
 }

@@ -396,7 +396,8 @@ static uint32_t shade(const shade_in *in, const double n_in[3], double value, in
     if (!normalize3(n)) n[0] = light[0], n[1] = light[1], n[2] = light[2];
     if (back) n[0] = -n[0], n[1] = -n[1], n[2] = -n[2];
     double lam = fmax(0, dot3(n, light));
-    if (in->m->scalar_kind == ES_SCALARS_NONE) memcpy(base, spec->base_rgb, sizeof base);
+    if (in->m->scalar_kind == ES_SCALARS_NONE)
+        memcpy(base, in->m->rgb ? in->m->rgb : spec->base_rgb, sizeof base);
     else es_colormap_rgb(spec->cmap, isfinite(value) ? (value - in->vmin) / (in->vmax - in->vmin)
                                                      : NAN, base);
     /* a small Blinn-Phong highlight (exponent 40) under the headlight */

@@ -45,6 +45,9 @@ struct es_multiscale {
     es_ctx *ctx;
     const es_mesh *mesh;
     es_multiscale_opts opts;
+    uint64_t seed;          /* of this hierarchy's seed faces */
+    es_multiscale **alt;    /* the other tries' hierarchies (opts.tries - 1) */
+    double *scratch;        /* with alternatives: 3V + 2E for comparing their results */
     ms_node *node;          /* node 0 is the root */
     int64_t nnode, cap;
     es__spd *spd;

@@ -11,7 +11,8 @@
 
 #include <math.h>
 
-static const char *const names[] = {"edge-length", "multiscale", "shape-space", "data-driven"};
+static const char *const names[] = {"edge-length", "multiscale", "shape-space", "data-driven",
+                                    "paper",       "conformal",  "data-driven-el"};
 
 const char *es_morph_method_name(es_morph_method m)
 {
@@ -20,13 +21,17 @@ const char *es_morph_method_name(es_morph_method m)
 
 es_status es_morph_method_from_name(es_ctx *ctx, const char *name, es_morph_method *out)
 {
-    for (size_t i = 0; name && i < sizeof names / sizeof names[0]; i++)
-        if (strcmp(name, names[i]) == 0) {
+    char known[256] = "";
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+        if (name && strcmp(name, names[i]) == 0) {
             *out = (es_morph_method)i;
             return ES_OK;
         }
-    ES_FAIL(ctx, ES_ENOTFOUND, "unknown interpolation method '%s' (known: edge-length, "
-            "multiscale, shape-space, data-driven)", name ? name : "");
+        snprintf(known + strlen(known), sizeof known - strlen(known), "%s%s", i ? ", " : "",
+                 names[i]);
+    }
+    ES_FAIL(ctx, ES_ENOTFOUND, "unknown interpolation method '%s' (known: %s)",
+            name ? name : "", known);
 }
 
 es_status es_morph_report(es_ctx *ctx, const es_mesh *mesh, const double *target,

@@ -33,11 +33,16 @@ void es_multiscale_opts_init(es_multiscale_opts *o)
     o->patches = 6;
     o->leaf_faces = 0;
     o->passes = 4;
+    o->tries = 4;
 }
 
 void es_multiscale_free(es_multiscale *ms)
 {
     if (!ms) return;
+    for (int i = 0; ms->alt && i < ms->opts.tries - 1; i++) es_multiscale_free(ms->alt[i]);
+
+    es__free(ms->ctx, ms->alt);
+    es__free(ms->ctx, ms->scratch);
     es__ms_free_nodes(ms);
     es__spd_free(ms->spd);
     es__free(ms->ctx, ms->work);
@@ -45,8 +50,44 @@ void es_multiscale_free(es_multiscale *ms)
     es__free(ms->ctx, ms);
 }
 
+/* One hierarchy from seed `seed`. */
+static es_status new_one(es_ctx *ctx, const es_mesh *mesh, const es_multiscale_opts *opts,
+                         uint64_t seed, es_multiscale **out);
+
 es_status es_multiscale_new(es_ctx *ctx, const es_mesh *mesh, const es_multiscale_opts *opts,
                             es_multiscale **out)
+{
+    es_multiscale_opts o;
+    es_multiscale *ms = NULL;
+    uint64_t seed = es_ctx_seed(ctx);
+    es_status rc;
+    *out = NULL;
+    if (opts) o = *opts;
+    else es_multiscale_opts_init(&o);
+    if (o.tries < 1 || o.tries > 64)
+        ES_FAIL(ctx, ES_EINVAL, "multiscale: tries must be 1 .. 64 (got %d)", o.tries);
+    if ((rc = new_one(ctx, mesh, &o, seed, &ms)) != ES_OK) return rc;
+    ms->scratch = es__alloc_array(ctx, 3 * es_mesh_nverts(mesh) + es_mesh_nedges(mesh),
+                                  sizeof *ms->scratch);
+    if (!ms->scratch) rc = ES_ENOMEM;
+    if (rc == ES_OK && o.tries > 1 && !(ms->alt = es__calloc(ctx, (size_t)o.tries - 1,
+                                                              sizeof *ms->alt)))
+        rc = ES_ENOMEM;
+    for (int i = 1; rc == ES_OK && i < o.tries; i++) {
+        if ((rc = es__progress(ctx, "multiscale: hierarchies", i, o.tries)) == ES_OK)
+            rc = new_one(ctx, mesh, &o, seed + (uint64_t)i, &ms->alt[i - 1]);
+    }
+    if (rc != ES_OK) {
+        es_multiscale_free(ms);
+        return rc;
+    }
+    ms->info.tries = o.tries;
+    *out = ms;
+    return ES_OK;
+}
+
+static es_status new_one(es_ctx *ctx, const es_mesh *mesh, const es_multiscale_opts *opts,
+                         uint64_t seed, es_multiscale **out)
 {
     es_multiscale *ms;
     es_status rc;
@@ -56,8 +97,8 @@ es_status es_multiscale_new(es_ctx *ctx, const es_mesh *mesh, const es_multiscal
     if (!(ms = es__calloc(ctx, 1, sizeof *ms))) return ES_ENOMEM;
     ms->ctx = ctx;
     ms->mesh = mesh;
-    if (opts) ms->opts = *opts;
-    else es_multiscale_opts_init(&ms->opts);
+    ms->opts = *opts;
+    ms->seed = seed;
     if (ms->opts.patches < 2 || ms->opts.patches > 64 || ms->opts.passes < 0 ||
         ms->opts.leaf_faces < 0) {
         int64_t patches = ms->opts.patches;
@@ -201,27 +242,13 @@ static es_status blend_inner(es_multiscale *ms, ms_node *n, const double *len, d
     return ES_OK;
 }
 
-es_status es_multiscale_solve(es_ctx *ctx, es_multiscale *ms, const double *len,
-                              const double *alpha, double *xyz)
+/* One hierarchy's solve (arguments checked by the caller). */
+static es_status solve_one(es_multiscale *ms, const double *len, const double *alpha,
+                           double *xyz)
 {
-    const es_mesh *mesh;
-    const uint8_t *eb;
-    int64_t ne, nv;
+    int64_t nv = es_mesh_nverts(ms->mesh);
     double t_leaf = 0, t_reg = 0, t_blend = 0, t0;
     es_status rc = ES_OK;
-    if (!ms || !len || !alpha || !xyz) ES_FAIL(ctx, ES_EINVAL, "multiscale: NULL argument");
-    mesh = ms->mesh;
-    ne = es_mesh_nedges(mesh);
-    nv = es_mesh_nverts(mesh);
-    eb = es_mesh_edge_on_boundary(mesh);
-    for (int64_t e = 0; e < ne; e++) {
-        if (!(len[e] > 0) || !isfinite(len[e]))
-            ES_FAIL(ctx, ES_EINVAL, "multiscale: edge %lld has length %g (must be finite and "
-                    "positive)", (long long)e, len[e]);
-        if (!eb[e] && !isfinite(alpha[e]))
-            ES_FAIL(ctx, ES_EINVAL, "multiscale: edge %lld has a dihedral that is not finite",
-                    (long long)e);
-    }
     /* children come after their parents: bottom up is backwards */
     for (int64_t i = ms->nnode - 1; i >= 0 && rc == ES_OK; i--) {
         ms_node *n = &ms->node[i];
@@ -240,6 +267,76 @@ es_status es_multiscale_solve(es_ctx *ctx, es_multiscale *ms, const double *len,
     ms->info.t_leaves = t_leaf;
     ms->info.t_register = t_reg;
     ms->info.t_blend = t_blend;
+    return ES_OK;
+}
+
+/* The method's own energy of positions x against its targets: the mean
+ * squared relative length error over all edges plus the mean squared
+ * dihedral error (wrapped to (-pi, pi]) over the interior ones. work: E. */
+static double energy(const es_multiscale *ms, const double *len, const double *alpha,
+                     const double *x, double *work)
+{
+    const es_mesh *m = ms->mesh;
+    const int64_t *ed = es_mesh_edges(m);
+    const uint8_t *eb = es_mesh_edge_on_boundary(m);
+    int64_t ne = es_mesh_nedges(m), nin = 0;
+    double el = 0, ea = 0;
+    for (int64_t e = 0; e < ne; e++) {
+        double d[3];
+        es__v3_sub(x + 3 * ed[2 * e], x + 3 * ed[2 * e + 1], d);
+        el += pow((sqrt(es__v3_dot(d, d)) - len[e]) / len[e], 2);
+    }
+    if (es_dihedral_angles(ms->ctx, m, x, work) != ES_OK) return INFINITY;
+    for (int64_t e = 0; e < ne; e++)
+        if (!eb[e]) ea += pow(remainder(work[e] - alpha[e], 2 * M_PI), 2), nin++;
+    return el / (double)ne + (nin ? ea / (double)nin : 0);
+}
+
+es_status es_multiscale_solve(es_ctx *ctx, es_multiscale *ms, const double *len,
+                              const double *alpha, double *xyz)
+{
+    const es_mesh *mesh;
+    const uint8_t *eb;
+    int64_t ne, nv;
+    es_status rc;
+    if (!ms || !len || !alpha || !xyz) ES_FAIL(ctx, ES_EINVAL, "multiscale: NULL argument");
+    mesh = ms->mesh;
+    ne = es_mesh_nedges(mesh);
+    nv = es_mesh_nverts(mesh);
+    eb = es_mesh_edge_on_boundary(mesh);
+    for (int64_t e = 0; e < ne; e++) {
+        if (!(len[e] > 0) || !isfinite(len[e]))
+            ES_FAIL(ctx, ES_EINVAL, "multiscale: edge %lld has length %g (must be finite and "
+                    "positive)", (long long)e, len[e]);
+        if (!eb[e] && !isfinite(alpha[e]))
+            ES_FAIL(ctx, ES_EINVAL, "multiscale: edge %lld has a dihedral that is not finite",
+                    (long long)e);
+    }
+    if ((rc = solve_one(ms, len, alpha, xyz)) != ES_OK) return rc;
+    ms->info.chosen = 0;
+    if (ms->opts.tries > 1) {
+        /* the other hierarchies: the result of least energy is kept */
+        double *x = ms->scratch, *work = x + 3 * nv, best = energy(ms, len, alpha, xyz, work);
+        double tl = ms->info.t_leaves, tr = ms->info.t_register, tb = ms->info.t_blend;
+        ms->info.energy_max = best;
+        for (int i = 0; i < ms->opts.tries - 1; i++) {
+            es_multiscale *a = ms->alt[i];
+            double en;
+            if ((rc = solve_one(a, len, alpha, x)) != ES_OK) return rc;
+            tl += a->info.t_leaves, tr += a->info.t_register, tb += a->info.t_blend;
+            en = energy(ms, len, alpha, x, work);
+            ms->info.energy_max = fmax(ms->info.energy_max, en);
+            if (en < best) {
+                best = en;
+                ms->info.chosen = i + 1;
+                memcpy(xyz, x, 3 * (size_t)nv * sizeof *x);
+            }
+        }
+        ms->info.energy = best;
+        ms->info.t_leaves = tl, ms->info.t_register = tr, ms->info.t_blend = tb;
+    } else {
+        ms->info.energy = ms->info.energy_max = energy(ms, len, alpha, xyz, ms->scratch + 3 * nv);
+    }
     return ES_OK;
 }
 

@@ -367,7 +367,7 @@ es_status es__ms_build(es_multiscale *ms)
     b.faces = es_mesh_faces(ms->mesh);
     b.fe = es_mesh_face_edges(ms->mesh);
     b.ef = es_mesh_edge_faces(ms->mesh);
-    es_rng_init(&b.rng, es_ctx_seed(ctx));
+    es_rng_init(&b.rng, ms->seed);
     b.in_node = es__calloc(ctx, (size_t)b.nf, sizeof *b.in_node);
     b.part = es__alloc_array(ctx, b.nf, sizeof *b.part);
     b.stamp = es__calloc(ctx, (size_t)b.nf, sizeof *b.stamp);

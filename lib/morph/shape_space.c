@@ -22,6 +22,7 @@ struct es_shape_space {
     es_ctx *ctx;
     const es_mesh *mesh;
     int64_t nv, ne, nf;
+    int64_t cap;            /* stored candidates per vertex (opts.cap) */
     double *xa, *xb;        /* 3V each, B aligned to A */
     double *na, *nb;        /* 3F unit normals */
     double *la, *lb;        /* E lengths */
@@ -29,20 +30,31 @@ struct es_shape_space {
     int64_t nwalk;
     int64_t *root_edge;     /* per root step: the component's first edge, first vertex */
     int64_t ntree, ninterior;
-    /* candidate pool of a frame */
-    double *cpos;           /* 3 per candidate */
-    int64_t *cnext;         /* next candidate of the same vertex, -1 */
-    int64_t ncand, ccap;
-    int64_t *head, *tail, *count, *stamp;   /* V each */
+    /* candidate pool of a frame: slots with a position and a weight (how
+     * many of the paper's candidates the slot stands for), each vertex's in
+     * a chain from oldest to newest; freed slots on a free list */
+    double *cpos;           /* 3 per slot */
+    double *cw;             /* per slot */
+    int64_t *cnext;         /* next slot of the same vertex (or of the free list), -1 */
+    int64_t nslot, ccap, cfree;
+    int64_t *head, *tail, *count, *stamp;   /* V each: chain, stored slots, last update */
+    double *vsum, *vw;      /* 3V, V: weighted sum and weight of all a vertex's candidates */
     double *nt;             /* 3F normals at t */
-    int64_t last_max;
+    int64_t last_stored, last_max;
+    double last_paper, last_paper_max;
 };
+
+void es_shape_space_opts_init(es_shape_space_opts *o)
+{
+    o->cap = 32;
+}
 
 void es_shape_space_free(es_shape_space *ss)
 {
     if (!ss) return;
     void *p[] = {ss->xa, ss->xb, ss->na, ss->nb, ss->la, ss->lb, ss->walk, ss->root_edge,
-                 ss->cpos, ss->cnext, ss->head, ss->tail, ss->count, ss->stamp, ss->nt};
+                 ss->cpos, ss->cw, ss->cnext, ss->head, ss->tail, ss->count, ss->stamp,
+                 ss->vsum, ss->vw, ss->nt};
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) es__free(ss->ctx, p[i]);
     es__free(ss->ctx, ss);
 }
@@ -52,8 +64,10 @@ void es_shape_space_get_info(const es_shape_space *ss, es_shape_space_info *info
     if (!ss || !info) return;
     info->dual_arcs = ss->ninterior;
     info->tree_arcs = ss->ntree;
-    info->candidates = ss->ncand;
+    info->candidates = ss->last_stored;
     info->max_candidates = ss->last_max;
+    info->paper_candidates = ss->last_paper;
+    info->paper_max = ss->last_paper_max;
 }
 
 typedef struct arc { double w; int64_t e; } arc;
@@ -157,17 +171,26 @@ done:
 }
 
 es_status es_shape_space_new(es_ctx *ctx, const es_mesh *mesh, const double *xa,
-                             const double *xb, es_shape_space **out)
+                             const double *xb, const es_shape_space_opts *opts,
+                             es_shape_space **out)
 {
     es_shape_space *ss;
+    es_shape_space_opts dflt;
     const int64_t *F;
     es_status rc = ES_OK;
     double rms;
     *out = NULL;
+    if (!opts) {
+        es_shape_space_opts_init(&dflt);
+        opts = &dflt;
+    }
     if (!mesh || !xa || !xb) ES_FAIL(ctx, ES_EINVAL, "shape space: NULL argument");
     if (es_mesh_nfaces(mesh) < 1) ES_FAIL(ctx, ES_EINVAL, "shape space: mesh without faces");
+    if (opts->cap < 2)
+        ES_FAIL(ctx, ES_EINVAL, "shape space: cap must be >= 2 (got %lld)", (long long)opts->cap);
     if (!(ss = es__calloc(ctx, 1, sizeof *ss))) return ES_ENOMEM;
     ss->ctx = ctx;
+    ss->cap = opts->cap;
     ss->mesh = mesh;
     ss->nv = es_mesh_nverts(mesh);
     ss->ne = es_mesh_nedges(mesh);
@@ -185,6 +208,8 @@ es_status es_shape_space_new(es_ctx *ctx, const es_mesh *mesh, const double *xa,
     ALLOC(ss->tail, ss->nv);
     ALLOC(ss->count, ss->nv);
     ALLOC(ss->stamp, ss->nv);
+    ALLOC(ss->vsum, 3 * ss->nv);
+    ALLOC(ss->vw, ss->nv);
 #undef ALLOC
     if (rc != ES_OK) goto fail;
     for (int64_t i = 0; i < 3 * ss->nv; i++)
@@ -240,28 +265,53 @@ static void slerp(const double *u, const double *v, double t, const double *ref,
     es__rotate_axis(u, k, t * atan2(s, c), out);
 }
 
-/* A new candidate for vertex v. */
-static es_status add_candidate(es_shape_space *ss, int64_t v, const double *p, int64_t clock)
+/* A new candidate for vertex v at p, standing for w of the paper's. The
+ * vertex's totals take it whole; past `cap` stored slots the vertex's two
+ * oldest slots merge into their weighted mean (the newest, which the next
+ * face takes as "the latest candidate", stay exact). */
+static es_status add_candidate(es_shape_space *ss, int64_t v, const double *p, double w,
+                               int64_t clock)
 {
     int64_t i;
-    if (ss->ncand == ss->ccap) {
-        int64_t cap = ss->ccap ? 2 * ss->ccap : 4 * ss->nv + 16;
-        double *np = es__realloc(ss->ctx, ss->cpos, 3 * (size_t)cap * sizeof *np);
-        if (!np) return ES_ENOMEM;
-        ss->cpos = np;
-        int64_t *nn = es__realloc(ss->ctx, ss->cnext, (size_t)cap * sizeof *nn);
-        if (!nn) return ES_ENOMEM;
-        ss->cnext = nn;
-        ss->ccap = cap;
+    if (ss->cfree >= 0) {
+        i = ss->cfree;
+        ss->cfree = ss->cnext[i];
+    } else {
+        if (ss->nslot == ss->ccap) {
+            int64_t cap = ss->ccap ? 2 * ss->ccap : 4 * ss->nv + 16;
+            double *np = es__realloc(ss->ctx, ss->cpos, 3 * (size_t)cap * sizeof *np);
+            if (!np) return ES_ENOMEM;
+            ss->cpos = np;
+            if (!(np = es__realloc(ss->ctx, ss->cw, (size_t)cap * sizeof *np))) return ES_ENOMEM;
+            ss->cw = np;
+            int64_t *nn = es__realloc(ss->ctx, ss->cnext, (size_t)cap * sizeof *nn);
+            if (!nn) return ES_ENOMEM;
+            ss->cnext = nn;
+            ss->ccap = cap;
+        }
+        i = ss->nslot++;
     }
-    i = ss->ncand++;
-    for (int c = 0; c < 3; c++) ss->cpos[3 * i + c] = p[c];
+    for (int c = 0; c < 3; c++) ss->cpos[3 * i + c] = p[c], ss->vsum[3 * v + c] += w * p[c];
+    ss->cw[i] = w;
+    ss->vw[v] += w;
+    ss->last_paper += w;
     ss->cnext[i] = -1;
     if (ss->head[v] < 0) ss->head[v] = i;
     else ss->cnext[ss->tail[v]] = i;
     ss->tail[v] = i;
     ss->count[v]++;
     ss->stamp[v] = clock;
+    if (ss->count[v] > ss->cap) {
+        int64_t h = ss->head[v], n = ss->cnext[h];
+        double wh = ss->cw[h], wn = ss->cw[n];
+        for (int c = 0; c < 3; c++)
+            ss->cpos[3 * h + c] = (wh * ss->cpos[3 * h + c] + wn * ss->cpos[3 * n + c]) / (wh + wn);
+        ss->cw[h] = wh + wn;
+        ss->cnext[h] = ss->cnext[n];
+        ss->cnext[n] = ss->cfree;
+        ss->cfree = n;
+        ss->count[v]--;
+    }
     return ES_OK;
 }
 
@@ -314,9 +364,14 @@ es_status es_shape_space_frame(es_ctx *ctx, es_shape_space *ss, const double *le
         es__v3_sub(ss->xa + 3 * F[3 * f + 1], ss->xa + 3 * F[3 * f], ref);
         slerp(ss->na + 3 * f, ss->nb + 3 * f, t, ref, ss->nt + 3 * f);
     }
-    ss->ncand = 0;
-    ss->last_max = 0;
-    for (int64_t v = 0; v < ss->nv; v++) ss->head[v] = ss->tail[v] = -1, ss->count[v] = ss->stamp[v] = 0;
+    ss->nslot = 0;
+    ss->cfree = -1;
+    ss->last_max = ss->last_stored = 0;
+    ss->last_paper = ss->last_paper_max = 0;
+    for (int64_t v = 0; v < ss->nv; v++) {
+        ss->head[v] = ss->tail[v] = -1, ss->count[v] = ss->stamp[v] = 0;
+        ss->vsum[3 * v] = ss->vsum[3 * v + 1] = ss->vsum[3 * v + 2] = ss->vw[v] = 0;
+    }
     for (int64_t s = 0; s < ss->nwalk && rc == ES_OK; s++) {
         int64_t f = ss->walk[3 * s], e = ss->walk[3 * s + 1];
         if (e < 0) {
@@ -342,9 +397,9 @@ es_status es_shape_space_frame(es_ctx *ctx, es_shape_space *ss, const double *le
                 es__apex(pv, pu, ss->nt + 3 * f, len[e0], l_vw, l_uw, pw);
             else
                 es__apex(pu, pv, ss->nt + 3 * f, len[e0], l_uw, l_vw, pw);
-            if ((rc = add_candidate(ss, v, pv, ++clock)) != ES_OK ||
-                (rc = add_candidate(ss, u, pu, ++clock)) != ES_OK ||
-                (rc = add_candidate(ss, w, pw, ++clock)) != ES_OK)
+            if ((rc = add_candidate(ss, v, pv, 1, ++clock)) != ES_OK ||
+                (rc = add_candidate(ss, u, pu, 1, ++clock)) != ES_OK ||
+                (rc = add_candidate(ss, w, pw, 1, ++clock)) != ES_OK)
                 goto done;
             continue;
         }
@@ -356,24 +411,24 @@ es_status es_shape_space_frame(es_ctx *ctx, es_shape_space *ss, const double *le
             const double *n = ss->nt + 3 * f;
             side_lengths(ss, len, f, a, b, c, &l_ac, &l_bc);
             memcpy(p0, ss->cpos + 3 * ss->tail[v0], sizeof p0);
-            /* d2 candidates for c: the latest of v0 with each of v1's */
+            /* d2 candidates for c: the latest of v0 with each of v1's (a slot
+             * standing for w of them gives one standing for w) */
             for (int64_t i = ss->head[v1], k = 0; k < nc; i = ss->cnext[i], k++) {
-                double p1[3], pc[3];
+                double p1[3], pc[3], wi = ss->cw[i];
                 const double *pa = v0 == a ? p0 : p1, *pb = v0 == a ? p1 : p0;
                 memcpy(p1, ss->cpos + 3 * i, sizeof p1);
                 if (ef[2 * e] == f) es__apex(pa, pb, n, len[e], l_ac, l_bc, pc);
                 else es__apex(pb, pa, n, len[e], l_bc, l_ac, pc);
-                if ((rc = add_candidate(ss, c, pc, ++clock)) != ES_OK) goto done;
+                if ((rc = add_candidate(ss, c, pc, wi, ++clock)) != ES_OK) goto done;
             }
         }
     }
-    /* every vertex at the mean of its candidates */
+    /* every vertex at the mean of all its candidates */
     for (int64_t v = 0; v < ss->nv; v++) {
-        double s[3] = {0, 0, 0};
-        for (int64_t i = ss->head[v]; i >= 0; i = ss->cnext[i])
-            for (int c = 0; c < 3; c++) s[c] += ss->cpos[3 * i + c];
-        for (int c = 0; c < 3; c++) xyz[3 * v + c] = ss->count[v] ? s[c] / (double)ss->count[v] : 0;
+        for (int c = 0; c < 3; c++) xyz[3 * v + c] = ss->vw[v] > 0 ? ss->vsum[3 * v + c] / ss->vw[v] : 0;
         if (ss->count[v] > ss->last_max) ss->last_max = ss->count[v];
+        if (ss->vw[v] > ss->last_paper_max) ss->last_paper_max = ss->vw[v];
+        ss->last_stored += ss->count[v];
     }
 done:
     es__free(ctx, lt);

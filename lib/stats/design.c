@@ -8,8 +8,9 @@
  * factor; the intercept for a main effect) is in the model, by one indicator
  * per level otherwise (R's rule, Chambers & Hastie 1992, sec. 2.4.1); the
  * columns of a term are the products of its variables' codes, the first
- * variable varying fastest. Aliased columns are kept here: the fit's QR
- * finds them.
+ * variable varying fastest. A term that adds no rank to the terms before it
+ * is left out with a warning (design_alias.c); columns aliased within a term
+ * (an empty cell of an interaction) are kept: the fit's QR finds them.
  */
 #include "stats/stats_pkg.h"
 #include "core/text.h"
@@ -31,6 +32,12 @@ void es_design_free(es_design *d)
             es__free(ctx, d->levels[v][l]);
         if (d->levels) es__free(ctx, d->levels[v]);
     }
+    for (int64_t k = 0; k < d->ndropped; k++) {
+        es__free(ctx, d->dropped[k]);
+        es__free(ctx, d->dropped_why[k]);
+    }
+    es__free(ctx, d->dropped);
+    es__free(ctx, d->dropped_why);
     es__free(ctx, d->x);
     es__free(ctx, d->colnames);
     es__free(ctx, d->assign);
@@ -50,6 +57,32 @@ void es_design_free(es_design *d)
 static int cmp_str(const void *a, const void *b)
 {
     return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+/* Put level `ref` first (R's relevel): codes and levels renumbered. */
+static es_status relevel(es_ctx *ctx, es_design *d, int64_t v, const char *ref)
+{
+    const int64_t n = d->n, L = d->nlevels[v];
+    int64_t k = -1;
+    for (int64_t l = 0; l < L && k < 0; l++)
+        if (!strcmp(d->levels[v][l], ref)) k = l;
+    if (k < 0) {
+        char list[400] = "";
+        for (int64_t l = 0; l < L && strlen(list) < 300; l++) {
+            strcat(list, l ? ", " : "");
+            strncat(list, d->levels[v][l], 60);
+        }
+        ES_FAIL(ctx, ES_EINVAL, "model: reference '%s' is not a level of '%s' (its levels: %s)",
+                ref, d->vars[v], list);
+    }
+    char *first = d->levels[v][k];
+    memmove(d->levels[v] + 1, d->levels[v], (size_t)k * sizeof *d->levels[v]);
+    d->levels[v][0] = first;
+    for (int64_t i = 0; i < n; i++) {
+        int64_t *c = &d->codes[i + v * n];
+        *c = *c == k ? 0 : *c < k ? *c + 1 : *c;
+    }
+    return ES_OK;
 }
 
 /* Levels of a categorical variable: sorted distinct labels, codes per row. */
@@ -115,6 +148,9 @@ static es_status read_var(es_ctx *ctx, es_design *d, int64_t v, const es_model_c
                 numeric = 0;
             }
     }
+    if (numeric && col->reference)
+        ES_FAIL(ctx, ES_EINVAL, "model: a reference level '%s' is given for '%s', which is "
+                "numeric (write factor(%s))", col->reference, col->name, col->name);
     if (numeric) {
         for (int64_t i = 0; i < n; i++) {
             if (!isfinite(val[i]))
@@ -130,7 +166,10 @@ static es_status read_var(es_ctx *ctx, es_design *d, int64_t v, const es_model_c
         return ES_OK;
     }
     d->var_factor[v] = 1;
-    if (col->labels) return make_factor(ctx, d, v, col->labels);
+    if (col->labels) {
+        es_status rc = make_factor(ctx, d, v, col->labels);
+        return rc == ES_OK && col->reference ? relevel(ctx, d, v, col->reference) : rc;
+    }
     /* factor() of a numeric column given as numbers: their text */
     char **txt = es__calloc(ctx, (size_t)n, sizeof *txt);
     es_status rc = txt ? ES_OK : ES_ENOMEM;
@@ -140,6 +179,7 @@ static es_status read_var(es_ctx *ctx, es_design *d, int64_t v, const es_model_c
         if (!(txt[i] = es__strdup(ctx, b))) rc = ES_ENOMEM;
     }
     if (rc == ES_OK) rc = make_factor(ctx, d, v, (const char *const *)txt);
+    if (rc == ES_OK && col->reference) rc = relevel(ctx, d, v, col->reference);
     for (int64_t i = 0; txt && i < n; i++) es__free(ctx, txt[i]);
     es__free(ctx, txt);
     return rc;
@@ -171,12 +211,13 @@ static int64_t code_level(const vcode *vc, int64_t k) { return vc->coding == 0 ?
  * q^2 (20,000 columns of 600 rows: 10^11 flops, a few minutes). */
 #define MAX_COLUMNS 20000
 
-/* How term j codes each of its nv variables (vars, vc) and how many
- * columns that makes (*ncol, bounded). */
-static es_status term_codes(es_ctx *ctx, es_design *d, const es_formula *f, int64_t j,
-                            vcode *vc, int64_t *vars, int64_t *nv_out, int64_t *ncol_out)
+/* How design term j (formula term fj) codes each of its nv variables (vars,
+ * vc) and how many columns that makes (*ncol, bounded). */
+static es_status term_codes(es_ctx *ctx, es_design *d, const es_formula *f, int64_t fj,
+                            int64_t j, const int *skip, vcode *vc, int64_t *vars,
+                            int64_t *nv_out, int64_t *ncol_out)
 {
-    const uint64_t mask = es__formula_term_mask(f, j);
+    const uint64_t mask = es__formula_term_mask(f, fj);
     int64_t nv = 0, ncol = 1;
     for (int64_t v = 0; v < d->nvars; v++) {
         if (!(mask >> v & 1)) continue;
@@ -187,7 +228,7 @@ static es_status term_codes(es_ctx *ctx, es_design *d, const es_formula *f, int6
             uint64_t margin = mask & ~((uint64_t)1 << v);
             int present = margin == 0;
             for (int64_t t = 0; t < es_formula_nterms(f) && !present; t++)
-                present = es__formula_term_mask(f, t) == margin;
+                present = !skip[t] && es__formula_term_mask(f, t) == margin;
             c->coding = present ? (d->contrasts == ES_CONTRASTS_SUM ? 1 : 0) : 2;
             c->ncol = c->coding == 2 ? d->nlevels[v] : d->nlevels[v] - 1;
             d->term_coding[j + v * d->nterms] = c->coding;
@@ -257,18 +298,21 @@ static es_status fill_term_columns(es_ctx *ctx, es_design *d, const es_formula *
     return ES_OK;
 }
 
-/* Every term's columns after the intercept: counted (and bounded) first,
- * so that the arrays are allocated once. */
-static es_status build_columns(es_ctx *ctx, es_design *d, const es_formula *f)
+/* Every kept term's columns after the intercept: counted (and bounded)
+ * first, so that the arrays are allocated once. */
+static es_status build_columns(es_ctx *ctx, es_design *d, const es_formula *f, const int *skip)
 {
     vcode vc[64];
     int64_t vars[64], nv, ncol, total = 1, nvars = d->nvars > 0 ? d->nvars : 1;
+    const int64_t T = es_formula_nterms(f);
     es_status rc;
-    for (int64_t j = 0; j < d->nterms; j++) {
-        if ((rc = term_codes(ctx, d, f, j, vc, vars, &nv, &ncol)) != ES_OK) return rc;
+    for (int64_t fj = 0, j = 0; fj < T; fj++) {
+        if (skip[fj]) continue;
+        if ((rc = term_codes(ctx, d, f, fj, j, skip, vc, vars, &nv, &ncol)) != ES_OK) return rc;
         if ((total += ncol) > MAX_COLUMNS)
             ES_FAIL(ctx, ES_ERANGE, "model: the design has more than %d columns at the term "
                     "'%s'", MAX_COLUMNS, d->terms[j]);
+        j++;
     }
     if (!(d->x = es__alloc_array(ctx, d->n * total, sizeof *d->x)) ||
         !(d->colnames = es__calloc(ctx, (size_t)total, sizeof *d->colnames)) ||
@@ -280,27 +324,28 @@ static es_status build_columns(es_ctx *ctx, es_design *d, const es_formula *f)
     if (!(d->colnames[0] = es__strdup(ctx, "intercept"))) return ES_ENOMEM;
     d->assign[0] = -1;
     d->ncols = 1;
-    for (int64_t j = 0; j < d->nterms; j++)
-        if ((rc = term_codes(ctx, d, f, j, vc, vars, &nv, &ncol)) != ES_OK ||
+    for (int64_t fj = 0, j = 0; fj < T; fj++) {
+        if (skip[fj]) continue;
+        if ((rc = term_codes(ctx, d, f, fj, j, skip, vc, vars, &nv, &ncol)) != ES_OK ||
             (rc = fill_term_columns(ctx, d, f, j, vc, vars, nv, ncol, d->ncols)) != ES_OK)
             return rc;
+        j++;
+    }
     return ES_OK;
 }
 
-es_status es_design_build(es_ctx *ctx, const es_formula *f, int64_t n,
-                          const es_model_column *columns, int64_t ncolumns,
-                          es_contrasts contrasts, es_design **out)
+/* The design of f without the formula terms flagged in skip. */
+static es_status build(es_ctx *ctx, const es_formula *f, int64_t n, const es_model_column *columns,
+                       int64_t ncolumns, es_contrasts contrasts, const int *skip, es_design **out)
 {
     *out = NULL;
-    if (!f || n < 1 || (ncolumns > 0 && !columns))
-        ES_FAIL(ctx, ES_EINVAL, "model: no formula or no rows");
     es_design *d = es__calloc(ctx, 1, sizeof *d);
     if (!d) return ES_ENOMEM;
     d->ctx = ctx;
     d->n = n;
     d->contrasts = contrasts;
     d->nvars = es_formula_nvars(f);
-    d->nterms = es_formula_nterms(f);
+    for (int64_t t = 0; t < es_formula_nterms(f); t++) d->nterms += !skip[t];
     es_status rc = ES_OK;
     int64_t nv = d->nvars, nt = d->nterms;
     d->vars = es__calloc(ctx, (size_t)nv, sizeof *d->vars);
@@ -309,8 +354,8 @@ es_status es_design_build(es_ctx *ctx, const es_formula *f, int64_t n,
     d->levels = es__calloc(ctx, (size_t)nv, sizeof *d->levels);
     d->codes = es__alloc_array(ctx, n * nv, sizeof *d->codes);
     d->values = es__calloc(ctx, (size_t)(n * nv), sizeof *d->values);
-    d->terms = es__calloc(ctx, (size_t)nt, sizeof *d->terms);
-    d->term_vars = es__calloc(ctx, (size_t)(nt * nv), sizeof *d->term_vars);
+    d->terms = es__calloc(ctx, (size_t)(nt > 0 ? nt : 1), sizeof *d->terms);
+    d->term_vars = es__calloc(ctx, (size_t)(nt * nv > 0 ? nt * nv : 1), sizeof *d->term_vars);
     d->term_coding = es__alloc_array(ctx, nt * nv > 0 ? nt * nv : 1, sizeof *d->term_coding);
     if (!d->term_coding || !d->vars || !d->var_factor || !d->nlevels || !d->levels ||
         !d->codes || !d->values || !d->terms || !d->term_vars) {
@@ -335,19 +380,106 @@ es_status es_design_build(es_ctx *ctx, const es_formula *f, int64_t n,
         else rc = read_var(ctx, d, v, col, kind);
     }
     if (rc != ES_OK) goto done;
-    for (int64_t j = 0; j < nt; j++) {
-        if (!(d->terms[j] = es__strdup(ctx, es_formula_term(f, j)))) {
+    for (int64_t fj = 0, j = 0; fj < es_formula_nterms(f); fj++) {
+        if (skip[fj]) continue;
+        if (!(d->terms[j] = es__strdup(ctx, es_formula_term(f, fj)))) {
             rc = ES_ENOMEM;
             goto done;
         }
         for (int64_t v = 0; v < nv; v++)
-            d->term_vars[j + v * nt] = (int64_t)(es__formula_term_mask(f, j) >> v & 1);
+            d->term_vars[j + v * nt] = (int64_t)(es__formula_term_mask(f, fj) >> v & 1);
+        j++;
     }
     for (int64_t k = 0; k < nt * nv; k++) d->term_coding[k] = -1;
-    if ((rc = build_columns(ctx, d, f)) != ES_OK) goto done;
+    if ((rc = build_columns(ctx, d, f, skip)) != ES_OK) goto done;
     *out = d;
     d = NULL;
 done:
     es_design_free(d);
     return rc;
+}
+
+/* Record formula term fj as dropped, and why, in d (taking why). */
+static es_status note_dropped(es_ctx *ctx, es_design *d, const char *term, char *why)
+{
+    char **t = es__realloc(ctx, d->dropped, (size_t)(d->ndropped + 1) * sizeof *t);
+    if (!t) return ES_ENOMEM;
+    d->dropped = t;
+    char **w = es__realloc(ctx, d->dropped_why, (size_t)(d->ndropped + 1) * sizeof *w);
+    if (!w) return ES_ENOMEM;
+    d->dropped_why = w;
+    if (!(d->dropped[d->ndropped] = es__strdup(ctx, term))) return ES_ENOMEM;
+    d->dropped_why[d->ndropped++] = why;
+    return ES_OK;
+}
+
+es_status es_design_build(es_ctx *ctx, const es_formula *f, int64_t n,
+                          const es_model_column *columns, int64_t ncolumns,
+                          es_contrasts contrasts, es_design **out)
+{
+    *out = NULL;
+    if (!f || n < 1 || (ncolumns > 0 && !columns))
+        ES_FAIL(ctx, ES_EINVAL, "model: no formula or no rows");
+    const int64_t T = es_formula_nterms(f);
+    int *skip = es__calloc(ctx, (size_t)(T > 0 ? T : 1), sizeof *skip);
+    char **why = es__calloc(ctx, (size_t)(T > 0 ? T : 1), sizeof *why);
+    es_design *d = NULL;
+    es_status rc = skip && why ? ES_OK : ES_ENOMEM;
+    /* Build, find the first term that adds no rank, leave it out, rebuild
+     * (its absence can change how the terms after it are coded). */
+    while (rc == ES_OK) {
+        int64_t j = -1;
+        char msg[400];
+        if ((rc = build(ctx, f, n, columns, ncolumns, contrasts, skip, &d)) != ES_OK ||
+            (rc = es__design_first_aliased(ctx, d, &j, msg, sizeof msg)) != ES_OK || j < 0)
+            break;
+        int64_t fj = 0;
+        for (int64_t k = 0; fj < T; fj++)
+            if (!skip[fj] && k++ == j) break;
+        es__warn(ctx, "model: term '%s' %s (its columns are combinations of theirs): left out",
+                 d->terms[j], msg);
+        skip[fj] = 1;
+        if (!(why[fj] = es__strdup(ctx, msg))) rc = ES_ENOMEM;
+        es_design_free(d);
+        d = NULL;
+    }
+    for (int64_t fj = 0; rc == ES_OK && fj < T; fj++)
+        if (skip[fj]) {
+            rc = note_dropped(ctx, d, es_formula_term(f, fj), why[fj]);
+            if (rc == ES_OK) why[fj] = NULL;
+        }
+    if (rc == ES_OK && d->nterms == 0 && T > 0)
+        rc = es__fail(ctx, ES_EINVAL, "model: every term of the formula was left out (%s %s)",
+                      d->dropped[0], d->dropped_why[0]);
+    if (rc == ES_OK) {
+        *out = d;
+        d = NULL;
+    }
+    for (int64_t fj = 0; why && fj < T; fj++) es__free(ctx, why[fj]);
+    es__free(ctx, why);
+    es__free(ctx, skip);
+    es_design_free(d);
+    return rc;
+}
+
+/* 1 when the term label `term` ("a:b") has variable label `var` among its parts. */
+static int term_has_var(const char *term, const char *var)
+{
+    const size_t n = strlen(var);
+    for (const char *s = term; s; s = strchr(s, ':') ? strchr(s, ':') + 1 : NULL)
+        if (!strncmp(s, var, n) && (s[n] == ':' || s[n] == '\0')) return 1;
+    return 0;
+}
+
+const char *es_design_dropped(const es_design *d, const char *name)
+{
+    if (!d || !name) return NULL;
+    for (int64_t k = 0; k < d->ndropped; k++)
+        if (!strcmp(d->dropped[k], name)) return d->dropped_why[k];
+    /* a variable that only dropped terms held */
+    for (int64_t t = 0; t < d->nterms; t++)
+        if (term_has_var(d->terms[t], name)) return NULL;
+    for (int64_t k = 0; k < d->ndropped; k++)
+        if (term_has_var(d->dropped[k], name)) return d->dropped_why[k];
+    return NULL;
 }

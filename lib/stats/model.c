@@ -88,10 +88,11 @@ void es_model_free(es_model *m)
 {
     if (!m) return;
     es_ctx *ctx = m->ctx;
-    double *own[] = {m->ss, m->ms, m->r2, m->f, m->pval, m->fperm, m->coef, m->coef_weights,
-                     m->mean};
+    double *own[] = {m->ss, m->ms, m->r2, m->f, m->pval, m->z, m->fperm, m->ssperm, m->coef,
+                     m->coef_weights, m->mean};
     for (size_t i = 0; i < sizeof own / sizeof *own; i++) es__free(ctx, own[i]);
     es__free(ctx, m->df);
+    es__free(ctx, m->error);
     es__free(ctx, m->testable);
     if (m->priv) {
         es_pca_free(m->priv->pca);
@@ -293,6 +294,7 @@ static es_status permute_term(es_ctx *ctx, es_model *m, int64_t j, const double 
             double rss = ee - fs;
             double f = (ss / (double)df) / (rss / (double)m->df_resid);
             m->fperm[(b0 + k) + j * B] = f;
+            m->ssperm[(b0 + k) + j * B] = ss;
             if (f >= fobs - TIE_EPS * fmax(1.0, fabs(fobs))) count++;
         }
         if ((rc = es__progress(ctx, "model: permutations", j * B + b0 + nb, m->nterms * B)))
@@ -324,11 +326,26 @@ static es_status test_terms(es_ctx *ctx, es_model *m)
     /* the residual of the full model, directly (no cancellation) */
     if ((rc = es__model_residuals(ctx, m, m->priv->qf, m->rank, e)) != ES_OK) goto done;
     m->rss = cblas_ddot((int)(n * r), e, 1, e, 1);
+    if (!(m->rss > 1e-20 * m->tss)) {
+        rc = es__fail(ctx, ES_EINVAL, "model: the design fits the %lld rows exactly (residual "
+                      "sum of squares %.3g of %.3g): F is undefined; use fewer terms",
+                      (long long)n, m->rss, m->tss);
+        goto done;
+    }
     for (int64_t j = 0; j < T && rc == ES_OK; j++) {
         int64_t mr = 0, df = 0;
         if ((rc = es__model_term_basis(ctx, m, j, &ur, &mr, &df)) != ES_OK) break;
         const double *dd = ur + mr * n;
         m->df[j] = df;
+        if (df == 0) {
+            rc = es__fail(ctx, ES_EINVAL, "model: under type %s sums of squares the term '%s' "
+                          "adds nothing once %s in (its columns are combinations of theirs): "
+                          "its test would have 0 df; use type I, or leave out what holds it",
+                          m->ss_type == ES_SS_TYPE_III ? "III" : m->ss_type == ES_SS_TYPE_II ?
+                          "II" : "I", d->terms[j], m->ss_type == ES_SS_TYPE_I ?
+                          "the terms before it are" : "the other terms are");
+            break;
+        }
         int constant = 0;
         if ((rc = constant_in_blocks(ctx, m, dd, df, &constant)) != ES_OK) break;
         m->testable[j] = df > 0 && !constant;
@@ -348,7 +365,11 @@ static es_status test_terms(es_ctx *ctx, es_model *m)
             else if ((rc = es__model_residuals(ctx, m, ur, mr, e)) != ES_OK) break;
             rc = permute_term(ctx, m, j, dd, df, e);
         } else {
-            for (int64_t b = 0; b < m->permutations; b++) m->fperm[b + j * m->permutations] = NAN;
+            /* constant within blocks: every permutation leaves SS as observed */
+            for (int64_t b = 0; b < m->permutations; b++) {
+                m->fperm[b + j * m->permutations] = NAN;
+                m->ssperm[b + j * m->permutations] = df > 0 ? ss : NAN;
+            }
         }
         es__free(ctx, ur);
         ur = NULL;
@@ -357,6 +378,34 @@ done:
     es__free(ctx, e);
     es__free(ctx, dz);
     es__free(ctx, ur);
+    return rc;
+}
+
+/* Terms with an error term other than the residual: F = MS_j / MS_e, in the
+ * observed data and in each permutation (both terms' SS from the same row
+ * permutation, each under its own reduced model: RRPP's anova(error =));
+ * then every tested term's p-value and effect size from its F's. */
+static es_status finish_terms(es_ctx *ctx, es_model *m)
+{
+    const int64_t T = m->nterms, B = m->permutations;
+    double *s = es__alloc_array(ctx, B + 1, sizeof *s);
+    if (!s) return ES_ENOMEM;
+    es_status rc = ES_OK;
+    for (int64_t j = 0; j < T && rc == ES_OK; j++) {
+        const int64_t e = m->error[j];
+        if (e >= 0) {
+            m->f[j] = m->ms[j] / m->ms[e];
+            for (int64_t b = 0; b < B; b++)
+                m->fperm[b + j * B] = (m->ssperm[b + j * B] / (double)m->df[j]) /
+                                      (m->ssperm[b + e * B] / (double)m->df[e]);
+        }
+        m->z[j] = NAN;
+        if (B < 1 || isnan(m->pval[j])) continue;
+        s[0] = m->f[j];
+        memcpy(s + 1, m->fperm + j * B, (size_t)B * sizeof *s);
+        rc = es__perm_summary(ctx, s, B + 1, 0.95, &m->pval[j], &m->z[j], NULL);
+    }
+    es__free(ctx, s);
     return rc;
 }
 
@@ -401,10 +450,22 @@ es_status es_model_fit(es_ctx *ctx, const es_design *d, const es_source *src,
     m->r2 = es__alloc_array(ctx, T > 0 ? T : 1, sizeof(double));
     m->f = es__alloc_array(ctx, T > 0 ? T : 1, sizeof(double));
     m->pval = es__alloc_array(ctx, T > 0 ? T : 1, sizeof(double));
+    m->z = es__alloc_array(ctx, T > 0 ? T : 1, sizeof(double));
+    m->error = es__alloc_array(ctx, T > 0 ? T : 1, sizeof *m->error);
     m->fperm = es__alloc_array(ctx, (B > 0 ? B : 1) * (T > 0 ? T : 1), sizeof(double));
-    if (!m->df || !m->testable || !m->ss || !m->ms || !m->r2 || !m->f || !m->pval || !m->fperm) {
+    m->ssperm = es__alloc_array(ctx, (B > 0 ? B : 1) * (T > 0 ? T : 1), sizeof(double));
+    if (!m->df || !m->testable || !m->ss || !m->ms || !m->r2 || !m->f || !m->pval || !m->z ||
+        !m->error || !m->fperm || !m->ssperm) {
         rc = ES_ENOMEM;
         goto done;
+    }
+    for (int64_t j = 0; j < T; j++) {
+        m->error[j] = o.error ? o.error[j] : -1;
+        if (m->error[j] < -1 || m->error[j] >= T || m->error[j] == j) {
+            rc = es__fail(ctx, ES_EINVAL, "model: the error term of '%s' is %s", d->terms[j],
+                          m->error[j] == j ? "the term itself" : "not a term of the model");
+            goto done;
+        }
     }
     if (o.blocks) {
         if (!(m->priv->blocks = es__alloc_array(ctx, n, sizeof *m->priv->blocks))) {
@@ -439,7 +500,9 @@ es_status es_model_fit(es_ctx *ctx, const es_design *d, const es_source *src,
     m->priv->zz = cblas_ddot((int)(n * m->priv->r), m->priv->pca->scores, 1,
                              m->priv->pca->scores, 1);
     m->tss = m->priv->zz;
-    if ((rc = test_terms(ctx, m)) != ES_OK || (rc = coefficients(ctx, m)) != ES_OK) goto done;
+    if ((rc = test_terms(ctx, m)) != ES_OK || (rc = finish_terms(ctx, m)) != ES_OK ||
+        (rc = coefficients(ctx, m)) != ES_OK)
+        goto done;
     *out = m;
     m = NULL;
 done:

@@ -64,6 +64,16 @@ void es__perm_clear(es_ctx *ctx, es__perm *g);
  * NULL) gets x's coordinates: x = Q r. Returns 1 if appended. */
 int es__basis_add(int64_t n, double *q, int64_t *m, const double *x, double *r);
 
+/* The first term of d (in order) that adds no rank to the intercept and the
+ * terms before it, or *term = -1; why gets "duplicates 'sex'" (design_alias.c). */
+es_status es__design_first_aliased(es_ctx *ctx, const es_design *d, int64_t *term, char *why,
+                                   size_t whylen);
+
+/* p-value, Z and UCL of the observed statistic s[0] among s[0..n) (s[1..n)
+ * permuted; effect_size.c): p = #{s_b >= s_0 - tie} / n, NULL outputs skipped. */
+es_status es__perm_summary(es_ctx *ctx, const double *s, int64_t n, double confidence,
+                           double *p, double *z, double *ucl);
+
 /* What es_model_fit keeps for the analyses after it. */
 struct es_model_priv {
     es_pca *pca;         /* the principal coordinates: scores Z (N x r), components U */

@@ -16,6 +16,7 @@ void es_study_embed_opts_init(es_study_embed_opts *o)
 {
     memset(o, 0, sizeof *o);
     o->init = "prior";
+    o->cache = 1;
     es_embed_opts_init(&o->embed);
 }
 
@@ -86,42 +87,19 @@ static es_status write_residuals(es_ctx *ctx, const char *path, const es_embedde
     return es__table_end(ctx, &t, ES_OK);
 }
 
-/* 1 if the point is one mesh's lengths (a row or a file, coefficient 1):
- * exactly realizable. */
-static int one_mesh(es_ctx *ctx, const char *spec)
+/* The published pipeline from dihedrals alpha (NULL: those of init_xyz),
+ * aligned to init_xyz; the start's description says so. */
+static es_status solve_paper(es_ctx *ctx, es_embedder *emb, const es_study_embed_opts *o,
+                             const double *target, double scale, const double *alpha,
+                             const double *init_xyz, double *xyz, es_study_embed_result *res)
 {
-    es_point_expr *x = NULL;
-    double coef = 0;
-    es_point_leaf kind = ES_POINT_MEAN;
-    int one = 0;
-    if (!strncmp(spec, "row:", 4) || !strncmp(spec, "file:", 5)) {
-        if (es_point_parse(ctx, spec, &x) == ES_OK && es_point_expr_nterms(x) == 1) {
-            es_point_expr_term(x, 0, &coef, &kind, NULL, NULL);
-            one = coef == 1 && (kind == ES_POINT_ROW || kind == ES_POINT_FILE);
-        }
-        es_point_expr_free(x);
-        es_ctx_clear_error(ctx);
-    }
-    return one;
-}
-
-/* The prior of the point's row weights: its realization, dihedrals and
- * spread, and what the report says it started from. */
-static es_status point_prior(es_ctx *ctx, es_store *s, const es_mesh *mesh, const double *w,
-                             double *xyz, double *alpha, double *sd, char *desc, size_t ndesc)
-{
-    es_study_rows *rows = NULL;
-    int64_t n = es_store_nrows(s), used = 0, top = 0;
-    es_status rc = es_study_rows_load(ctx, s, mesh, &rows);
-    if (rc == ES_OK) rc = es_study_prior(ctx, rows, w, xyz, alpha, sd);
-    es_study_rows_free(rows);
-    for (int64_t i = 0; i < n; i++) {
-        used += w[i] != 0;
-        if (fabs(w[i]) > fabs(w[top])) top = i;
-    }
-    snprintf(desc, ndesc, "prior of %lld row%s (weight %.3g on %s), store frame", (long long)used,
-             used == 1 ? "" : "s", w[top], es_store_row_id(s, top));
-    return rc;
+    es_embed_paper_opts po;
+    size_t n = strlen(res->init);
+    es_embed_paper_opts_init(&po);
+    po.embed = o->embed;
+    snprintf(res->init + n, sizeof res->init - n, "; published pipeline (L-BFGS, stages 2-3)");
+    return es_embed_paper_solve(ctx, emb, target, scale, alpha, init_xyz, &po, xyz,
+                                &res->report);
 }
 
 es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o, double *xyz_out,
@@ -129,6 +107,7 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
 {
     es_mesh *mesh = NULL;
     es_embedder *emb = NULL;
+    es_study_embedder *se = NULL;
     double *target = NULL, *xyz = NULL, *init_xyz = NULL, *alpha = NULL, *sd = NULL, *w = NULL;
     double own;
     int64_t init_row = -1, *sel = NULL, nsel = 0, ne, nv, n = es_store_nrows(s);
@@ -137,6 +116,8 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
     es_status rc;
     memset(res, 0, sizeof *res);
     if (!o || !o->point) ES_FAIL(ctx, ES_EINVAL, "embed: no point given");
+    if (o->session && es_study_embedder_store(o->session) != s)
+        ES_FAIL(ctx, ES_EINVAL, "embed: the session given is of another store");
     if (o->name && (rc = es_store_result_check(ctx, s, "embed", o->name)) != ES_OK) return rc;
     if ((rc = es_store_mesh(ctx, s, &mesh)) != ES_OK) return rc;
     ne = es_mesh_nedges(mesh);
@@ -157,15 +138,25 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
         goto done;
     res->scale = o->scale > 0 ? o->scale : own;
     if (prior) {
-        es_embed_prior pr = {init_xyz, alpha, sd, NULL};
-        es_embed_opts eo = o->embed;
-        eo.prior_exact = one_mesh(ctx, o->point);
-        if ((rc = point_prior(ctx, s, mesh, w, init_xyz, alpha, sd, res->init,
-                              sizeof res->init)) != ES_OK ||
-            (rc = es_embedder_new(ctx, mesh, &emb)) != ES_OK ||
-            (rc = es_embed_prior_solve(ctx, emb, target, res->scale, &pr, &eo, xyz,
-                                       &res->report)) != ES_OK)
+        /* the session: the embedder and the rows for priors, from the cache
+         * beside the store when it is current (a fresh process skips their
+         * making) */
+        if (o->session) se = o->session;
+        else if ((rc = es_study_embedder_open(ctx, s, o->cache, &se)) != ES_OK) goto done;
+        if (o->paper) {
+            /* the published pipeline from the prior's dihedrals, in its frame */
+            snprintf(res->init, sizeof res->init, "prior's dihedrals and frame");
+            if ((rc = es_study_prior(ctx, es_study_embedder_rows(se), w, init_xyz, alpha,
+                                     sd)) != ES_OK ||
+                (rc = solve_paper(ctx, es_study_embedder_embedder(se), o, target, res->scale,
+                                  alpha, init_xyz, xyz, res)) != ES_OK)
+                goto done;
+        } else if ((rc = es_study_embedder_solve(ctx, se, target, res->scale, w, &o->embed,
+                                                 o->session && o->warm,
+                                                 es__study_point_is_one_mesh(ctx, o->point),
+                                                 xyz, res)) != ES_OK)
             goto done;
+        emb = es_study_embedder_embedder(se);
         /* provenance: the rows the prior drew on */
         for (int64_t i = 0; i < n; i++) nsel += w[i] != 0;
         if (nsel && !(sel = es__alloc_array(ctx, nsel, sizeof *sel))) {
@@ -177,8 +168,10 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
     } else if ((rc = choose_start(ctx, s, mesh, o->init, target, init_xyz, alpha, &init_row,
                                   &sel, &nsel, res->init, sizeof res->init)) != ES_OK ||
                (rc = es_embedder_new(ctx, mesh, &emb)) != ES_OK ||
-               (rc = es_embed_solve(ctx, emb, target, res->scale, sel ? alpha : NULL, init_xyz,
-                                    &o->embed, xyz, &res->report)) != ES_OK) {
+               (rc = o->paper ? solve_paper(ctx, emb, o, target, res->scale, sel ? alpha : NULL,
+                                            init_xyz, xyz, res)
+                              : es_embed_solve(ctx, emb, target, res->scale, sel ? alpha : NULL,
+                                               init_xyz, &o->embed, xyz, &res->report)) != ES_OK) {
         goto done;
     }
     /* with a stored result the files are staged beside their targets and
@@ -209,7 +202,9 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
     }
 done:
     es__file_set_abort(ctx, &files);   /* what is left of it: nothing after a commit */
+    if (se) emb = NULL;   /* the session's */
     es_embedder_free(emb);
+    if (se != o->session) es_study_embedder_free(se);
     es_mesh_free(mesh);
     es__free(ctx, sel);
     es__free(ctx, target);

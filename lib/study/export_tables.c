@@ -195,53 +195,6 @@ es_status es__t_gpa_loadings(es_ctx *ctx, es_store *s, const char *kind, const c
 
 /* ---- models ------------------------------------------------------------------------ */
 
-es_status es__t_model_anova(es_ctx *ctx, es_store *s, const char *kind, const char *name,
-                            const char *path)
-{
-    static const char *const ds[5] = {"ss", "ms", "r2", "f", "p"};
-    char **terms = NULL, grp[300];
-    int64_t nt = 0, *df = NULL, ndf = 0, nv = 0;
-    double *v[5] = {NULL}, dfr = 0, rss = 0, tss = 0, n = 0;
-    es__table_out t;
-    snprintf(grp, sizeof grp, "%s/%s", kind, name);
-    es_status rc = es__result_strings(ctx, s, kind, name, "terms", &terms, &nt);
-    if (rc == ES_OK) rc = es__result_ints(ctx, s, kind, name, "df", &df, &ndf);
-    for (int k = 0; k < 5 && rc == ES_OK; k++) {
-        rc = es__result_vector(ctx, s, kind, name, ds[k], &v[k], &nv);
-        if (rc == ES_OK && (nv != nt || ndf != nt))
-            rc = es__fail(ctx, ES_EFORMAT, "export: model/%s/%s has %lld values for %lld terms",
-                          name, ds[k], (long long)nv, (long long)nt);
-    }
-    if (rc == ES_OK && ((rc = es_store_get_attr_double(ctx, s, grp, "df_resid", &dfr)) != ES_OK ||
-                        (rc = es_store_get_attr_double(ctx, s, grp, "rss", &rss)) != ES_OK ||
-                        (rc = es_store_get_attr_double(ctx, s, grp, "tss", &tss)) != ES_OK ||
-                        (rc = es_store_get_attr_double(ctx, s, grp, "n", &n)) != ES_OK))
-        goto done;
-    if (rc != ES_OK || (rc = es__table_begin(ctx, path, &t)) != ES_OK) goto done;
-    fputs("term,df,ss,ms,r2,f,p\n", t.f);
-    for (int64_t j = 0; j < nt; j++) {
-        es_csv_write_field(t.f, terms[j]);
-        fprintf(t.f, ",%lld", (long long)df[j]);
-        for (int k = 0; k < 5; k++) es__table_number(t.f, v[k][j]);
-        fputc('\n', t.f);
-    }
-    fprintf(t.f, "Residual,%.0f", dfr);
-    es__table_number(t.f, rss);
-    es__table_number(t.f, rss / dfr);
-    es__table_number(t.f, rss / tss);
-    fputs(",,\n", t.f);
-    fprintf(t.f, "Total,%.0f", n - 1);
-    es__table_number(t.f, tss);
-    fputs(",,1,,\n", t.f);
-    rc = es__table_end(ctx, &t, ES_OK);
-done:
-    for (int64_t j = 0; j < nt; j++) es_free(ctx, terms[j]);
-    es_free(ctx, terms);
-    es_free(ctx, df);
-    for (int k = 0; k < 5; k++) es_free(ctx, v[k]);
-    return rc;
-}
-
 /* A matrix of p-vectors (dataset [ncol][p]) as an edge table in edge-length
  * space or a coordinate table in Procrustes space. */
 static es_status model_vectors(es_ctx *ctx, es_store *s, const char *name, const char *ds,
@@ -323,38 +276,29 @@ es_status es__t_model_weights(es_ctx *ctx, es_store *s, const char *kind, const 
     return rc;
 }
 
-es_status es__t_model_pairwise(es_ctx *ctx, es_store *s, const char *kind, const char *name,
-                               const char *path)
+/* Per-landmark tests (Procrustes space): landmark, f, p, q. */
+static es_status landmark_table(es_ctx *ctx, es_store *s, const char *kind, const char *name,
+                                const char *path)
 {
-    char **lv = NULL;
-    int64_t L = 0;
-    es_mat d = {0}, p = {0};
+    static const char *const ds[3] = {"landmark_f", "landmark_p", "landmark_q"};
+    double *v[3] = {NULL};
+    int64_t n[3] = {0};
     es__table_out t;
-    es_status rc = es__result_strings(ctx, s, kind, name, "pairwise_levels", &lv, &L);
-    if (rc == ES_ENOTFOUND)
-        rc = es__fail(ctx, ES_ENOTFOUND, "export: model/%s has no pairwise comparison (fit it "
-                      "with --pairwise FACTOR)", name);
-    if (rc == ES_OK) rc = es__result_matrix(ctx, s, kind, name, "pairwise_distances", &d);
-    if (rc == ES_OK) rc = es__result_matrix(ctx, s, kind, name, "pairwise_p", &p);
-    if (rc == ES_OK && (d.rows != L || d.cols != L || p.rows != L || p.cols != L))
-        rc = es__fail(ctx, ES_EFORMAT, "export: model/%s/pairwise_* are inconsistent", name);
+    es_status rc = ES_OK;
+    for (int k = 0; k < 3 && rc == ES_OK; k++)
+        if ((rc = es__result_vector(ctx, s, kind, name, ds[k], &v[k], &n[k])) == ES_OK &&
+            n[k] != n[0])
+            rc = es__fail(ctx, ES_EFORMAT, "export: model/%s/%s is inconsistent", name, ds[k]);
     if (rc == ES_OK && (rc = es__table_begin(ctx, path, &t)) == ES_OK) {
-        fputs("level_a,level_b,distance,p\n", t.f);
-        for (int64_t a = 0; a < L; a++)
-            for (int64_t b = a + 1; b < L; b++) {
-                es_csv_write_field(t.f, lv[a]);
-                fputc(',', t.f);
-                es_csv_write_field(t.f, lv[b]);
-                es__table_number(t.f, ES_AT(d, a, b));
-                es__table_number(t.f, ES_AT(p, a, b));
-                fputc('\n', t.f);
-            }
+        fputs("landmark,f,p,q\n", t.f);
+        for (int64_t i = 0; i < n[0]; i++) {
+            fprintf(t.f, "%lld", (long long)(i + 1));
+            for (int k = 0; k < 3; k++) es__table_number(t.f, v[k][i]);
+            fputc('\n', t.f);
+        }
         rc = es__table_end(ctx, &t, ES_OK);
     }
-    for (int64_t i = 0; i < L; i++) es_free(ctx, lv[i]);
-    es_free(ctx, lv);
-    es_free(ctx, d.data);
-    es_free(ctx, p.data);
+    for (int k = 0; k < 3; k++) es_free(ctx, v[k]);
     return rc;
 }
 
@@ -364,13 +308,16 @@ es_status es__t_model_edges(es_ctx *ctx, es_store *s, const char *kind, const ch
     static const char *const ds[3] = {"edge_f", "edge_p", "edge_q"}, *const cols[3] = {"f", "p",
                                                                                           "q"};
     const int64_t E = es_store_nedges(s);
-    double *all = es__alloc_array(ctx, 3 * E > 0 ? 3 * E : 1, sizeof *all), *v = NULL;
+    double *all = NULL, *v = NULL;
     int64_t n = 0;
     char p[700];
-    es_status rc = all ? es__result_path(ctx, p, sizeof p, kind, name, "edge_f") : ES_ENOMEM;
+    es_status rc = es__result_path(ctx, p, sizeof p, kind, name, "landmark_f");
+    if (rc == ES_OK && es_store_has(s, p)) return landmark_table(ctx, s, kind, name, path);
+    all = es__alloc_array(ctx, 3 * E > 0 ? 3 * E : 1, sizeof *all);
+    rc = all ? es__result_path(ctx, p, sizeof p, kind, name, "edge_f") : ES_ENOMEM;
     if (rc == ES_OK && !es_store_has(s, p))
-        rc = es__fail(ctx, ES_ENOTFOUND, "export: model/%s has no per-edge tests (fit it with "
-                      "--edges TERM)", name);
+        rc = es__fail(ctx, ES_ENOTFOUND, "export: model/%s has no per-edge or per-landmark "
+                      "tests (fit it with --edges TERM)", name);
     for (int k = 0; k < 3 && rc == ES_OK; k++) {
         if ((rc = es__result_vector(ctx, s, kind, name, ds[k], &v, &n)) != ES_OK) break;
         if (n != E) rc = es__fail(ctx, ES_EFORMAT, "export: model/%s/%s is not per edge", name,

@@ -32,6 +32,8 @@ void es_study_interp_opts_init(es_study_interp_opts *o)
     o->t1 = 1;
     o->steps = 9;
     es_embed_opts_init(&o->embed);
+    es_multiscale_opts_init(&o->multiscale);
+    es_data_path_opts_init(&o->path);
 }
 
 /* t of frame i of `steps` from t0 to t1 inclusive. */
@@ -91,7 +93,7 @@ typedef struct walk {
     const es_study_interp_opts *o;
     const es_mesh *mesh;
     es_embedder *emb;
-    es_study_rows *rows;
+    es_study_embedder *se;   /* the embedder and the rows for priors (cached) */
     char name[256];
     es__file_set files;     /* the frames, renamed into place at the end */
 } walk;
@@ -189,21 +191,20 @@ static es_status used_rows(es_ctx *ctx, int64_t n, const double *w, int64_t **ro
     return ES_OK;
 }
 
-/* Embed frame i (lengths v at scale, weights w) near its prior and emit it. */
+/* Embed frame i (lengths v at scale, weights w) near its prior, from the
+ * last frame (warm) unless o->cold, and emit it. */
 static es_status embed_frame(walk *wk, int64_t i, double t, const double *v, double scale,
-                             const double *w, double *prior, double *res)
+                             const double *w, double *res)
 {
     es_ctx *ctx = wk->ctx;
     const es_study_interp_opts *o = wk->o;
-    int64_t ne = es_mesh_nedges(wk->mesh), nv = es_mesh_nverts(wk->mesh);
     int64_t n = es_store_nrows(wk->store), *rows = NULL, nrows = 0;
-    double *alpha = prior + 3 * nv, *sd = alpha + ne;
     char params[1024], heading[64], init[64];
-    es_embed_report rep;
-    es_embed_prior pr = {prior, alpha, sd, NULL};
+    es_study_embed_result er;
+    const es_embed_report *rep = &er.report;
     es_status rc;
-    if ((rc = es_study_prior(ctx, wk->rows, w, prior, alpha, sd)) != ES_OK ||
-        (rc = es_embed_prior_solve(ctx, wk->emb, v, scale, &pr, &o->embed, res, &rep)) != ES_OK ||
+    if ((rc = es_study_embedder_solve(ctx, wk->se, v, scale, w, &o->embed, i > 0 && !o->cold, 0, res,
+                                      &er)) != ES_OK ||
         (rc = used_rows(ctx, n, w, &rows, &nrows)) != ES_OK) {
         es__free(ctx, rows);
         return rc;
@@ -217,7 +218,8 @@ static es_status embed_frame(walk *wk, int64_t i, double t, const double *v, dou
         snprintf(heading, sizeof heading, "t = %.4g", t);
     }
     snprintf(init, sizeof init, "prior of %lld rows, store frame", (long long)nrows);
-    rc = emit_frame(wk, i, heading, v, res, &rep, &prov, init);
+    rc = emit_frame(wk, i, heading, v, res, rep, &prov, init);
+    es__progress(ctx, "interp: frames", i + 1, o->steps);
     es__free(ctx, rows);
     return rc;
 }
@@ -227,10 +229,10 @@ static es_status walk_frames(walk *wk, double *res)
     es_ctx *ctx = wk->ctx;
     es_store *s = wk->store;
     const es_study_interp_opts *o = wk->o;
-    int64_t ne = es_mesh_nedges(wk->mesh), nv = es_mesh_nverts(wk->mesh), nr = es_store_nrows(s);
+    int64_t ne = es_mesh_nedges(wk->mesh), nr = es_store_nrows(s);
     const char *from = o->weights ? o->weights : o->from, *to = o->weights ? o->weights : o->to;
-    double *a = es__alloc_array(ctx, 5 * ne + 3 * nv + 3 * nr, sizeof *a);
-    double sa, sb, scale, *b = a + ne, *v = b + ne, *prior = v + ne, *wa = prior + 3 * nv + 2 * ne;
+    double *a = es__alloc_array(ctx, 3 * ne + 3 * nr, sizeof *a);
+    double sa, sb, scale, *b = a + ne, *v = b + ne, *wa = v + ne;
     double *wb = wa + nr, *w = wb + nr;
     es_status rc = ES_OK;
     if (!a) return ES_ENOMEM;
@@ -240,13 +242,14 @@ static es_status walk_frames(walk *wk, double *res)
     /* every frame is checked before the first is written */
     for (int64_t i = 0; rc == ES_OK && i < o->steps; i++)
         rc = lerp_frame(ctx, ne, nr, a, b, sa, sb, wa, wb, frame_t(o, i), v, &scale, NULL);
-    if (rc == ES_OK && (rc = es_study_rows_load(ctx, s, wk->mesh, &wk->rows)) != ES_OK) goto done;
+    if (rc == ES_OK && (rc = es_study_embedder_open(ctx, s, 1, &wk->se)) != ES_OK) goto done;
+    wk->emb = es_study_embedder_embedder(wk->se);
     for (int64_t i = 0; rc == ES_OK && i < o->steps; i++) {
         double t = frame_t(o, i);
         /* the embedder reports its progress; a cancel stops the walk here */
         if ((rc = es__cancelled(ctx, "interp"))) break;
         lerp_frame(ctx, ne, nr, a, b, sa, sb, wa, wb, t, v, &scale, w);
-        rc = embed_frame(wk, i, t, v, scale, w, prior, res);
+        rc = embed_frame(wk, i, t, v, scale, w, res);
     }
 done:
     es__free(ctx, a);
@@ -263,7 +266,8 @@ es_status es_study_interp(es_ctx *ctx, es_store *store, const es_study_interp_op
     char probe[4096];
     es_status rc;
     if (!o || !o->output) ES_FAIL(ctx, ES_EINVAL, "interp: no output given");
-    if (o->weights ? (o->from || o->to) : (!o->from || !o->to))
+    if (o->weights ? (o->from || o->to)
+                   : (!o->from || (!o->to && o->method != ES_MORPH_CONFORMAL)))
         ES_FAIL(ctx, ES_EINVAL, "interp: give from and to, or weights");
     if (o->steps < 1) ES_FAIL(ctx, ES_EINVAL, "interp: steps must be >= 1");
     if (!o->weights && o->steps > 1 && es_study_frame_path(o->output, 0, probe, sizeof probe))
@@ -291,11 +295,9 @@ es_status es_study_interp(es_ctx *ctx, es_store *store, const es_study_interp_op
     }
     wk.mesh = mesh;
     if (!(res = es__alloc_array(ctx, 3 * es_mesh_nverts(mesh), sizeof *res))) rc = ES_ENOMEM;
-    if (rc == ES_OK) rc = es_embedder_new(ctx, mesh, &wk.emb);
     if (rc == ES_OK) rc = walk_frames(&wk, res);
     rc = es__study_frames_done(ctx, store, o, rc, was_pending, &wk.files);
-    es_study_rows_free(wk.rows);
-    es_embedder_free(wk.emb);
+    es_study_embedder_free(wk.se);
     es_mesh_free(mesh);
     es__free(ctx, res);
     return rc;

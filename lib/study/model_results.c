@@ -35,11 +35,14 @@ es_status es__model_save(es_ctx *ctx, es_store *s, const es_study_model_opts *o,
     es_status rc;
     double *ct = NULL, *lt = NULL;
     snprintf(params, sizeof params, "formula=%s; gpa=%s; where=%s; block=%s; ss=%s; "
-             "permutation=%s; permutations=%lld; contrasts=%s; pairwise=%s; edges=%s",
+             "permutation=%s; permutations=%lld; contrasts=%s; reference=%s; pairwise=%s; "
+             "slopes=%s; at=%s; null=%s; edges=%s",
              o->formula, o->gpa ? o->gpa : "", o->where ? o->where : "", o->block ? o->block : "",
              type_name(m->ss_type), m->scheme == ES_PERM_RAW ? "raw" : "rrpp", (long long)B,
              d->contrasts == ES_CONTRASTS_SUM ? "sum" : "treatment",
-             o->pairwise ? o->pairwise : "", o->edge_term ? o->edge_term : "");
+             o->reference ? o->reference : "", o->pairwise ? o->pairwise : "",
+             o->slopes ? o->slopes : "", o->at ? o->at : "",
+             o->null_formula ? o->null_formula : "", o->edge_term ? o->edge_term : "");
     es_provenance prov = {o->command ? o->command : "es_study_model", r->rows, n, params};
     if ((rc = es_store_result_begin(ctx, s, "model", o->name, &prov)) != ES_OK) return rc;
     snprintf(grp, sizeof grp, "model/%s", o->name);
@@ -58,6 +61,25 @@ es_status es__model_save(es_ctx *ctx, es_store *s, const es_study_model_opts *o,
     PUT(es_store_put_vector(ctx, s, P("r2"), m->r2, T));
     PUT(es_store_put_vector(ctx, s, P("f"), m->f, T));
     PUT(es_store_put_vector(ctx, s, P("p"), m->pval, T));
+    PUT(es_store_put_vector(ctx, s, P("z"), m->z, T));
+    {
+        const char **err = es__alloc_array(ctx, T > 0 ? T : 1, sizeof *err);
+        if (!err) {
+            rc = ES_ENOMEM;
+            goto done;
+        }
+        for (int64_t j = 0; j < T; j++)
+            err[j] = m->error[j] < 0 ? "Residual" : d->terms[m->error[j]];
+        rc = es_store_put_strings(ctx, s, P("error_terms"), err, T);
+        es__free(ctx, (void *)err);
+        if (rc != ES_OK) goto done;
+    }
+    if (d->ndropped) {
+        PUT(es_store_put_strings(ctx, s, P("dropped_terms"), (const char *const *)d->dropped,
+                                 d->ndropped));
+        PUT(es_store_put_strings(ctx, s, P("dropped_why"), (const char *const *)d->dropped_why,
+                                 d->ndropped));
+    }
     PUT(es_store_put_ints(ctx, s, P("rows"), r->rows, n));
     PUT(es_store_put_strings(ctx, s, P("coef_names"), (const char *const *)d->colnames, q));
     if (!(ct = transpose(ctx, m->coef, q, p))) {
@@ -81,12 +103,29 @@ es_status es__model_save(es_ctx *ctx, es_store *s, const es_study_model_opts *o,
         PUT(es_store_put_matrix(ctx, s, P("lsmean_weights"), (es_mat){pw->weights, n, L, n}));
         PUT(es_store_put_matrix(ctx, s, P("pairwise_distances"), (es_mat){pw->dist, L, L, L}));
         PUT(es_store_put_matrix(ctx, s, P("pairwise_p"), (es_mat){pw->pval, L, L, L}));
+        const double *extra[11] = {pw->z, pw->ucl, pw->vcor, pw->angle, pw->angle_ucl,
+                                   pw->angle_z, pw->angle_p, pw->dlength, pw->dlength_ucl,
+                                   pw->dlength_z, pw->dlength_p};
+        static const char *const names[11] = {
+            "pairwise_z", "pairwise_ucl", "pairwise_vcor", "pairwise_angle",
+            "pairwise_angle_ucl", "pairwise_angle_z", "pairwise_angle_p", "pairwise_dlength",
+            "pairwise_dlength_ucl", "pairwise_dlength_z", "pairwise_dlength_p"};
+        for (int k = 0; k < 11; k++)
+            if (extra[k])
+                PUT(es_store_put_matrix(ctx, s, P(names[k]), (es_mat){(double *)extra[k], L, L, L}));
+        PUT(es_store_put_vector(ctx, s, P("lsmean_at"), pw->at, pw->nvars));
+        PUT(es_store_put_strings(ctx, s, P("lsmean_at_vars"), (const char *const *)d->vars,
+                                 d->nvars));
         PUT(es_store_put_attr(ctx, s, grp, "pairwise", o->pairwise));
+        PUT(es_store_put_attr(ctx, s, grp, "pairwise_slopes", o->slopes ? o->slopes : ""));
+        PUT(es_store_put_attr_double(ctx, s, grp, "pairwise_confidence", pw->confidence));
     }
     if (r->edge_f) {
-        PUT(es_store_put_vector(ctx, s, P("edge_f"), r->edge_f, p));
-        PUT(es_store_put_vector(ctx, s, P("edge_p"), r->edge_p, p));
-        PUT(es_store_put_vector(ctx, s, P("edge_q"), r->edge_q, p));
+        const int lm = o->gpa != NULL;   /* per landmark in Procrustes space */
+        const int64_t k = r->ntests;
+        PUT(es_store_put_vector(ctx, s, P(lm ? "landmark_f" : "edge_f"), r->edge_f, k));
+        PUT(es_store_put_vector(ctx, s, P(lm ? "landmark_p" : "edge_p"), r->edge_p, k));
+        PUT(es_store_put_vector(ctx, s, P(lm ? "landmark_q" : "edge_q"), r->edge_q, k));
         PUT(es_store_put_attr(ctx, s, grp, "edge_term", o->edge_term));
         PUT(es_store_put_attr_int(ctx, s, grp, "edge_permutations",
                                   o->edge_permutations < 0 ? B : o->edge_permutations));
@@ -111,6 +150,16 @@ es_status es__model_save(es_ctx *ctx, es_store *s, const es_study_model_opts *o,
     PUT(es_store_put_attr_int(ctx, s, grp, "df_resid", m->df_resid));
     PUT(es_store_put_attr_double(ctx, s, grp, "rss", m->rss));
     PUT(es_store_put_attr_double(ctx, s, grp, "tss", m->tss));
+    if (r->comparison) {
+        const es_model_comparison *c = r->comparison;
+        char label[600];
+        es__model_null_label(r->null_design, label, sizeof label);
+        PUT(es_store_put_attr(ctx, s, grp, "null_model", label));
+        const double row[7] = {(double)c->df, c->ss, c->ms, c->r2, c->f, c->z, c->pval};
+        static const char *const keys[7] = {"null_df", "null_ss", "null_ms", "null_r2",
+                                            "null_f", "null_z", "null_p"};
+        for (int k = 0; k < 7; k++) PUT(es_store_put_attr_double(ctx, s, grp, keys[k], row[k]));
+    }
 #undef PUT
 #undef P
 done:

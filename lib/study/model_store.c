@@ -31,6 +31,10 @@ void es_study_model_free(es_study_model_result *r)
     if (!r) return;
     es_ctx *ctx = r->ctx;
     es_model_pairwise_free(r->pairwise);
+    es_model_comparison_free(r->comparison);
+    es_model_free(r->null_model);
+    es_design_free(r->null_design);
+    es_formula_free(r->null_formula);
     es_model_free(r->model);
     es_design_free(r->design);
     es_formula_free(r->formula);
@@ -49,6 +53,7 @@ typedef struct response {
     es_mat aligned;        /* GPA: k*d x n_gpa (owned) */
     int64_t *cols;         /* GPA: the aligned column of each model row (owned) */
     double *size;          /* N sizes (owned) */
+    int64_t dim;           /* GPA: coordinates per landmark; 0: edge lengths */
     es_source src;
 } response;
 
@@ -94,8 +99,15 @@ static es_status gpa_response(es_ctx *ctx, es_store *s, const char *gpa, const i
     if (!es_store_has(s, path))
         ES_FAIL(ctx, ES_ENOTFOUND, "model: no GPA result '%s' (run edgespace gpa --name %s)",
                 gpa, gpa);
+    double dim = 0;
+    snprintf(path, sizeof path, "gpa/%s", gpa);
+    if ((rc = es_store_get_attr_double(ctx, s, path, "dim", &dim)) != ES_OK) return rc;
+    rp->dim = (int64_t)dim;
     snprintf(path, sizeof path, "gpa/%s/aligned", gpa);
     if ((rc = es_store_get_matrix(ctx, s, path, &rp->aligned)) != ES_OK) return rc;
+    if (rp->dim < 1 || rp->aligned.rows % rp->dim)
+        ES_FAIL(ctx, ES_EFORMAT, "model: GPA result '%s' has %lld coordinates in %lld "
+                "dimensions", gpa, (long long)rp->aligned.rows, (long long)rp->dim);
     snprintf(path, sizeof path, "gpa/%s/input_rows", gpa);
     if ((rc = es_store_get_ints(ctx, s, path, &grows, &ng)) != ES_OK) goto done;
     snprintf(path, sizeof path, "gpa/%s/size", gpa);
@@ -142,15 +154,17 @@ done:
 
 /* Columns for the formula's variables: label columns, or the size. */
 static es_status columns(es_ctx *ctx, es_store *s, const es_study_model_result *res,
-                         const response *rp, es_model_column *cols, const char ***lab)
+                         const es_formula *f, const response *rp, es_model_column *cols,
+                         const char ***lab)
 {
-    const int64_t n = res->nrows, nv = es_formula_nvars(res->formula);
+    const int64_t n = res->nrows, nv = es_formula_nvars(f);
     for (int64_t v = 0; v < nv; v++) {
-        const char *name = es_formula_var(res->formula, v, NULL);
+        const char *name = es_formula_var(f, v, NULL);
         int64_t col = es_store_find_column(s, name);
         cols[v].name = name;
         cols[v].labels = NULL;
         cols[v].values = NULL;
+        cols[v].reference = NULL;
         if (col < 0 && !strcmp(name, "size")) {
             cols[v].values = rp->size;
             continue;
@@ -198,6 +212,69 @@ static int known_column(void *ud, const char *name, char *why, size_t n)
     return 0;
 }
 
+/* The fit's companions: a null model to compare with, pairwise comparisons,
+ * per-variable tests, the common allometric component. */
+static es_status after_fit(es_ctx *ctx, es_store *store, const es_study_model_opts *o,
+                           es_study_model_result *r, const response *rp, const es_model_opts *mo)
+{
+    es_status rc = ES_OK;
+    const int64_t p = r->model->p, nv = r->design->nvars;
+    if (o->null_formula) {
+        const char **lab[64] = {NULL};
+        es_model_column cols[64];
+        if ((rc = es_formula_parse_checked(ctx, o->null_formula, known_column, store,
+                                           &r->null_formula)) == ES_OK &&
+            (rc = columns(ctx, store, r, r->null_formula, rp, cols, lab)) == ES_OK &&
+            (rc = es_design_build(ctx, r->null_formula, r->nrows, cols,
+                                  es_formula_nvars(r->null_formula), r->design->contrasts,
+                                  &r->null_design)) == ES_OK) {
+            es_model_opts no = *mo;
+            no.error = NULL;
+            no.permutations = 0;
+            if ((rc = es_model_fit(ctx, r->null_design, &rp->src, &no, &r->null_model)) == ES_OK)
+                rc = es_model_compare(ctx, r->null_model, r->model, &r->comparison);
+        }
+        for (int v = 0; v < 64; v++) es__free(ctx, (void *)lab[v]);
+        if (rc != ES_OK) return rc;
+    }
+    if (o->pairwise) {
+        es_model_pairwise_opts po;
+        es_model_pairwise_opts_init(&po);
+        double *at = es__alloc_array(ctx, nv > 0 ? nv : 1, sizeof *at);
+        if (!at) return ES_ENOMEM;
+        po.covariate = o->slopes;
+        po.at = at;
+        if ((rc = es__model_at(ctx, r->design, r->formula, o->at, at)) == ES_OK)
+            rc = es_model_pairwise_fit(ctx, r->model, o->pairwise, &po, &r->pairwise);
+        es__free(ctx, at);
+        if (rc != ES_OK) return rc;
+    } else if (o->slopes || o->at) {
+        ES_FAIL(ctx, ES_EINVAL, "model: %s needs a pairwise factor", o->slopes ? "slopes" : "at");
+    }
+    if (o->edge_term) {
+        const int64_t k = rp->dim ? p / rp->dim : p;
+        int64_t *group = NULL;
+        r->ntests = k;
+        r->edge_f = es__alloc_array(ctx, k, sizeof *r->edge_f);
+        r->edge_p = es__alloc_array(ctx, k, sizeof *r->edge_p);
+        r->edge_q = es__alloc_array(ctx, k, sizeof *r->edge_q);
+        if (rp->dim && (group = es__alloc_array(ctx, p, sizeof *group)))
+            for (int64_t e = 0; e < p; e++) group[e] = e % k;   /* x1..xk, y1..yk, ... */
+        if (!r->edge_f || !r->edge_p || !r->edge_q || (rp->dim && !group)) rc = ES_ENOMEM;
+        else rc = es_model_group_tests(ctx, r->model, o->edge_term, o->edge_permutations,
+                                       rp->dim ? k : 0, group, r->edge_f, r->edge_p, r->edge_q);
+        es__free(ctx, group);
+        if (rc != ES_OK) return rc;
+    }
+    if (es_model_find_term(r->model, "log(size)") >= 0) {
+        r->cac = es__alloc_array(ctx, p, sizeof *r->cac);
+        r->cac_scores = es__alloc_array(ctx, r->nrows, sizeof *r->cac_scores);
+        if (!r->cac || !r->cac_scores) return ES_ENOMEM;
+        rc = es_model_cac(ctx, r->model, "log(size)", r->cac, r->cac_scores);
+    }
+    return rc;
+}
+
 es_status es_study_model(es_ctx *ctx, es_store *store, const es_study_model_opts *opts,
                          es_study_model_result **out)
 {
@@ -210,12 +287,12 @@ es_status es_study_model(es_ctx *ctx, es_store *store, const es_study_model_opts
     if (!store || !o.formula) ES_FAIL(ctx, ES_EINVAL, "model: no store or no formula");
     if (o.name && (!*o.name || strchr(o.name, '/')))
         ES_FAIL(ctx, ES_EINVAL, "model: bad result name '%s' (no '/', not empty)", o.name);
-    if (o.edge_term && o.gpa)
-        ES_FAIL(ctx, ES_EINVAL, "model: per-edge tests need edge-length space (leave out the "
-                "GPA result)");
+    if (o.nerrors < 0 || (o.nerrors > 0 && !o.errors))
+        ES_FAIL(ctx, ES_EINVAL, "model: bad error-term list");
     es_study_model_result *r = es__calloc(ctx, 1, sizeof *r);
-    int64_t *sel = NULL, nsel = 0, *blocks = NULL;
+    int64_t *sel = NULL, nsel = 0, *blocks = NULL, *error = NULL;
     const char **lab[64] = {NULL};
+    char *refs = NULL;
     es_model_column cols[64];
     es_status rc;
     if (!r) return ES_ENOMEM;
@@ -244,10 +321,23 @@ es_status es_study_model(es_ctx *ctx, es_store *store, const es_study_model_opts
         goto done;
     }
     for (int64_t i = 0; i < r->nrows; i++) r->ids[i] = es_store_row_id(store, r->rows[i]);
-    if ((rc = columns(ctx, store, r, &rp, cols, lab)) != ES_OK ||
+    if ((rc = columns(ctx, store, r, r->formula, &rp, cols, lab)) != ES_OK ||
+        (rc = es__model_references(ctx, r->formula, o.reference, r->nrows, cols, &refs)) != ES_OK ||
         (rc = es_design_build(ctx, r->formula, r->nrows, cols, es_formula_nvars(r->formula),
                               o.contrasts, &r->design)) != ES_OK)
         goto done;
+    if (o.edge_term && es_design_dropped(r->design, o.edge_term)) {
+        rc = es__fail(ctx, ES_EINVAL, "model: --edges %s: the term %s and was left out of the "
+                      "model: test what it duplicates", o.edge_term,
+                      es_design_dropped(r->design, o.edge_term));
+        goto done;
+    }
+    if (!(error = es__alloc_array(ctx, r->design->nterms > 0 ? r->design->nterms : 1,
+                                  sizeof *error))) {
+        rc = ES_ENOMEM;
+        goto done;
+    }
+    if ((rc = es__model_errors(ctx, r->design, o.errors, o.nerrors, error)) != ES_OK) goto done;
     if (o.block && (rc = blocks_of(ctx, store, r, o.block, &blocks)) != ES_OK) goto done;
     /* a taken name is refused before the permutations run */
     if (o.name && (rc = es_store_result_check(ctx, store, "model", o.name)) != ES_OK) goto done;
@@ -257,70 +347,20 @@ es_status es_study_model(es_ctx *ctx, es_store *store, const es_study_model_opts
     mo.scheme = o.scheme;
     mo.permutations = o.permutations;
     mo.blocks = blocks;
-    if ((rc = es_model_fit(ctx, r->design, &rp.src, &mo, &r->model)) != ES_OK) goto done;
-    if (o.pairwise && (rc = es_model_pairwise_fit(ctx, r->model, o.pairwise, &r->pairwise)) != ES_OK)
+    mo.error = error;
+    if ((rc = es_model_fit(ctx, r->design, &rp.src, &mo, &r->model)) != ES_OK ||
+        (rc = after_fit(ctx, store, &o, r, &rp, &mo)) != ES_OK)
         goto done;
-    const int64_t p = r->model->p;
-    if (o.edge_term) {
-        r->edge_f = es__alloc_array(ctx, p, sizeof *r->edge_f);
-        r->edge_p = es__alloc_array(ctx, p, sizeof *r->edge_p);
-        r->edge_q = es__alloc_array(ctx, p, sizeof *r->edge_q);
-        if (!r->edge_f || !r->edge_p || !r->edge_q) {
-            rc = ES_ENOMEM;
-            goto done;
-        }
-        if ((rc = es_model_variable_tests(ctx, r->model, o.edge_term, o.edge_permutations,
-                                          r->edge_f, r->edge_p, r->edge_q)) != ES_OK)
-            goto done;
-    }
-    if (es_model_find_term(r->model, "log(size)") >= 0) {
-        r->cac = es__alloc_array(ctx, p, sizeof *r->cac);
-        r->cac_scores = es__alloc_array(ctx, r->nrows, sizeof *r->cac_scores);
-        if (!r->cac || !r->cac_scores) {
-            rc = ES_ENOMEM;
-            goto done;
-        }
-        if ((rc = es_model_cac(ctx, r->model, "log(size)", r->cac, r->cac_scores)) != ES_OK)
-            goto done;
-    }
     if (o.name && (rc = es__model_save(ctx, store, &o, r)) != ES_OK) goto done;
     *out = r;
     r = NULL;
 done:
     for (int v = 0; v < 64; v++) es__free(ctx, (void *)lab[v]);
+    es__free(ctx, refs);
     es__free(ctx, sel);
     es__free(ctx, blocks);
+    es__free(ctx, error);
     response_clear(ctx, &rp);
     es_study_model_free(r);
     return rc;
-}
-
-es_status es_study_write_model_table(es_ctx *ctx, const es_study_model_result *r,
-                                     const char *path)
-{
-    es__table_out t;
-    if (!r || !r->model) ES_FAIL(ctx, ES_EINVAL, "model: no result to write");
-    es_status rc = es__table_begin(ctx, path, &t);
-    if (rc != ES_OK) return rc;
-    const es_model *m = r->model;
-    fputs("term,df,ss,ms,r2,f,p\n", t.f);
-    for (int64_t j = 0; j < m->nterms; j++) {
-        es_csv_write_field(t.f, r->design->terms[j]);
-        fprintf(t.f, ",%lld", (long long)m->df[j]);
-        es__table_number(t.f, m->ss[j]);
-        es__table_number(t.f, m->ms[j]);
-        es__table_number(t.f, m->r2[j]);
-        es__table_number(t.f, m->f[j]);
-        es__table_number(t.f, m->pval[j]);
-        fputc('\n', t.f);
-    }
-    fprintf(t.f, "Residual,%lld", (long long)m->df_resid);
-    es__table_number(t.f, m->rss);
-    es__table_number(t.f, m->rss / (double)m->df_resid);
-    es__table_number(t.f, m->rss / m->tss);
-    fputs(",,\n", t.f);
-    fprintf(t.f, "Total,%lld", (long long)(m->n - 1));
-    es__table_number(t.f, m->tss);
-    fputs(",,1,,\n", t.f);
-    return es__table_end(ctx, &t, ES_OK);
 }

@@ -62,23 +62,6 @@ static es_status mean_spec(es_ctx *ctx, const char *filter, char *out, size_t n)
     return ES_OK;
 }
 
-/* Embed one point of the PCA's space near its prior, as es_study_embed does. */
-static es_status embed_point(es_ctx *ctx, es_store *s, es_embedder *emb,
-                             const es_study_rows *rows, const char *spec, const char *pca,
-                             const es_embed_opts *eo, double *work, double *xyz,
-                             es_embed_report *rep)
-{
-    int64_t n = es_store_nrows(s), E = es_store_nedges(s), V3 = 3 * es_store_nverts(s);
-    double *target = work, *w = work + E, *pxyz = w + n, *alpha = pxyz + V3, *sd = alpha + E;
-    double scale;
-    es_embed_prior pr = {pxyz, alpha, sd, NULL};
-    es_status rc;
-    if ((rc = es_study_point_weights(ctx, s, spec, pca, target, &scale, w)) != ES_OK ||
-        (rc = es_study_prior(ctx, rows, w, pxyz, alpha, sd)) != ES_OK)
-        return rc;
-    return es_embed_prior_solve(ctx, emb, target, scale, &pr, eo, xyz, rep);
-}
-
 /* The modes of an edge-length PCA, linearized (see the top of the file):
  * mean (3V), basis (3V x K), variance (K), scores (K x N). */
 static es_status edge_length_model(es_ctx *ctx, es_store *s, const es_study_statismo_opts *o,
@@ -87,12 +70,11 @@ static es_status edge_length_model(es_ctx *ctx, es_store *s, const es_study_stat
 {
     es_pca *p = NULL, *q = NULL;
     es_mesh *mesh = NULL;
-    es_embedder *emb = NULL;
-    es_study_rows *rows = NULL;
-    es_embed_report rep;
+    es_study_embedder *se = NULL;
+    es_study_embed_result er;
     char path[600], filter[512] = "", mspec[1200], spec[1300];
-    int64_t *prow = NULL, nprow = 0, K, V3 = 3 * es_store_nverts(s), N = es_store_nrows(s);
-    double *D = NULL, *work = NULL, *xp = NULL;
+    int64_t *prow = NULL, nprow = 0, K, V3 = 3 * es_store_nverts(s);
+    double *D = NULL, *xp = NULL;
     const char *name = o->pca_name;
     char **names = NULL;
     int64_t nnames = 0;
@@ -115,14 +97,12 @@ static es_status edge_length_model(es_ctx *ctx, es_store *s, const es_study_stat
     }
     if ((rc = mean_spec(ctx, filter, mspec, sizeof mspec)) != ES_OK ||
         (rc = es_store_mesh(ctx, s, &mesh)) != ES_OK ||
-        (rc = es_study_rows_load(ctx, s, mesh, &rows)) != ES_OK ||
-        (rc = es_embedder_new(ctx, mesh, &emb)) != ES_OK)
+        (rc = es_study_embedder_open(ctx, s, 1, &se)) != ES_OK)
         goto done;
     bufs[0] = es__alloc_array(ctx, V3, sizeof(double));           /* mean */
     D = es__alloc_array(ctx, V3 * 2 * K, sizeof *D);               /* +-d_k */
     xp = es__alloc_array(ctx, V3, sizeof *xp);
-    work = es__alloc_array(ctx, 3 * es_store_nedges(s) + N + V3, sizeof *work);
-    if (!bufs[0] || !D || !xp || !work) {
+    if (!bufs[0] || !D || !xp) {
         rc = ES_ENOMEM;
         goto done;
     }
@@ -134,11 +114,13 @@ static es_status edge_length_model(es_ctx *ctx, es_store *s, const es_study_stat
         if ((rc = es__progress(ctx, "statismo: embedding", j, 2 * K + 1))) break;
         if (j == 0) snprintf(spec, sizeof spec, "%s", mspec);
         else snprintf(spec, sizeof spec, "%s + %.17g*pc:%lld", mspec, c, (long long)k + 1);
-        if ((rc = embed_point(ctx, s, emb, rows, spec, name, &o->embed, work, out,
-                              &rep)) != ES_OK)
+        /* each point from its own prior, as es_study_embed starts it: a model
+         * file is a function of the store, not of the order its points were
+         * embedded in (warm starts left mean -/+ c sd 1e-4 asymmetric) */
+        if ((rc = es_study_embedder_point(ctx, se, spec, name, 0, &o->embed, 0, out, &er)) != ES_OK)
             break;
-        r->worst_rms_ratio = fmax(r->worst_rms_ratio, rep.rms_ratio);
-        r->worst_bend_ratio = fmax(r->worst_bend_ratio, rep.bend_ratio);
+        r->worst_rms_ratio = fmax(r->worst_rms_ratio, er.report.rms_ratio);
+        r->worst_bend_ratio = fmax(r->worst_bend_ratio, er.report.bend_ratio);
         if (j > 0 && j % 2 == 0) {
             /* d_k = (X(+c) - X(-c)) / 2c; how far from linear: the second
              * difference against the first */
@@ -200,13 +182,11 @@ static es_status edge_length_model(es_ctx *ctx, es_store *s, const es_study_stat
 done:
     es_pca_free(p);
     es_pca_free(q);
-    es_embedder_free(emb);
-    es_study_rows_free(rows);
+    es_study_embedder_free(se);
     es_mesh_free(mesh);
     es__free(ctx, prow);
     es__free(ctx, D);
     es__free(ctx, xp);
-    es__free(ctx, work);
     for (int64_t i = 0; i < nnames; i++) es_free(ctx, names[i]);
     es_free(ctx, names);
     return rc;

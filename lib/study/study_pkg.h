@@ -68,9 +68,50 @@ ES__TABLE(es__t_model_scores);
 ES__TABLE(es__t_model_permutations);
 #undef ES__TABLE
 
+/* A model's requests as written (model_requests.c): --reference
+ * "LEVEL|FACTOR=LEVEL,..." onto the columns (cols[v].reference points into
+ * *held, a copy of spec that the caller frees after es_design_build);
+ * --at "NAME=VALUE|mean,..." into at (nvars, NaN: the mean); --error
+ * "TERM=ERROR" items into error (nterms, -1: the residual). */
+es_status es__model_references(es_ctx *ctx, const es_formula *f, const char *spec, int64_t n,
+                               es_model_column *cols, char **held);
+es_status es__model_at(es_ctx *ctx, const es_design *d, const es_formula *f, const char *spec,
+                       double *at);
+es_status es__model_errors(es_ctx *ctx, const es_design *d, const char *const *spec,
+                           int64_t count, int64_t *error);
+
+/* "~ a + b" of a design's terms ("~ 1" without any) into buf. */
+void es__model_null_label(const es_design *d, char *buf, size_t len);
+
 /* Store a model as model/<o->name> (model_results.c). */
 es_status es__model_save(es_ctx *ctx, es_store *s, const es_study_model_opts *o,
                          const es_study_model_result *r);
+/* ---- embeddings: the rows for priors and their cache (prior.c, embed_cache.c) */
+
+/* An es_study_rows of n rows with its arrays (3V x n aligned positions, E x n
+ * dihedrals) for the caller to fill. */
+/* The rows of a prior (n of them) and the embedder of mesh that uses them
+ * against the context's memory limit (es_embed_check_memory), before
+ * either is allocated. */
+es_status es__study_rows_check_memory(es_ctx *ctx, const es_mesh *mesh, int64_t n);
+es_status es__study_rows_new(es_ctx *ctx, int64_t n, int64_t nv, int64_t ne, es_study_rows **out,
+                             double **aligned, double **alpha);
+void es__study_rows_arrays(const es_study_rows *r, const double **aligned, const double **alpha);
+/* The cache's key for the store as it is now (reads the positions of rows
+ * without a content hash). */
+es_status es__study_cache_key(es_ctx *ctx, es_store *s, uint64_t *key);
+/* The cached vertex order and rows for this key, or both NULL (no cache, or a
+ * stale or damaged one: the log says which). Fails only without memory. */
+es_status es__study_cache_load(es_ctx *ctx, es_store *s, uint64_t key, int64_t **order,
+                               es_study_rows **rows);
+/* Keep them for the next command; a failure is only logged. */
+void es__study_cache_save(es_ctx *ctx, es_store *s, uint64_t key, const int64_t *order,
+                          const es_study_rows *rows);
+
+/* 1 if a point expression is one mesh's lengths (a row or a file with
+ * coefficient 1): exactly realizable (embed_session.c). */
+int es__study_point_is_one_mesh(es_ctx *ctx, const char *spec);
+
 /* ---- embeddings and interpolation by the other papers' methods ------------ */
 
 /* Store a mesh result as /analysis/embed/<name> (what es_study_store_embedding

@@ -44,13 +44,14 @@ static void log_to_stderr(void *userdata, es_log_level level, const char *msg)
 
 static void usage(FILE *f, const char *name)
 {
-    fprintf(f, "usage: %s [--out DIR] [--data DIR] [--synthetic] [--small] [--seed N]\n\n"
+    fprintf(f, "usage: %s [--out DIR] [--data DIR] [--synthetic] [--small | --all] [--seed N]\n\n"
                "  --out DIR     where report.md, figures, CSV and run.json go\n"
                "                (default: $EDGESPACE_NOTEBOOK_OUT/%s, else out/%s)\n"
                "  --data DIR    folder holding the data sets (default: $EDGESPACE_SHARED/data,\n"
                "                else ../shared/data beside the source tree)\n"
                "  --synthetic   ignore real data; use the project's synthetic data\n"
                "  --small       the small sizes the test suite runs\n"
+               "  --all         also the inputs a default run leaves out for time\n"
                "  --seed N      seed of everything random (default 0x5eed)\n", name, name,
             name);
 }
@@ -69,7 +70,7 @@ int nb_open(notebook *n, const char *name, const char *title, int argc, char **a
         {"out", required_argument, NULL, 'o'}, {"data", required_argument, NULL, 'd'},
         {"synthetic", no_argument, NULL, 'S'}, {"small", no_argument, NULL, 's'},
         {"seed", required_argument, NULL, 'r'}, {"help", no_argument, NULL, 'h'},
-        {NULL, 0, NULL, 0}};
+        {"all", no_argument, NULL, 'A'}, {NULL, 0, NULL, 0}};
     const char *out = NULL, *data = NULL, *env;
     int c;
 
@@ -85,6 +86,7 @@ int nb_open(notebook *n, const char *name, const char *title, int argc, char **a
         case 'd': data = optarg; break;
         case 'S': n->synthetic = 1; break;
         case 's': n->small = 1; break;
+        case 'A': n->all = 1; break;
         case 'r': {
             char *end;
             errno = 0;
@@ -142,7 +144,7 @@ int nb_open(notebook *n, const char *name, const char *title, int argc, char **a
     fprintf(n->report, "# %s\n\n", title);
     fprintf(n->report, "*Notebook `notebooks-c/%s.c`, libedgespace %s (%s), seed %#llx%s.*\n\n",
             name, es_version(), NB_GIT_DESCRIBE, (unsigned long long)n->seed,
-            n->small ? ", small run" : "");
+            n->small ? ", small run" : n->all ? ", every input (--all)" : "");
     printf("%s: writing %s/\n", name, n->outdir);
     return 0;
 }
@@ -169,6 +171,30 @@ const char *nb_dataset(notebook *n, const char *set)
     if (!is_dir(buf)) return NULL;
     nb_input(n, "dataset", "%s", buf);
     return buf;
+}
+
+int nb_read_mesh(notebook *n, const char *dir, const char *file, es_mesh **mesh, double **xyz)
+{
+    char path[8192];
+    es_meshdata md;
+    es_status rc;
+    snprintf(path, sizeof path, "%s/%s", dir, file);
+    *xyz = NULL;
+    if ((rc = es_meshdata_read(n->ctx, path, ES_FORMAT_AUTO, &md)) != ES_OK)
+        return nb_fail(n, rc, path);
+    if (!*mesh) {
+        rc = es_mesh_new(n->ctx, md.nverts, md.nfaces, md.faces, md.xyz, mesh);
+    } else if (md.nverts != es_mesh_nverts(*mesh) || md.nfaces != es_mesh_nfaces(*mesh) ||
+               memcmp(md.faces, es_mesh_faces(*mesh), 3 * sizeof(int64_t) * (size_t)md.nfaces)) {
+        es_meshdata_clear(n->ctx, &md);
+        fprintf(stderr, "%s: %s: another face list than the study's first mesh\n", n->name,
+                path);
+        return nb_fail(n, ES_EMISMATCH, path);
+    }
+    if (rc == ES_OK && !(*xyz = malloc(3 * sizeof(double) * (size_t)md.nverts))) rc = ES_ENOMEM;
+    if (rc == ES_OK) memcpy(*xyz, md.xyz, 3 * sizeof(double) * (size_t)md.nverts);
+    es_meshdata_clear(n->ctx, &md);
+    return rc == ES_OK ? 0 : nb_fail(n, rc, path);
 }
 
 void nb_input(notebook *n, const char *key, const char *fmt, ...)
@@ -357,6 +383,7 @@ static cJSON *run_json(const notebook *n, double total)
     cJSON_AddStringToObject(root, "git_describe", NB_GIT_DESCRIBE);
     cJSON_AddNumberToObject(root, "seed", (double)n->seed);
     cJSON_AddBoolToObject(root, "small", n->small);
+    cJSON_AddBoolToObject(root, "all", n->all);
     cJSON_AddBoolToObject(root, "synthetic_requested", n->synthetic);
     cJSON_AddStringToObject(root, "data_dir", n->datadir);
     inputs = cJSON_AddObjectToObject(root, "inputs");

@@ -16,7 +16,8 @@
  * else $EDGESPACE_SHARED/data, else the NB_SHARED_DIR given at build time
  * (../shared beside the source tree) + /data; --synthetic ignores it all
  * and makes the project's own synthetic data. --small picks the small
- * sizes the test suite runs (also $EDGESPACE_NOTEBOOK_SMALL=1).
+ * sizes the test suite runs (also $EDGESPACE_NOTEBOOK_SMALL=1); --all adds
+ * the inputs a default run leaves out because they take minutes.
  */
 #ifndef EDGESPACE_NOTEBOOK_H
 #define EDGESPACE_NOTEBOOK_H
@@ -49,6 +50,7 @@ typedef struct notebook {
     char datadir[4096];         /* folder of the data sets, "" if none */
     int synthetic;              /* --synthetic given */
     int small;                  /* --small given */
+    int all;                    /* --all given: inputs a default run leaves out for time */
     uint64_t seed;
     es_ctx *ctx;
     FILE *report;               /* report.md */
@@ -116,6 +118,12 @@ void nb_output(notebook *nb, const char *file);
 /* Self-check: record metric `op` bound ("<", "<=", ">", ">=") and print
  * it; a miss makes nb_close return 1. NaN metrics fail. Returns pass. */
 int nb_check(notebook *nb, const char *name, double metric, const char *op, double bound);
+
+/* Read the mesh file <dir>/<file> (an input of the study): its positions
+ * into a malloc'd 3 x V array *xyz and, when *mesh is NULL, its topology
+ * (with these positions as reference) into *mesh; a later file must have
+ * the same face list. Returns 0, or 1 after nb_fail. */
+int nb_read_mesh(notebook *nb, const char *dir, const char *file, es_mesh **mesh, double **xyz);
 
 /* Seconds on a monotonic clock. */
 double nb_now(void);

@@ -31,6 +31,7 @@ from ._native import INCLUDE_DIR, LIBRARY_PATH, LoadError, ffi, lib
 from .mesh import (Embedder, Embedding, Mesh, embed, embed_opts, normalize_lengths,
                    read_mesh)
 from .render import FiguresUnavailable, Image, auto_view, plot_scatter, plot_scree, render
+from .session import StudyEmbedder
 from .store import PCA, Store, ingest
 
 __all__ = [
@@ -40,7 +41,8 @@ __all__ = [
     "CancelledError",
     "LoadError", "Mesh", "Embedder", "Embedding", "embed", "embed_opts",
     "normalize_lengths", "read_mesh", "render", "plot_scatter", "plot_scree", "auto_view",
-    "Image", "FiguresUnavailable", "Store", "PCA", "ingest", "synth", "pca", "version",
+    "Image", "FiguresUnavailable", "Store", "StudyEmbedder", "PCA", "ingest", "synth", "pca",
+    "version",
     "has_figures", "LIBRARY_PATH", "INCLUDE_DIR", "ffi", "lib",
 ]
 

@@ -40,12 +40,16 @@ class EdgespaceWarning(UserWarning):
 
 def _tqdm():
     """tqdm's bar class for where we run: widgets in a Jupyter kernel that has
-    ipywidgets, text on a terminal; None where neither would read well (a
-    kernel without widgets, where text bars leave blank lines) or without
-    tqdm."""
+    ipywidgets 7 or later (tqdm.notebook's need; Debian 12's 6.0 sends widget
+    messages that nbclient cannot read, and a notebook executed by nbconvert
+    then fails with KeyError 'state'), text on a terminal; None where neither
+    would read well (a kernel without usable widgets, where text bars leave
+    blank lines) or without tqdm."""
     try:
         if "ipykernel" in sys.modules:
-            import ipywidgets  # noqa: F401
+            import ipywidgets
+            if int(str(getattr(ipywidgets, "__version__", "0")).split(".")[0]) < 7:
+                return None
             from tqdm.notebook import tqdm
         else:
             from tqdm.std import tqdm

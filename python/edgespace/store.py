@@ -8,8 +8,8 @@ that array), positions as (V, 3), labels as arrays of str. Results the
 library allocates (a PCA, a comparison) are read-only views that keep their
 owner alive.
 
-Models (issue 15, linear models on the store) are not bound yet: they will
-be Store methods beside mean/pca/diff calling their es_study_* functions.
+Linear models (Store.model) come back as a ModelResult whose tables view the
+library's arrays, with the summary text the command prints.
 """
 import os
 import tempfile
@@ -123,10 +123,55 @@ class CompareResult(Result):
 
 class ModelResult(Result):
     """A linear model with permutation tests (es_study_model): terms (T,),
-    df, ss, ms, r2, f, p (T,) the ANOVA table (p NaN where untestable),
-    df_resid, rss, tss, coef_names (q,), coef (q, P), coef_weights (q, N),
-    mean (P,), rows (N,) store rows, and with edges= edge_f/edge_p/edge_q
-    (E,), with log(size) a term cac (P,) and cac_scores (N,)."""
+    df, ss, ms, r2, f, z, p (T,) the ANOVA table (z: RRPP's effect size; p
+    and z NaN where untestable), error (T,) each F's error term, dropped
+    {term: why} the terms left out as aliased, df_resid, rss, tss,
+    coef_names (q,), coef (q, P), coef_weights (q, N), mean (P,), rows (N,)
+    store rows; with pairwise= a PairwiseResult `pairwise`; with null= the
+    comparison (dict: df, ss, ms, r2, f, z, p); with edges= edge_f/edge_p/
+    edge_q (E edges, or k landmarks with gpa=); with log(size) a term cac
+    (P,) and cac_scores (N,); summary, the table as `edgespace model`
+    prints it (also repr in a notebook); anova() the table as a pandas
+    DataFrame (or a dict without pandas)."""
+
+    def anova(self):
+        cols = {"term": list(self.terms), "df": self.df, "ss": self.ss, "ms": self.ms,
+                "r2": self.r2, "f": self.f, "z": self.z, "p": self.p, "error": self.error}
+        return _frame(cols, "term")
+
+    def _repr_pretty_(self, p, cycle):
+        p.text(self.summary)
+
+
+class PairwiseResult(Result):
+    """Pairwise comparisons (es_model_pairwise): levels (L,), slopes (bool),
+    lsmeans (L, P) the LS means or slopes, weights (L, N), at {variable:
+    value} the numeric values of the LS means, confidence; L x L matrices
+    d, ucl, z, p, and for slopes r, angle (degrees), angle_ucl, angle_z,
+    angle_p, dlength, dlength_ucl, dlength_z, dlength_p; table() a row per
+    pair as a DataFrame (or dict), the layout of `model -o`'s pairwise CSV."""
+
+    def table(self):
+        L = len(self.levels)
+        pairs = [(a, b) for a in range(L) for b in range(a + 1, L)]
+        names = ["d", "ucl", "z", "p"] + (["r", "angle", "angle_ucl", "angle_z", "angle_p",
+                                           "dlength", "dlength_ucl", "dlength_z", "dlength_p"]
+                                          if self.slopes else [])
+        cols = {"level_a": [self.levels[a] for a, _ in pairs],
+                "level_b": [self.levels[b] for _, b in pairs]}
+        for k in names:
+            cols[k] = [getattr(self, k)[a, b] for a, b in pairs]
+        return _frame(cols, None)
+
+
+def _frame(cols, index):
+    """A pandas DataFrame of the columns (pandas installed), else the dict."""
+    try:
+        import pandas as pd
+    except ImportError:
+        return cols
+    df = pd.DataFrame(cols)
+    return df.set_index(index) if index else df
 
 
 def ingest(store_path, manifest=None, files=None, create=True, threads=0, ctx=None):
@@ -163,6 +208,7 @@ class Store:
         self._ptr = A.owned(self.ctx, _ptr, lib.es_store_close)
         self.writable = bool(write)
         self._mesh = None
+        self._sessions = []   # StudyEmbedder sessions, closed before the store
 
     open = classmethod(lambda cls, path, write=False, ctx=None: cls(path, write, ctx))
 
@@ -225,6 +271,7 @@ class Store:
         with self.ctx.closing():
             if self._ptr is None:
                 return
+            self._close_sessions()
             try:
                 if self.writable:
                     self.commit()
@@ -236,6 +283,7 @@ class Store:
         """Close, discarding uncommitted writes."""
         with self.ctx.closing():
             if self._ptr is not None:
+                self._close_sessions()
                 ffi.gc(self._ptr, None)   # no es_store_close at collection
                 lib.es_store_abort(self._ptr)
                 self._ptr = None
@@ -576,13 +624,33 @@ class Store:
                       0 if r is None else len(r), row, dist)
         return int(row[0]), float(dist[0])
 
+    def _close_sessions(self):
+        for s in self._sessions:
+            s.close()
+        self._sessions = []
+
+    def embedder(self, cache=True):
+        """An embedding session (StudyEmbedder): embed(point, warm=True, fast=...)
+        costs only the solve; the mesh, embedder and rows for priors are made
+        once (from STORE.es-cache when it is current; cache=False neither
+        reads nor writes it). Closed with the store."""
+        from .session import StudyEmbedder
+        s = StudyEmbedder(self, cache)
+        self._sessions.append(s)
+        return s
+
     def embed(self, point, pca=None, init=None, scale=0.0, name=None, output=None,
-              residuals=None, **opts):
+              residuals=None, warm=False, **opts):
         """Embed a point of the store's space (es_study_embed: near the prior
         of its row weights, in the store's frame, unless init names an explicit
         start). Returns Embedding(V, F, report) with report["scale"] and
         report["init"]. name stores /analysis/embed/<name> (write handle);
-        output/residuals write the mesh and per-vertex CSV. opts: es_embed_opts."""
+        output/residuals write the mesh and per-vertex CSV. opts: es_embed_opts.
+        The store keeps one embedding session for these calls (made on the
+        first, from STORE.es-cache when current), so the next one costs only
+        its solve; warm=True starts from the last call's correction of its
+        prior (default: from the point's own prior, the same mesh whatever
+        came before)."""
         o = ffi.new("es_study_embed_opts *")
         lib.es_study_embed_opts_init(o)
         keep = [_c(point), _c(pca), _c(init), _c(name), _c(output), _c(residuals),
@@ -592,6 +660,14 @@ class Store:
             o.init = keep[2]
         o.name, o.output, o.residuals, o.command = keep[3], keep[4], keep[5], keep[6]
         o.scale = float(scale)
+        if init is None or init == "prior":
+            s = getattr(self, "_embed_session", None)
+            if s is None or s._ptr is None or s.nrows != self.nrows:   # rows added since
+                if s is not None:
+                    s.close()
+                self._embed_session = self.embedder()
+            o.session = self._embed_session.ptr
+            o.warm = 1 if warm else 0
         set_embed_opts(o.embed, opts)
         xyz = np.empty((self.nverts, 3))
         res = ffi.new("es_study_embed_result *")
@@ -602,12 +678,14 @@ class Store:
         return Embedding(xyz, self.mesh.faces, rep)
 
     def interp(self, from_=None, to=None, steps=9, t0=0.0, t1=1.0, weights=None, pca=None,
-               name=None, output=None, **opts):
+               name=None, output=None, cold=False, **opts):
         """A walk from `from_` (t = t0) to `to` (t = t1) in `steps` frames, or one
         weighted combination of rows (weights="0.3*row:a + 0.7*row:b"), each
-        frame embedded as es_study_interp embeds it. Returns a list of
-        Embedding (report["t_heading"] says which t). output: a mesh file
-        pattern ("walk_%02d.obj") to keep the frames; name stores them."""
+        frame embedded as es_study_interp embeds it: from the last frame's
+        correction of its prior (a warm start), or with cold=True from its own
+        prior, as embed() does. Returns a list of Embedding (report["t_heading"]
+        says which t). output: a mesh file pattern ("walk_%02d.obj") to keep the
+        frames; name stores them."""
         o = ffi.new("es_study_interp_opts *")
         lib.es_study_interp_opts_init(o)
         frames = []
@@ -623,6 +701,7 @@ class Store:
             setattr(o, "from", keep[0])   # a Python keyword
             o.to, o.weights, o.pca_name, o.output, o.name, o.command = keep[1:]
             o.t0, o.t1, o.steps = float(t0), float(t1), A.index(steps, "steps")
+            o.cold = 1 if cold else 0
             o.frame = cb
             set_embed_opts(o.embed, opts)
             self._call(lib.es_study_interp, o)
@@ -720,22 +799,31 @@ class Store:
 
     def model(self, formula, gpa=None, where=None, block=None, ss_type=1, permute="rrpp",
               permutations=999, contrasts="treatment", pairwise=None, edges=None,
-              edge_permutations=-1, name=None):
+              edge_permutations=-1, name=None, reference=None, slopes=None, at=None,
+              errors=None, null=None):
         """A linear model of the shapes on label columns with permutation
         tests (es_study_model): in edge-length space, or on GPA result
         `gpa`'s aligned coordinates; stored as model/<name> (None: not
-        stored) and committed."""
+        stored) and committed. reference: "LEVEL" or "FACTOR=LEVEL,..."
+        baselines; pairwise: a factor whose LS means (or with slopes=VAR its
+        slopes on VAR) are compared; at: "NAME=VALUE|mean,..." the LS means'
+        covariate values; errors: {"TERM": "ERROR_TERM"} for nested designs;
+        null: a nested formula the model is compared with (RRPP's
+        anova(null, full)); edges: a term tested per edge (per landmark with
+        gpa). The options are the command's (edgespace model --help)."""
         schemes = {"rrpp": lib.ES_PERM_RRPP, "raw": lib.ES_PERM_RAW}
         codings = {"treatment": lib.ES_CONTRASTS_TREATMENT, "sum": lib.ES_CONTRASTS_SUM}
         if permute not in schemes or contrasts not in codings or ss_type not in (1, 2, 3):
             raise ValueError(f"model: permute in {sorted(schemes)}, contrasts in "
                              f"{sorted(codings)}, ss_type in 1, 2, 3")
         keep = [_c(formula), _c(gpa), _c(where), _c(block), _c(pairwise), _c(edges), _c(name),
-                self._command("model")]
+                self._command("model"), _c(reference), _c(slopes), _c(at), _c(null)]
         o = ffi.new("es_study_model_opts *")
         lib.es_study_model_opts_init(o)
         (o.formula, o.gpa, o.where, o.block, o.pairwise, o.edge_term, o.name,
-         o.command) = keep
+         o.command, o.reference, o.slopes, o.at, o.null_formula) = keep
+        errs = A.CStrings([f"{t}={e}" for t, e in (errors or {}).items()])
+        o.errors, o.nerrors = errs.ptr, len(errs)
         o.ss_type, o.scheme, o.contrasts = ss_type, schemes[permute], codings[contrasts]
         o.permutations = A.index(permutations, "permutations")
         o.edge_permutations = A.index(edge_permutations, "edge_permutations")
@@ -746,17 +834,33 @@ class Store:
             self.commit()
         m, d = r.model, r.design
         T, q, P, N = int(m.nterms), int(m.ncoef), int(m.p), int(r.nrows)
+        text = ffi.new("char **")
+        self.ctx.call(lib.es_study_model_summary, r, text)
+        summary = A.string(text[0])
+        lib.es_free(self.ctx.ptr, text[0])
+        terms = [A.string(d.terms[j]) for j in range(T)]
         res = ModelResult(
-            terms=[A.string(d.terms[j]) for j in range(T)],
+            terms=terms, summary=summary,
+            error=["Residual" if m.error[j] < 0 else terms[m.error[j]] for j in range(T)],
+            dropped={A.string(d.dropped[k]): A.string(d.dropped_why[k])
+                     for k in range(int(d.ndropped))},
             df=A.view(m.df, (T,), r, "i8"), ss=A.view(m.ss, (T,), r), ms=A.view(m.ms, (T,), r),
             r2=A.view(m.r2, (T,), r), f=A.view(m.f, (T,), r), p=A.view(m.pval, (T,), r),
+            z=A.view(m.z, (T,), r),
             df_resid=int(m.df_resid), rss=m.rss, tss=m.tss,
             coef_names=[A.string(d.colnames[c]) for c in range(q)],
             coef=A.view(m.coef, (P, q), r).T, coef_weights=A.view(m.coef_weights, (q, N), r),
             mean=A.view(m.mean, (P,), r), rows=A.view(r.rows, (N,), r, "i8"))
         if r.edge_f != ffi.NULL:
-            res.edge_f, res.edge_p, res.edge_q = (A.view(v, (P,), r)
+            K = int(r.ntests)
+            res.edge_f, res.edge_p, res.edge_q = (A.view(v, (K,), r)
                                                   for v in (r.edge_f, r.edge_p, r.edge_q))
+        if r.pairwise != ffi.NULL:
+            res.pairwise = _pairwise(r.pairwise, d, r)
+        if r.comparison != ffi.NULL:
+            c = r.comparison
+            res.comparison = {"null": null, "df": int(c.df), "ss": c.ss, "ms": c.ms, "r2": c.r2,
+                              "f": c.f, "z": c.z, "p": c.pval}
         if r.cac != ffi.NULL:
             res.cac, res.cac_scores = A.view(r.cac, (P,), r), A.view(r.cac_scores, (N,), r)
         return res
@@ -801,3 +905,23 @@ class Store:
             return "<edgespace.Store (closed)>"
         return (f"<edgespace.Store {self.path!r} {self.topology_kind} N={self.nrows} "
                 f"V={self.nverts} E={self.nedges}>")
+
+
+def _pairwise(pw, d, owner):
+    """A PairwiseResult viewing es_model_pairwise pw (owned by owner)."""
+    L, P, N, V = int(pw.nlevels), int(pw.p), int(pw.n), int(pw.nvars)
+    deg = 180.0 / np.pi
+    out = PairwiseResult(
+        levels=[A.string(pw.levels[k]) for k in range(L)], slopes=bool(pw.slopes),
+        confidence=pw.confidence, lsmeans=A.view(pw.lsmeans, (P, L), owner).T,
+        weights=A.view(pw.weights, (L, N), owner),
+        at={A.string(d.vars[v]): pw.at[v] for v in range(V) if not np.isnan(pw.at[v])})
+    for k, ptr in (("d", pw.dist), ("p", pw.pval), ("z", pw.z), ("ucl", pw.ucl)):
+        setattr(out, k, A.view(ptr, (L, L), owner))
+    if pw.slopes:
+        for k in ("vcor", "angle_p", "angle_z", "dlength", "dlength_p", "dlength_z",
+                  "dlength_ucl"):
+            setattr(out, "r" if k == "vcor" else k, A.view(getattr(pw, k), (L, L), owner))
+        out.angle = A.view(pw.angle, (L, L), owner) * deg
+        out.angle_ucl = A.view(pw.angle_ucl, (L, L), owner) * deg
+    return out

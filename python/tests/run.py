@@ -28,6 +28,9 @@ GROUPS = {
     "optional": {"tqdm": "python3-tqdm", "pandas": "python3-pandas"},
     # executing notebooks-py/*.ipynb with Debian's python3 as the kernel
     "notebooks": {"nbconvert": "jupyter-nbconvert", "ipykernel": "python3-ipykernel"},
+    # oracles: SciPy's fmin_l_bfgs_b, the minimizer of the published pipeline
+    # (test_paper_oracle.py; skipped without it, and --check fails)
+    "oracle": {"scipy": "python3-scipy"},
 }
 PROGRAMS = {"notebooks": {"jupyter-nbconvert": "jupyter-nbconvert"}}
 

@@ -183,7 +183,7 @@ def test_model(store_path, cli_copy, tmp_path, cli, ctx):
             assert int(row[1]) == m.df[j]
             for col, v in zip(row[2:6], (m.ss[j], m.ms[j], m.r2[j], m.f[j])):
                 assert float(col) == v                              # bit for bit
-        assert float(body[0][6]) == m.p[0] and np.isnan(m.p[1])    # the block: untestable
+        assert float(body[0][7]) == m.p[0] and np.isnan(m.p[1])    # the block: untestable
         L, expr = s.lengths(), s.label("expression")
         grand = L.mean(axis=0)
         ss = sum((expr == g).sum() * ((L[expr == g].mean(axis=0) - grand) ** 2).sum()
@@ -200,3 +200,38 @@ def test_model(store_path, cli_copy, tmp_path, cli, ctx):
             s.model("~ mood", permutations=0)
         with pytest.raises(ValueError):
             s.model("~ expression", permute="shuffle")
+
+
+def test_model_pairwise_z(store_path, cli_copy, tmp_path, cli, ctx):
+    """Z and the pairwise table as `edgespace model -o` writes them, bit for
+    bit; the LS means from their row weights (numpy); the summary; the
+    aliased copy left out with a warning; the comparison with a null model."""
+    cli("model", cli_copy, "~ expression + subject", "--block", "subject", "-p", "49",
+        "--pairwise", "expression", "--reference", "neutral", "--no-store",
+        "--csv", tmp_path / "a.csv")
+    head, body = table(tmp_path / "a.csv")
+    phead, pbody = table(tmp_path / "a.pairwise.csv")
+    with es.Store(store_path, write=True, ctx=ctx) as s:
+        m = s.model("~ expression + subject", block="subject", permutations=49,
+                    pairwise="expression", reference="neutral")
+        assert head[6] == "z" and float(body[0][6]) == m.z[0] and np.isnan(m.z[1])
+        assert m.error == ["Residual", "Residual"] and m.dropped == {}
+        assert m.coef_names[1].startswith("expression=") and "neutral" not in m.coef_names[1]
+        pw = m.pairwise
+        assert phead == ["level_a", "level_b", "d", "ucl", "z", "p"] and not pw.slopes
+        t = pw.table()
+        for row, (a, b) in zip(pbody, [(0, 1), (0, 2), (1, 2)]):
+            assert row[:2] == [pw.levels[a], pw.levels[b]]
+            assert [float(v) for v in row[2:]] == [pw.d[a, b], pw.ucl[a, b], pw.z[a, b],
+                                                   pw.p[a, b]]
+        assert len(t["d"]) == 3
+        L = s.lengths()[m.rows]
+        assert np.allclose(pw.weights @ L, pw.lsmeans, rtol=0, atol=1e-12)   # numpy
+        assert np.isclose(pw.d[0, 1], np.linalg.norm(pw.lsmeans[0] - pw.lsmeans[1]), rtol=1e-10)
+        assert "pairwise distances of LS means" in m.summary and "expression" in m.summary
+        with pytest.warns(es.EdgespaceWarning, match="'factor.expression.' duplicates"):
+            c = s.model("~ expression + factor(expression)", permutations=0)
+        assert c.terms == ["expression"] and c.dropped == {
+            "factor(expression)": "duplicates 'expression'"}
+        n = s.model("~ expression + subject", permutations=19, null="~ subject")
+        assert n.comparison["df"] == 2 and n.comparison["f"] > 1

@@ -8,7 +8,9 @@ use (issue 25), each case a finding of the audit:
   freed the store under pca(): heap-use-after-free), and from a callback of
   that call is refused;
 - one Embedder shared by two and four threads: the solves take turns and
-  agree with one thread's (they hung in CHOLMOD, or segfaulted);
+  agree with one thread's (they hung in CHOLMOD, or segfaulted); the same
+  for an embedding session (Store.embedder()), whose close() from another
+  thread waits for the running embedding;
 - NUL inside a string argument is refused (it cut the string short), and a
   float where an index or count belongs (it was truncated);
 - an exception in a progress callback cancels the work: it is raised, and
@@ -139,6 +141,51 @@ def test_shared_embedder_takes_turns(store_path, nthreads):
     assert not errors and not any(t.is_alive() for t in ts), errors
     for i in range(nthreads):
         assert np.array_equal(got[i], want[i])
+
+
+def test_shared_session_takes_turns_and_close_waits(store_path):
+    ctx = es.Context(progress=None)
+    s = es.Store(store_path, ctx=ctx)
+    se = s.embedder(cache=False)
+    a, b = s.ids[0], s.ids[1]
+    points = ["mean", f"row:{a}", f"lerp(row:{a}, row:{b}, 0.5)"]
+    want = [se.embed(p, warm=False).V for p in points]
+    got, errors = [None] * len(points), []
+    barrier = threading.Barrier(len(points))
+
+    def work(i):
+        try:
+            barrier.wait()
+            for _ in range(2):
+                got[i] = se.embed(points[i], warm=False).V
+        except BaseException as e:   # noqa: B036
+            errors.append(e)
+    ts = [threading.Thread(target=work, args=(i,)) for i in range(len(points))]
+    for t in ts:
+        t.start()
+    for t in ts:
+        t.join(120)
+    assert not errors and not any(t.is_alive() for t in ts), errors
+    for i in range(len(points)):
+        assert np.array_equal(got[i], want[i])
+    # a close from another thread while an embedding runs waits for it
+    started, done = threading.Event(), []
+    ctx.progress = lambda what, d, t: started.set()
+
+    def one():
+        try:
+            done.append(se.embed(points[1], warm=False).V)
+        except BaseException as e:   # noqa: B036
+            errors.append(e)
+    t = threading.Thread(target=one)
+    t.start()
+    assert started.wait(30)
+    s.close()                       # closes the session too, after the embedding
+    t.join(60)
+    assert not t.is_alive() and not errors, errors
+    assert len(done) == 1 and np.array_equal(done[0], want[1])
+    with pytest.raises(ValueError, match="closed"):
+        se.embed("mean")
 
 
 # ---- strings and indices -------------------------------------------------------------

@@ -4,8 +4,9 @@
  * measured in the oracle README, misses both on all four pairs), both for
  * es_interp_embed and for the study's walk near the data's prior
  * (es_study_interp); there embed of lerp(row:a, row:b, 0.5) must give the
- * walk's frame at t = 0.5 exactly, and on closed meshes (rigid for their
- * lengths) the prior's walk must agree with es_interp_embed. Suite slow.
+ * cold walk's frame at t = 0.5 exactly (the warm walk's within 1e-3 of the
+ * diagonal), and on closed meshes (rigid for their lengths) the prior's
+ * walk must agree with es_interp_embed. Suite slow.
  */
 #include "es_test.h"
 #include "es_test_files.h"
@@ -49,6 +50,7 @@ static void study_walk(es_ctx *ctx, const char *dir, const char *pa, const char 
     es_study_interp_opts_init(&wo);
     wo.from = from, wo.to = to, wo.steps = 3, wo.output = pat;
     wo.frame = keep_middle, wo.userdata = &rep;
+    wo.cold = 1;   /* every frame from its own prior: embed's start (warm below) */
     ES_CHECK_OK(ctx, es_study_interp(ctx, s, &wo));
     fprintf(stderr, "%s walk near the prior, t=0.5: rms %.3f%%, max %.2f%%, bending %.3f x the "
             "prior's\n", dir, 100 * rep.rms_ratio, 100 * rep.max_rel, rep.bend_ratio);
@@ -77,6 +79,19 @@ static void study_walk(es_ctx *ctx, const char *dir, const char *pa, const char 
             ES_CHECK_MSG(rms <= 1e-3 * diag, "%s: %g x diag from es_interp_embed", dir, rms / diag);
             free(c);
         }
+    }
+    /* warm (the default): each frame from the last one's correction, within
+     * the solver's tolerance of the cold frame */
+    if (walk && nb == nv) {
+        double *cold = walk, *warm = NULL, ss = 0, diag = es_bbox_diagonal(nv, walk);
+        wo.cold = 0;
+        ES_CHECK_OK(ctx, es_study_interp(ctx, s, &wo));
+        warm = es_test_obj_positions(mid, &nb);
+        for (int64_t i = 0; warm && i < 3 * nv; i++) ss += (warm[i] - cold[i]) * (warm[i] - cold[i]);
+        fprintf(stderr, "%s warm walk's middle frame %.3g x diag from the cold one\n", dir,
+                sqrt(ss / (double)nv) / diag);
+        ES_CHECK(warm && sqrt(ss / (double)nv) <= 1e-3 * diag);
+        free(warm);
     }
     free(walk), free(pt);
     es_store_close(s);

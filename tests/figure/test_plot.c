@@ -249,6 +249,35 @@ static void test_lines(es_ctx *ctx)
     ES_CHECK(info.n_skipped == 1 && info.logy);
     ES_CHECK(info.ymin <= 5e-5 && info.ymax >= 4.2e-3);
     ES_CHECK_OK(ctx, es_plot_lines(ctx, &s, tp_path("plot", "lines_log.png"), NULL));
+    /* a series of dots only (points_only): its points drawn, nothing between
+     * them; the curve beside it still a line */
+    {
+        static const int dots[2] = {1, 0};
+        double xd[2] = {0.2, 0.8}, yd[2] = {2e-3, 2e-3};
+        es_series sd[2] = {{"examples", 2, xd, yd}, {"path", N, t, mx}};
+        s.logy = 0;
+        s.markers = 0;
+        s.series = sd;
+        s.points_only = dots;
+        png = tp_path("plot", "lines_dots.png");
+        ES_CHECK_OK(ctx, es_plot_lines(ctx, &s, png, &info));
+        ES_CHECK(tp_load(png, &im) == 0);
+        if (im.s) {
+            double px, py, rgb[3], want[3];
+            es_palette_rgb(0, want);
+            es_plot_info_to_device(&info, xd[0], yd[0], &px, &py);
+            tp_rgb(&im, (int)floor(px), (int)floor(py), rgb);
+            ES_CHECK_MSG(tp_dist(rgb, want) < 0.15, "no dot at the first example");
+            es_plot_info_to_device(&info, 0.5, yd[0], &px, &py);   /* between the dots */
+            tp_rgb(&im, (int)floor(px), (int)floor(py), rgb);
+            ES_CHECK_MSG(tp_dist(rgb, want) > 0.3, "a line between the dots");
+            es_palette_rgb(1, want);
+            es_plot_info_to_device(&info, t[N / 2], mx[N / 2], &px, &py);
+            tp_rgb(&im, (int)floor(px), (int)floor(py), rgb);
+            ES_CHECK(tp_dist(rgb, want) < 0.15);
+            tp_free(&im);
+        }
+    }
 }
 
 /* Long curves: time linear in the points (one cairo path for a whole zig-zag

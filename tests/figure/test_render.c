@@ -139,6 +139,20 @@ static void test_square(es_ctx *ctx)
             ES_CHECK_CLOSE(front[k], fmin(1, spec.base_rgb[k] + 0.12), 0, 2.5 / 255);
         tp_free(&im);
     }
+    /* the mesh's own colour (es_render_mesh.rgb) instead of the spec's */
+    {
+        static const double blue[3] = {0.25, 0.4, 0.7};
+        double own[3];
+        it.rgb = blue;
+        ES_CHECK_OK(ctx, es_render(ctx, &spec, png, &rep));
+        ES_CHECK(tp_load(png, &im) == 0);
+        if (im.s) {
+            tp_rgb(&im, 150, 100, own);
+            for (int k = 0; k < 3; k++) ES_CHECK_CLOSE(own[k], blue[k] + 0.12, 0, 2.5 / 255);
+            tp_free(&im);
+        }
+        it.rgb = NULL;
+    }
     /* from behind: drawn darker, or culled */
     spec.has_view = 1;
     spec.view[0] = 0, spec.view[1] = 0, spec.view[2] = 1;

@@ -242,8 +242,20 @@ int main(void)
                                            0, NULL, &vec, NULL, NULL),
                        ES_EINVAL, "model 'pm' is in procrustes space");
     }
+    /* per-landmark tests in Procrustes space: a vertex's 3 coordinates together */
     o.edge_term = "expression";
-    ES_CHECK_FAILS(ctx, es_study_model(ctx, s, &o, &r), ES_EINVAL, "need edge-length space");
+    o.formula = "~ expression + subject";
+    o.name = NULL;
+    ES_CHECK_OK(ctx, es_study_model(ctx, s, &o, &r));
+    if (r) {
+        int64_t sig = 0;
+        ES_CHECK(r->ntests == es_store_nverts(s));
+        for (int64_t k = 0; k < r->ntests; k++) sig += r->edge_q[k] < 0.05;
+        ES_CHECK_MSG(sig > 0, "no vertex moves with expression (%lld of %lld; f %g p %g q %g)", (long long)sig,
+                     (long long)r->ntests, r->edge_f[0], r->edge_p[0], r->edge_q[0]);
+    }
+    es_study_model_free(r);
+    r = NULL;
     o.edge_term = NULL;
     o.gpa = "nope";
     ES_CHECK_FAILS(ctx, es_study_model(ctx, s, &o, &r), ES_ENOTFOUND, "no GPA result 'nope'");

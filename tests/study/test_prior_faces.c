@@ -182,7 +182,24 @@ static void evaluate(es_ctx *ctx, const char *store, int64_t nheld, char **held,
                     100 * r.max_rel, r.bend_ratio,
                     r.n_bad_faces ? " (not realizable: lengths break the triangle inequality)"
                                   : "");
-            if (r.n_bad_faces) continue;
+            if (r.n_bad_faces) {
+                /* no mesh has these lengths: the data's bending decides where they
+                 * cannot be met (es_embed_opts.realize_bend), and the report says
+                 * how far the lengths had to be moved to form triangles. The
+                 * vertex blend itself misses such lengths by far more than the
+                 * output does (its start RMS ratio is printed), so the distance
+                 * from it is held to what was measured (0.36 % on face-study
+                 * mean + 2 sd on PC 1), not to the realizable points' bound */
+                fprintf(stderr, "  the vertex blend's own length RMS %.3f %%; %lld lengths moved "
+                        "to form triangles, by at most %.3g %%\n", 100 * r.rms_ratio_linear,
+                        (long long)r.n_projected, 100 * r.projection_max);
+                ES_CHECK_MSG(r.bend_ratio <= b->bend, "c (not realizable): %s bending %.4f > %.3f",
+                             point, r.bend_ratio, b->bend);
+                ES_CHECK_MSG(r.n_projected > 0 && r.prior_rms <= 2 * b->c_dist,
+                             "c (not realizable): %s %.4f %% from the vertex blend", point,
+                             100 * r.prior_rms);
+                continue;
+            }
             ES_CHECK_MSG(r.prior_rms <= b->c_dist, "c: %s %.4f %% > %.3f %%", point,
                          100 * r.prior_rms, 100 * b->c_dist);
             check_realized("c", &r, b);

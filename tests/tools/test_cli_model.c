@@ -88,13 +88,14 @@ int main(void)
     if (!es_test_edgespace()) ES_TEST_SKIP("EDGESPACE not set");
     static es_test_out r, r2;
     char dir[512], faces[600], store[600], manifest[700], anova[600], lengths[600], fig[600],
-        var[600];
+        var[600], pairwise_csv[600];
     snprintf(dir, sizeof dir, "%s/test-cli-model", ES_BUILD_ROOT);
     mkdir(dir, 0777);
     snprintf(faces, sizeof faces, "%s/faces", dir);
     snprintf(store, sizeof store, "%s/faces.h5", dir);
     snprintf(manifest, sizeof manifest, "%s/manifest.csv", faces);
     snprintf(anova, sizeof anova, "%s/anova.csv", dir);
+    snprintf(pairwise_csv, sizeof pairwise_csv, "%s/anova.pairwise.csv", dir);
     snprintf(lengths, sizeof lengths, "%s/lengths.csv", dir);
     snprintf(fig, sizeof fig, "%s/edges.png", dir);
     snprintf(var, sizeof var, "%s/variation.png", dir);
@@ -182,7 +183,7 @@ int main(void)
            "--pairwise", "expression", "--edges", "expression", "-n", "m", "-o", anova,
            ES_HAVE_FIGURES ? "--figure" : "--seed", ES_HAVE_FIGURES ? fig : "7");
     ES_CHECK_MSG(r.status == 0 && strstr(r.out, "(block)") &&
-                 strstr(r.out, "stored as /analysis/model/m") &&
+                 strstr(r.out, "stored as /analysis/model/m") && strstr(r.out, "pairwise table: ") &&
                  strstr(r.out, "edges with FDR q < 0.05"), "%s%s", r.out, r.err);
     es_ctx *ctx = NULL;
     if (es_ctx_new(&ctx) != ES_OK) return 1;
@@ -199,8 +200,10 @@ int main(void)
     ES_CHECK_CLOSE(csv_value(&ta, "expression", 5), (ss[0] / (X - 1)) / (ss[2] / df_res), 1e-9,
                    0);
     /* p of 99 permutations: at its floor 1/100 for this strong an effect */
-    ES_CHECK_CLOSE(csv_value(&ta, "expression", 6), 0.01, 1e-12, 0);
-    ES_CHECK(isnan(csv_value(&ta, "subject", 6)));
+    ES_CHECK_CLOSE(csv_value(&ta, "expression", 7), 0.01, 1e-12, 0);
+    ES_CHECK(isnan(csv_value(&ta, "subject", 7)) && isnan(csv_value(&ta, "subject", 6)));
+    /* the effect size of so strong an effect is far out in its distribution */
+    ES_CHECK_MSG(csv_value(&ta, "expression", 6) > 2, "Z %g", csv_value(&ta, "expression", 6));
     es__csv_table_clear(ctx, &ta);
     es__csv_table_clear(ctx, &tl);
 
@@ -212,8 +215,12 @@ int main(void)
     ES_CHECK_MSG(r.status == 0 && want && !strcmp(r.out, want), "%s%s", r.out, r.err);
     es__free(ctx, want);
     ES_RUN(&r, dir, "export", store, "--result", "model/m", "--table", "pairwise", "--csv", "-");
-    ES_CHECK_MSG(r.status == 0 && strstr(r.out, "level_a,level_b,distance,p\n") &&
+    ES_CHECK_MSG(r.status == 0 && strstr(r.out, "level_a,level_b,d,ucl,z,p\n") &&
                  strstr(r.out, "happy,neutral,"), "%s%s", r.out, r.err);
+    /* ... and equals the pairwise table -o wrote beside the ANOVA table */
+    ES_CHECK_OK(ctx, es__read_file(ctx, pairwise_csv, ES__READ_TEXT, &want, &wn));
+    ES_CHECK_MSG(want && !strcmp(r.out, want), "%s", r.out);
+    es__free(ctx, want);
     ES_RUN(&r, dir, "export", store, "--result", "model/m", "--table", "attributes", "--csv", "-");
     ES_CHECK(r.status == 0 && strstr(r.out, "formula,~ expression + subject\n") &&
              strstr(r.out, "block,subject\n"));

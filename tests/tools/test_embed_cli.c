@@ -46,9 +46,10 @@ static void check_frames_do_not_jump(const char *dir, const char *stem, int widt
 static void check_methods(const char *dir, const char *store)
 {
     static es_test_out r;
-    static const char *const methods[] = {"multiscale", "shape-space", "data-driven"};
+    static const char *const methods[] = {"multiscale", "shape-space", "data-driven", "paper",
+                                          "data-driven-el"};
     char pat[4400], p[4400], name[64], buf[256];
-    for (int m = 0; m < 3; m++) {
+    for (int m = 0; m < 5; m++) {
         snprintf(pat, sizeof pat, "%s/m%d_%%02d.obj", dir, m);
         snprintf(name, sizeof name, "m%d", m);
         ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-1", "--steps",
@@ -75,12 +76,129 @@ static void check_methods(const char *dir, const char *store)
         es_store_close(s);
         es_ctx_free(ctx);
     }
+    /* --seed and --tries: the same seed gives the same frames, byte for byte;
+     * another seed with one hierarchy other frames */
+    {
+        char f[3][4400];
+        for (int k = 0; k < 3; k++) {
+            snprintf(f[k], sizeof f[k], "%s/seed%d.obj", dir, k);
+            ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-2",
+                   "--steps", "1", "--t0", "0.5", "--method", "multiscale", "--seed",
+                   k == 2 ? "8" : "7", "--tries", "1", "-o", f[k], "--no-store");
+            ES_CHECK_MSG(r.status == 0, "--seed: %d %s", r.status, r.err);
+        }
+        size_t n0 = 0, n1 = 0, n2 = 0;
+        char *b0 = es_test_slurp(f[0], &n0), *b1 = es_test_slurp(f[1], &n1);
+        char *b2 = es_test_slurp(f[2], &n2);
+        ES_CHECK(b0 && b1 && b2 && n0 == n1 && memcmp(b0, b1, n0) == 0);
+        ES_CHECK(b0 && b2 && (n0 != n2 || memcmp(b0, b2, n0) != 0));
+        free(b0), free(b1), free(b2);
+        ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-2", "--method",
+               "multiscale", "--tries", "0", "-o", f[0]);
+        ES_CHECK_MSG(r.status == 2 && strstr(r.err, "--tries"), "%d %s", r.status, r.err);
+        /* data-driven's K and sigma: taken (recorded in the stored parameters), bad
+         * values refused */
+        snprintf(pat, sizeof pat, "%s/dd_%%d.obj", dir);
+        ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-2", "--method",
+               "data-driven", "--knn", "1", "--sigma", "0.5", "--steps", "3", "-o", pat,
+               "--name", "ddk");
+        ES_CHECK_MSG(r.status == 0, "--knn 1 --sigma 0.5: %d %s", r.status, r.err);
+        {
+            es_ctx *c2 = NULL;
+            es_store *st = NULL;
+            ES_CHECK(es_ctx_new(&c2) == ES_OK);
+            if (c2) ES_CHECK_OK(c2, es_store_open(c2, store, ES_STORE_READ, &st));
+            if (st) {
+                char par[1024];
+                ES_CHECK_OK(c2, es_store_get_attr(c2, st, "embed/ddk_01", "params", par,
+                                                  sizeof par));
+                ES_CHECK_MSG(strstr(par, "knn=1;") && strstr(par, "sigma=0.5"), "%s", par);
+            }
+            es_store_close(st);
+            es_ctx_free(c2);
+        }
+        ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-2", "--method",
+               "data-driven", "--sigma", "0", "-o", pat);
+        ES_CHECK_MSG(r.status == 2 && strstr(r.err, "--sigma"), "%d %s", r.status, r.err);
+    }
     ES_RUN(&r, dir, "interp", store, "--from", "row:mesh-0", "--to", "row:mesh-1", "--method",
            "sideways", "-o", pat);
     ES_CHECK_MSG(r.status == 2 && strstr(r.err, "known: edge-length"), "%d %s", r.status, r.err);
     ES_RUN(&r, dir, "interp", store, "--from", "mean", "--to", "row:mesh-1", "--method",
            "multiscale", "-o", pat, "--no-store");
     ES_CHECK_MSG(r.status == 1 && strstr(r.err, "row:ID"), "%d %s", r.status, r.err);
+}
+
+/* embed --paper / --method paper: the published pipeline runs its stage 1
+ * (L-BFGS) on an open mesh (two boundary loops) as on a closed one (the old
+ * --paper started from the prior's positions and ran 0 dihedral iterations
+ * there), says so, and is stored like any embedding. interp --method
+ * conformal on the same open tubes. */
+static void check_paper_conformal(const char *dir)
+{
+    static es_test_out r;
+    char tubes[4200], store[4400], man[4400], out[4400];
+    es_ctx *ctx = NULL;
+    es_synth_opts so;
+    es_synth_set set;
+    snprintf(tubes, sizeof tubes, "%s/tubes", dir);
+    snprintf(store, sizeof store, "%s/tubes.h5", dir);
+    snprintf(man, sizeof man, "%s/manifest.csv", tubes);
+    snprintf(out, sizeof out, "%s/paper.obj", dir);
+    ES_CHECK(es_ctx_new(&ctx) == ES_OK);
+    es_synth_opts_init(&so);
+    so.n = 3;
+    ES_CHECK_OK(ctx, es_synth_generate(ctx, ES_SYNTH_TUBE, &so, &set));
+    ES_CHECK_OK(ctx, es_synth_write(ctx, &set, tubes));
+    ES_RUN(&r, dir, "ingest", "-q", store, "--manifest", man);
+    ES_CHECK_MSG(r.status == 0, "ingest tubes: %s", r.err);
+    for (int k = 0; k < 2; k++) {
+        char point[512], *it;
+        snprintf(point, sizeof point, "0.5*row:%s + 0.5*row:%s", set.names[0], set.names[2]);
+        if (k)
+            ES_RUN(&r, dir, "embed", store, "--point", point, "-o", out, "--method", "paper",
+                   "--name", "p1");
+        else
+            ES_RUN(&r, dir, "embed", store, "--point", point, "-o", out, "--paper");
+        it = strstr(r.out, "stage 1 ");
+        ES_CHECK_MSG(r.status == 0 && strstr(r.out, "published pipeline") && it &&
+                         atol(it + 8) > 0 && strstr(r.out, "refinement 0"),
+                     "embed --paper on an open mesh: %d %s %s", r.status, r.out, r.err);
+    }
+    ES_RUN(&r, dir, "embed", store, "--point", "mean", "-o", out, "--method", "fast");
+    ES_CHECK_MSG(r.status == 2 && strstr(r.err, "default or paper"), "%d %s", r.status, r.err);
+    /* interp --method conformal: one row to the sphere; the open tube closed
+     * off (two apexes more in the files), the last frame realizes the
+     * factors, results stored on the store's vertices */
+    {
+        char pat[4400], row[300], p[4400], buf[64];
+        es_meshdata md = {0};
+        es_store *s = NULL;
+        snprintf(pat, sizeof pat, "%s/conf_%%d.obj", dir);
+        snprintf(row, sizeof row, "row:%s", set.names[1]);
+        ES_RUN(&r, dir, "interp", store, "--from", row, "--method", "conformal", "--steps", "3",
+               "-o", pat, "--name", "conf");
+        ES_CHECK_MSG(r.status == 0 && strstr(r.out, "k = 0.5 (conformal; 2 holes closed"),
+                     "interp --method conformal: %d %s %s", r.status, r.out, r.err);
+        snprintf(p, sizeof p, "%s/conf_2.obj", dir);
+        ES_CHECK_OK(ctx, es_meshdata_read(ctx, p, ES_FORMAT_OBJ, &md));
+        ES_CHECK(md.nverts == set.nverts + 2);
+        es_meshdata_clear(ctx, &md);
+        ES_CHECK_OK(ctx, es_store_open(ctx, store, ES_STORE_READ, &s));
+        if (s) {
+            ES_CHECK_OK(ctx, es_store_get_attr(ctx, s, "embed/conf_02", "rms_ratio", buf,
+                                               sizeof buf));
+            ES_CHECK_MSG(atof(buf) < 1e-8, "conformal k = 1: RMS ratio %s", buf);
+            ES_CHECK_OK(ctx, es_store_get_attr(ctx, s, "embed/conf_02", "init", buf, sizeof buf));
+            ES_CHECK_MSG(!strcmp(buf, "conformal"), "init %s", buf);
+        }
+        es_store_close(s);
+        ES_RUN(&r, dir, "interp", store, "--from", row, "--to", row, "--method", "conformal",
+               "-o", pat, "--no-store");
+        ES_CHECK_MSG(r.status == 1 && strstr(r.err, "--from only"), "%d %s", r.status, r.err);
+    }
+    es_synth_set_clear(ctx, &set);
+    es_ctx_free(ctx);
 }
 
 int main(void)
@@ -269,6 +387,7 @@ int main(void)
     ES_CHECK(r.status == 2 && strstr(r.err, "pattern"));
 
     check_methods(dir, store);
+    check_paper_conformal(dir);
 
     /* embed a stored row from the nearest other start, and from a given row */
     snprintf(out, sizeof out, "%s/e.obj", dir);

@@ -92,7 +92,7 @@ int main(int argc, char **argv)
     }
     gen g = {E, a, x, 12345};
     es_source src = {.nedges = E, .nrows = N, .read = gen_read, .userdata = &g};
-    es_model_column cols[3] = {{"a", a, NULL}, {"b", b, NULL}, {"x", NULL, x}};
+    es_model_column cols[3] = {{"a", a, NULL, NULL}, {"b", b, NULL, NULL}, {"x", NULL, x, NULL}};
     es_formula *f = NULL;
     es_design *d = NULL;
     es_model *m0 = NULL, *m = NULL;

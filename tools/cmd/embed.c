@@ -37,16 +37,19 @@ static const char usage[] =
     "                       scale, else the mean scale of the store)\n"
     "  -n, --name NAME      result name in the store (default: the output's base name)\n"
     "      --no-store       do not write the report into the store\n"
-    "      --bending W      weight of the prior's bending term against the lengths\n"
-    "                       (default 0.0025; 0: the prior only starts and frames it)\n"
-    "      --refine-iters N refinement iterations (default 12; more for accuracy,\n"
-    "                       0 for the linear stages only)\n"
+CLI_EMBED_HELP
     "      --residuals CSV  per vertex of the output: closure energy, mean relative\n"
     "                       edge error and, with the prior, distance from the prior's\n"
     "                       realization / bbox diagonal (header closure,edge_error\n"
     "                       [,deviation]; render MESH --scalars CSV draws the first)\n"
-    "      --paper          the published method's stages only (stage 1 always, no\n"
-    "                       refinement), for comparison\n"
+    "  -m, --method M       default (the above) or paper: the published pipeline\n"
+    "                       for comparison (L-BFGS on the closure energy from the\n"
+    "                       start's dihedrals, frames and positions by least squares,\n"
+    "                       no refinement; open meshes too)\n"
+    "      --paper          the same as --method paper\n"
+    "      --no-cache       neither read nor write STORE.es-cache (the embedder's\n"
+    "                       vertex order and the rows made ready for priors, kept\n"
+    "                       beside the store so the next command skips them)\n"
     "      --replace        replace a stored result of that name (else refused)\n"
     "      --max-memory SIZE  refuse a mesh whose embedding needs more (default: the\n"
     "                       machine's memory, or $EDGESPACE_MAX_MEMORY; e.g. 8G)\n"
@@ -61,14 +64,13 @@ int cmd_embed(int argc, char **argv)
         {"init", required_argument, NULL, 'i'},  {"scale", required_argument, NULL, 's'},
         {"name", required_argument, NULL, 'n'},  {"no-store", no_argument, NULL, 'N'},
         {"paper", no_argument, NULL, 'P'},       {"replace", no_argument, NULL, 'X'},
-        {"help", no_argument, NULL, 'h'},        {"bending", required_argument, NULL, 'B'},
-        {"refine-iters", required_argument, NULL, 'R'},
+        {"help", no_argument, NULL, 'h'},        CLI_EMBED_LONGOPTS,
         {"residuals", required_argument, NULL, 'r'}, {"pca", required_argument, NULL, 'c'},
+        {"no-cache", no_argument, NULL, 'C'},    {"method", required_argument, NULL, 'm'},
         {"max-memory", required_argument, NULL, 'M'}, {NULL, 0, NULL, 0}};
     char namebuf[256], text[1024], *cmd = NULL;
     es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
-    int c, store_it = 1;
-    int64_t iters;
+    int c, e, store_it = 1;
     uint64_t max_memory = 0;
     es_ctx *ctx;
     es_store *s = NULL;
@@ -77,7 +79,7 @@ int cmd_embed(int argc, char **argv)
     es_status rc;
     es_study_embed_opts_init(&o);
     optind = 1;
-    while ((c = getopt_long(argc, argv, "p:o:i:s:n:h", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "p:o:i:s:n:m:h", longopts, NULL)) != -1) {
         switch (c) {
         case 'p': o.point = optarg; break;
         case 'o': o.output = optarg; break;
@@ -90,29 +92,25 @@ int cmd_embed(int argc, char **argv)
             break;
         case 'n': o.name = optarg; break;
         case 'N': store_it = 0; break;
-        case 'P':   /* the published method's stages only */
-            o.embed.dihedral_mode = ES_EMBED_DIHEDRAL_ON;
-            o.embed.refine_max_iter = 0;
+        case 'P': o.paper = 1; break;
+        case 'm':
+            if (strcmp(optarg, "default") && strcmp(optarg, "paper"))
+                return cli_usage_error("embed", "--method wants default or paper");
+            o.paper = !strcmp(optarg, "paper");
             break;
-        case 'B': {
-            double mu;
-            if (cli_parse_double(optarg, &mu) || !(mu >= 0))
-                return cli_usage_error("embed", "--bending wants a weight >= 0");
-            o.embed.prior_mu = mu;
-            break;
-        }
-        case 'R':
-            if (cli_parse_i64(optarg, &iters) || iters < 0 || iters > 100000)
-                return cli_usage_error("embed", "--refine-iters wants a count >= 0");
-            o.embed.refine_max_iter = (int)iters;
-            break;
+        case 'C': o.cache = 0; break;
         case 'X': wmode = ES_STORE_REPLACE; break;
         case 'M':
             if (cli_parse_size(optarg, &max_memory))
                 return cli_usage_error("embed", "--max-memory wants a size such as 8G");
             break;
         case 'h': fputs(usage, stdout); return CLI_OK;
-        default: return cli_usage_error("embed", "bad option");
+        default:
+            if ((e = cli_embed_option("embed", c, optarg, &o.embed)) >= 0) {
+                if (e) return e;
+                break;
+            }
+            return cli_usage_error("embed", "bad option");
         }
     }
     if (optind != argc - 1) return cli_usage_error("embed", "give exactly one STORE");

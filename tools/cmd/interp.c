@@ -12,6 +12,7 @@
 
 static const char usage[] =
     "usage: edgespace interp STORE --from A --to B [--steps N] -o PATTERN\n"
+    "       edgespace interp STORE --from row:ID --method conformal -o PATTERN\n"
     "       edgespace interp STORE --weights \"0.2*row:a + 0.3*row:b + 0.5*row:c\" -o OUT\n"
     "\n"
     "Interpolate stored shapes in edge-length space (weighted mean of normalized\n"
@@ -19,10 +20,9 @@ static const char usage[] =
     "start) and embed each result as a mesh. Weights or t outside [0, 1]\n"
     "extrapolate; a walk that leaves edge-length space (a length reaches 0 or\n"
     "below) is refused, naming t and the edge, before any frame is written.\n"
-    "Between two points that are not both rows (a stored point, a mean, an\n"
-    "expression) each frame starts from the previous frame's dihedrals (the\n"
-    "first from the nearest stored row; a frame at a row end from that row's).\n"
-    "Sequences are aligned frame to frame. Reports are printed\n"
+    "Each frame is embedded near the prior of its row weights, in the store's\n"
+    "frame (as embed does), starting from the last frame's correction of its\n"
+    "prior (--cold: from its own prior). Reports are printed\n"
     "and stored under /analysis/embed/NAME_<i> (per-vertex residuals included).\n"
     "\n"
     "  -f, --from A          first shape (t = 0): row:ID, a stored point's name, or\n"
@@ -37,9 +37,13 @@ static const char usage[] =
     "                        one integer conversion, e.g. 'cat_%02d.obj' (%% for %)\n"
     "  -n, --name NAME       result name in the store (default: output base name)\n"
     "      --no-store        do not write reports into the store\n"
-    "      --bending W      weight of the prior's bending term against the lengths\n"
-    "                       (default 0.0025; 0: the prior only starts and frames it)\n"
-    "      --refine-iters N  refinement iterations per frame (default 12)\n"
+;
+
+static const char usage2[] =
+CLI_EMBED_HELP
+    "      --cold            every frame from its own prior, as embed starts the same\n"
+    "                        point (default: from the last frame's correction of its\n"
+    "                        prior, a warm start)\n"
     "      --replace         replace a stored result of that name (else refused)\n"
     "      --max-memory SIZE refuse a mesh whose embedding needs more (default: the\n"
     "                        machine's memory, or $EDGESPACE_MAX_MEMORY; e.g. 8G)\n"
@@ -48,7 +52,23 @@ static const char usage[] =
     "                        multiscale (Winkler et al. 2010), shape-space (Wuhrer\n"
     "                        et al. 2010), each frame put together by the method,\n"
     "                        in A's frame; data-driven (Gao et al. 2017): a path\n"
-    "                        through the store's rows, each frame embedded as above\n"
+    "                        through the store's rows in the paper's rotation-\n"
+    "                        invariant coordinates, each frame decoded from them;\n"
+    "                        data-driven-el: the same path in edge-length space,\n"
+    "                        each frame embedded as above;\n"
+    "                        paper: the published pipeline (embed --paper) on each\n"
+    "                        frame from the rows' averaged dihedrals; conformal\n"
+    "                        (--from row:ID only): the row mapped to the sphere by\n"
+    "                        discrete conformal factors, t = their k (an open mesh\n"
+    "                        closed off first; frame files of the closed mesh)\n"
+    "      --knn K           data-driven: neighbours per row in the path's graph (6)\n"
+    "      --sigma S         data-driven: the examples' pull falls off as exp(-d / S),\n"
+    "                        d in mean neighbour distances (default 1)\n"
+    "      --seed S          seed of the multiscale hierarchies' random seed faces\n"
+    "                        (default the library's)\n"
+    "      --tries N         multiscale: hierarchies from seeds S .. S+N-1, each frame\n"
+    "                        kept from the one of least energy (its length and\n"
+    "                        dihedral misfit; default 4, 1: one hierarchy)\n"
     "  -h, --help            show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -89,14 +109,16 @@ int cmd_interp(int argc, char **argv)
         {"t1", required_argument, NULL, '1'},   {"weights", required_argument, NULL, 'w'},
         {"output", required_argument, NULL, 'o'}, {"name", required_argument, NULL, 'n'},
         {"no-store", no_argument, NULL, 'N'},   {"replace", no_argument, NULL, 'X'},
-        {"help", no_argument, NULL, 'h'},       {"bending", required_argument, NULL, 'B'},
-        {"refine-iters", required_argument, NULL, 'R'}, {"pca", required_argument, NULL, 'c'},
-        {"method", required_argument, NULL, 'm'}, {"max-memory", required_argument, NULL, 'M'},
+        {"help", no_argument, NULL, 'h'},       CLI_EMBED_LONGOPTS,
+        {"pca", required_argument, NULL, 'c'},  {"cold", no_argument, NULL, 'C'},
+        {"method", required_argument, NULL, 'm'}, {"seed", required_argument, NULL, 'S'},
+        {"tries", required_argument, NULL, 'T'}, {"knn", required_argument, NULL, 'K'},
+        {"sigma", required_argument, NULL, 'G'}, {"max-memory", required_argument, NULL, 'M'},
         {NULL, 0, NULL, 0}};
     es_study_interp_opts o;
     es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
-    int c, store_it = 1;
-    int64_t iters;
+    int c, e, store_it = 1;
+    int64_t seed = -1, tries;
     uint64_t max_memory = 0;
     es_ctx *ctx;
     es_store *s = NULL;
@@ -125,32 +147,43 @@ int cmd_interp(int argc, char **argv)
         case 'o': o.output = optarg; break;
         case 'n': o.name = optarg; break;
         case 'N': store_it = 0; break;
-        case 'B': {
-            double mu;
-            if (cli_parse_double(optarg, &mu) || !(mu >= 0))
-                return cli_usage_error("interp", "--bending wants a weight >= 0");
-            o.embed.prior_mu = mu;
+        case 'C': o.cold = 1; break;
+        case 'S':
+            if (cli_parse_i64(optarg, &seed) || seed < 0)
+                return cli_usage_error("interp", "--seed wants an integer >= 0");
             break;
-        }
-        case 'R':
-            if (cli_parse_i64(optarg, &iters) || iters < 0 || iters > 100000)
-                return cli_usage_error("interp", "--refine-iters wants a count >= 0");
-            o.embed.refine_max_iter = (int)iters;
+        case 'T':
+            if (cli_parse_i64(optarg, &tries) || tries < 1 || tries > 64)
+                return cli_usage_error("interp", "--tries wants 1 .. 64");
+            o.multiscale.tries = (int)tries;
+            break;
+        case 'K':
+            if (cli_parse_i64(optarg, &o.path.knn) || o.path.knn < 1)
+                return cli_usage_error("interp", "--knn wants a count >= 1");
+            break;
+        case 'G':
+            if (cli_parse_double(optarg, &o.path.sigma) || !(o.path.sigma > 0))
+                return cli_usage_error("interp", "--sigma wants a positive number");
             break;
         case 'X': wmode = ES_STORE_REPLACE; break;
         case 'M':
             if (cli_parse_size(optarg, &max_memory))
                 return cli_usage_error("interp", "--max-memory wants a size such as 8G");
             break;
-        case 'h': fputs(usage, stdout); return CLI_OK;
-        default: return cli_usage_error("interp", "bad option");
+        case 'h': fputs(usage, stdout), fputs(usage2, stdout); return CLI_OK;
+        default:
+            if ((e = cli_embed_option("interp", c, optarg, &o.embed)) >= 0) {
+                if (e) return e;
+                break;
+            }
+            return cli_usage_error("interp", "bad option");
         }
     }
     if (optind != argc - 1) return cli_usage_error("interp", "give exactly one STORE");
     if (!o.output) return cli_usage_error("interp", "--output is required");
     if (o.weights && (o.from || o.to))
         return cli_usage_error("interp", "--weights excludes --from/--to");
-    if (!o.weights && (!o.from || !o.to))
+    if (!o.weights && (!o.from || (!o.to && !(method && !strcmp(method, "conformal")))))
         return cli_usage_error("interp", "give --from A --to B, or --weights");
     if (o.weights) o.steps = 1;
     char probe[4096], stored[300];
@@ -159,6 +192,7 @@ int cmd_interp(int argc, char **argv)
                                "with one integer conversion, like 'out_%%02d.obj'");
     if (!(ctx = cli_ctx_new("interp"))) return CLI_FAIL;
     if (max_memory) es_ctx_set_memory_limit(ctx, max_memory);
+    if (seed >= 0) es_ctx_set_seed(ctx, (uint64_t)seed);
     if (o.weights && !weights_are_rows(ctx, o.weights)) {
         es_ctx_free(ctx);
         return cli_usage_error("interp", "--weights wants 'w1*row:a + w2*row:b ...' with two "

@@ -14,12 +14,13 @@
 static const char usage[] =
     "usage: edgespace model STORE FORMULA [options]\n"
     "\n"
-    "Fit FORMULA (\"~ expression + subject\", \"~ log(size) + species * sex\") to the\n"
-    "shapes of STORE and test every term by permutation (model/<name> in\n"
-    "datasets-spec/analysis-results.md).\n"
-    "Variables are label columns: numeric when every value is a number, factor(COL)\n"
-    "to make one categorical, log(COL); size is each row's size (scale, or centroid\n"
-    "size with --gpa) unless a label column has that name.\n"
+    "Fit FORMULA (\"~ expression + subject\", \"~ log(size) * species\") to the shapes\n"
+    "of STORE and test every term by permutation, with RRPP's effect size Z\n"
+    "(model/<name> in datasets-spec/analysis-results.md). Variables are label\n"
+    "columns: numeric when every value is a number, factor(COL) to make one\n"
+    "categorical, log(COL); size is each row's size (scale, or centroid size with\n"
+    "--gpa) unless a label column has that name. A term that duplicates earlier\n"
+    "ones is left out with a warning.\n"
     "\n"
     "  -g, --gpa NAME         model the coordinates of GPA result NAME (Procrustes\n"
     "                         space) instead of the normalized edge lengths\n"
@@ -32,49 +33,34 @@ static const char usage[] =
     "                         geomorph, RRPP) or the rows themselves (raw: adonis2)\n"
     "  -p, --permutations N   permutations (999; 0: no p-values)\n"
     "      --contrasts treatment|sum   factor coding (treatment)\n"
+    "      --reference LEVELS the baseline level: LEVEL or FACTOR=LEVEL, comma-separated\n"
+    "                         (default: the first level in byte order)\n"
+    "      --error TERM=ERROR test TERM over ERROR's mean square (nested designs,\n"
+    "                         e.g. population=population:colony); repeatable\n"
+    "      --null FORMULA     compare the model with this nested one (RRPP's anova)\n"
     "      --pairwise FACTOR  compare the least-squares means of FACTOR's levels\n"
+    "      --slopes VAR       with --pairwise: compare the levels' slopes on VAR\n"
+    "                         instead (\"log(size)\"; the model needs VAR * FACTOR)\n"
+    "      --at NAME=VALUE    LS means at VALUE (a number or mean) of a numeric\n"
+    "                         variable (\"log(size)=mean\", the default) or of the\n"
+    "                         column a log() reads (\"size=mean\": log of mean size)\n"
     "      --edges TERM       per-edge F of TERM with permutation p and FDR q values\n"
+    "                         (with --gpa: per landmark, its coordinates together)\n"
     "      --edge-permutations N       for --edges (default: --permutations)\n"
     "      --seed S           seed of the permutations (default: the library's)\n"
     "  -n, --name NAME        result name (default: model)\n"
     "      --no-store         leave the store unchanged\n"
     "      --replace          replace a stored result of that name (else refused)\n"
-    "  -o, --csv PATH         write the ANOVA table as CSV (- for stdout)\n"
+    "  -o, --csv PATH         write the ANOVA table as CSV (- for stdout); with\n"
+    "                         --pairwise the pairwise table goes to PATH's stem +\n"
+    "                         .pairwise.csv (after a blank line for -)\n"
     "  -f, --figure PATH      with --edges: -log10 q of every edge on the mean mesh\n"
     "  -h, --help             show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
 
-enum { O_PERMUTE = 256, O_CONTRASTS, O_PAIRWISE, O_EDGES, O_EDGE_PERM, O_SEED, O_NOSTORE };
-
-static int print_table(FILE *out, const es_study_model_result *r)
-{
-    const es_model *m = r->model;
-    fprintf(out, "%-24s %5s %14s %14s %8s %10s %8s\n", "term", "df", "SS", "MS", "R2", "F", "p");
-    for (int64_t j = 0; j < m->nterms; j++) {
-        fprintf(out, "%-24s %5lld %14.6g %14.6g %8.4f %10.4g ", r->design->terms[j],
-                (long long)m->df[j], m->ss[j], m->ms[j], m->r2[j], m->f[j]);
-        if (isnan(m->pval[j])) fprintf(out, "%8s\n", m->testable[j] ? "-" : "(block)");
-        else fprintf(out, "%8.4g\n", m->pval[j]);
-    }
-    fprintf(out, "%-24s %5lld %14.6g %14.6g %8.4f\n", "Residual", (long long)m->df_resid, m->rss,
-            m->rss / (double)m->df_resid, m->rss / m->tss);
-    fprintf(out, "%-24s %5lld %14.6g\n", "Total", (long long)(m->n - 1), m->tss);
-    if (r->pairwise) {
-        const es_model_pairwise *pw = r->pairwise;
-        fprintf(out, "pairwise distances of LS means (p):\n");
-        for (int64_t a = 0; a < pw->nlevels; a++)
-            for (int64_t b = a + 1; b < pw->nlevels; b++)
-                fprintf(out, "  %-16s %-16s %12.6g  (p %.4g)\n", pw->levels[a], pw->levels[b],
-                        pw->dist[a + b * pw->nlevels], pw->pval[a + b * pw->nlevels]);
-    }
-    if (r->edge_q) {
-        int64_t n = 0, E = m->p;
-        for (int64_t e = 0; e < E; e++) n += r->edge_q[e] < 0.05;
-        fprintf(out, "edges with FDR q < 0.05: %lld of %lld\n", (long long)n, (long long)E);
-    }
-    return 0;
-}
+enum { O_PERMUTE = 256, O_CONTRASTS, O_PAIRWISE, O_EDGES, O_EDGE_PERM, O_SEED, O_NOSTORE,
+       O_REFERENCE, O_ERROR, O_NULL, O_SLOPES, O_AT, MAX_ERRORS = 32 };
 
 int cmd_model(int argc, char **argv)
 {
@@ -90,7 +76,11 @@ int cmd_model(int argc, char **argv)
         {"seed", required_argument, NULL, O_SEED}, {"name", required_argument, NULL, 'n'},
         {"no-store", no_argument, NULL, O_NOSTORE}, {"csv", required_argument, NULL, 'o'},
         {"figure", required_argument, NULL, 'f'}, {"help", no_argument, NULL, 'h'},
-        {"replace", no_argument, NULL, 'R'}, {NULL, 0, NULL, 0}};
+        {"replace", no_argument, NULL, 'R'}, {"reference", required_argument, NULL, O_REFERENCE},
+        {"error", required_argument, NULL, O_ERROR}, {"null", required_argument, NULL, O_NULL},
+        {"slopes", required_argument, NULL, O_SLOPES}, {"at", required_argument, NULL, O_AT},
+        {NULL, 0, NULL, 0}};
+    const char *errors[MAX_ERRORS];
     es_study_model_opts o;
     es_study_model_opts_init(&o);
     const char *csv = NULL, *figure = NULL, *name = "model";
@@ -126,6 +116,14 @@ int cmd_model(int argc, char **argv)
             else return cli_usage_error("model", "--contrasts is treatment or sum");
             break;
         case O_PAIRWISE: o.pairwise = optarg; break;
+        case O_REFERENCE: o.reference = optarg; break;
+        case O_NULL: o.null_formula = optarg; break;
+        case O_SLOPES: o.slopes = optarg; break;
+        case O_AT: o.at = optarg; break;
+        case O_ERROR:
+            if (o.nerrors == MAX_ERRORS) return cli_usage_error("model", "too many --error");
+            errors[o.nerrors++] = optarg;
+            break;
         case O_EDGES: o.edge_term = optarg; break;
         case O_EDGE_PERM:
             if (cli_parse_i64(optarg, &o.edge_permutations) || o.edge_permutations < 0 ||
@@ -148,8 +146,12 @@ int cmd_model(int argc, char **argv)
     }
     if (optind != argc - 2) return cli_usage_error("model", "give a STORE and a FORMULA");
     if (figure && !o.edge_term) return cli_usage_error("model", "--figure needs --edges TERM");
+    if (figure && o.gpa) return cli_usage_error("model", "--figure draws edges: not with --gpa");
     if (figure && !ES_HAVE_FIGURES)
         return cli_usage_error("model", "this build has no figures (cairo)");
+    if ((o.slopes || o.at) && !o.pairwise)
+        return cli_usage_error("model", "--%s needs --pairwise FACTOR", o.slopes ? "slopes" : "at");
+    o.errors = errors;
     o.formula = argv[optind + 1];
     o.name = nostore ? NULL : name;
     es_ctx *ctx = cli_ctx_new("model");
@@ -167,12 +169,29 @@ int cmd_model(int argc, char **argv)
         cli_fail("model", ctx, rc);
         goto done;
     }
+    char *text = NULL;
+    if ((rc = es_study_model_summary(ctx, r, &text)) != ES_OK) {
+        cli_fail("model", ctx, rc);
+        goto done;
+    }
     FILE *out = cli_report_stream(csv);   /* "-o -": stdout is the CSV alone */
-    print_table(out, r);
+    fputs(text, out);
+    es_free(ctx, text);
     if (o.name) fprintf(out, "stored as /analysis/model/%s\n", o.name);
     ret = CLI_OK;
     if (csv && (rc = es_study_write_model_table(ctx, r, csv)) != ES_OK)
         ret = cli_fail("model", ctx, rc);
+    if (ret == CLI_OK && csv && r->pairwise) {
+        /* the pairwise table beside the ANOVA table: x.csv -> x.pairwise.csv */
+        char pw[4096];
+        const char *dot = strrchr(csv, '.'), *slash = strrchr(csv, '/');
+        int stem = dot && (!slash || dot > slash) ? (int)(dot - csv) : (int)strlen(csv);
+        snprintf(pw, sizeof pw, "%.*s.pairwise.csv", stem, csv);
+        if (!strcmp(csv, "-")) putchar('\n');
+        if ((rc = es_study_write_pairwise_table(ctx, r, strcmp(csv, "-") ? pw : "-")) != ES_OK)
+            ret = cli_fail("model", ctx, rc);
+        else if (strcmp(csv, "-")) printf("pairwise table: %s\n", pw);
+    }
 #if ES_HAVE_FIGURES
     if (ret == CLI_OK && figure) {
         if ((rc = es_figure_edge_tests(ctx, st, r, figure)) != ES_OK) ret = cli_fail("model", ctx, rc);

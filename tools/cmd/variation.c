@@ -28,6 +28,7 @@ static const char usage[] =
     "  -k, --k K              how far (2)\n"
     "      --panel PIXELS     panel width and height (360)\n"
     "      --title TEXT       title (default: automatic)\n"
+CLI_EMBED_HELP
     "  -h, --help             show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -53,12 +54,12 @@ int cmd_variation(int argc, char **argv)
         {"pcs", required_argument, NULL, 'c'}, {"coef", required_argument, NULL, O_COEF},
         {"k", required_argument, NULL, 'k'}, {"panel", required_argument, NULL, O_PANEL},
         {"title", required_argument, NULL, O_TITLE}, {"help", no_argument, NULL, 'h'},
-        {NULL, 0, NULL, 0}};
+        CLI_EMBED_LONGOPTS, {NULL, 0, NULL, 0}};
     es_figure_variation_opts o;
     es_figure_variation_opts_init(&o);
     int64_t pcs[ES_VARIATION_MAX_AXES], panel = 0;
     const char *out = NULL;
-    int c;
+    int c, e;
     optind = 1;
     while ((c = getopt_long(argc, argv, "o:P:c:k:h", lo, NULL)) != -1) {
         switch (c) {
@@ -82,7 +83,12 @@ int cmd_variation(int argc, char **argv)
             break;
         case O_TITLE: o.title = optarg; break;
         case 'h': fputs(usage, stdout); return CLI_OK;
-        default: return cli_usage_error(VERB, "bad option");
+        default:
+            if ((e = cli_embed_option(VERB, c, optarg, &o.embed)) >= 0) {
+                if (e) return e;
+                break;
+            }
+            return cli_usage_error(VERB, "bad option");
         }
     }
     if (optind != argc - 1) return cli_usage_error(VERB, "give exactly one STORE");

@@ -20,6 +20,12 @@
  * Optionally (continuation_steps > 0 with initial positions) stage 4 runs
  * along the path from the initial mesh's own lengths (which it realizes
  * exactly) to the target, warm-started step by step.
+ * From positions (es_embed_prior_solve on open meshes: the prior's
+ * realization, or a warm start) the solve is instead local-global
+ * iterations on the triangles the target lengths make, with L-BFGS on a
+ * factored V x V Laplacian (lib/embed/local_global.c), and stage 4 only
+ * finishes where they did not meet the accuracy asked for (es_embed_opts:
+ * solver, lg_*).
  *
  * Conventions are those of ../shared/oracle/embed (es_geom.h signs): the
  * angle alpha_e is the signed bending angle, alpha = 0 flat, < 0 convex;
@@ -52,6 +58,16 @@ typedef enum es_embed_dihedral_mode {
     ES_EMBED_DIHEDRAL_ON,       /* always stage 1 (the paper) */
     ES_EMBED_DIHEDRAL_OFF       /* skip stage 1: stages 2-3 from the initial dihedrals */
 } es_embed_dihedral_mode;
+
+/* The solver of a solve that starts from positions (es_embed_prior_solve on
+ * an open mesh, where the prior's realization is the start). */
+typedef enum es_embed_solver {
+    ES_EMBED_SOLVER_AUTO = 0,   /* local-global iterations (below) */
+    ES_EMBED_SOLVER_LOCAL_GLOBAL,
+    ES_EMBED_SOLVER_LM          /* Levenberg-Marquardt on the lengths with the bending
+                                   prior (the solver before the local-global one: a
+                                   3V x 3V factorization per iteration) */
+} es_embed_solver;
 
 typedef struct es_embed_opts {
     es_embed_dihedral_mode dihedral_mode;   /* default AUTO (see above) */
@@ -121,6 +137,40 @@ typedef struct es_embed_opts {
     int prior_bend_closed;    /* 1: the bending term on closed meshes too (default 0: a
                                  closed mesh is rigid for its lengths, which decide alone
                                  after the prior's start, as es_interp_embed does) */
+    /* From positions (es_embed_prior_solve on open meshes): local-global
+     * iterations on the triangles the target lengths make, with L-BFGS
+     * (lib/embed/local_global.c), each a pass over the faces and one
+     * back-substitution with a V x V factor (9.4K vertices: about 2.5 ms);
+     * where they have not met the tolerances within lg_max_iter, the
+     * Levenberg-Marquardt refinement (refine_max_iter, the prior's bending
+     * term held at its last weight) finishes until it does: a Newton step
+     * fixes the last length error with less bending than more local-global
+     * iterations would. Measured on face-study in tools/bench/bench_walk.c
+     * and tests/study/test_prior_faces.c. */
+    es_embed_solver solver;   /* default AUTO (local-global, then the polish) */
+    int lg_max_iter;          /* local-global iterations at most (default 40; exact
+                                 targets, prior_exact, twice as many) */
+    double lg_rms_tol;        /* the accuracy asked for: RMS ratio <= lg_rms_tol and max
+                                 relative error <= lg_max_tol (defaults 5e-4, 1e-2; a
+                                 third of each for an exact target) */
+    double lg_max_tol;
+    double lg_rtol;           /* local-global also stops when its energy falls by less
+                                 than this fraction per iteration over five (1e-4) */
+    int lg_history;           /* L-BFGS pairs kept (default 6) */
+    int lg_polish;            /* where the local-global iterations did not meet the
+                                 tolerances: Levenberg-Marquardt iterations at most
+                                 (and at most refine_max_iter) toward them (default 4;
+                                 0: local-global alone, es_embed_opts_fast) */
+    double realize_bend;      /* for such a target (no mesh has its lengths) the
+                                 Levenberg-Marquardt finish always runs, with the prior's
+                                 bending term held at realize_bend x prior_mu, so that the
+                                 data's bending decides where the lengths cannot be met
+                                 (default 3; 0: as for any target) */
+    double realize_margin;    /* target lengths that break the triangle inequality on a
+                                 face are replaced by the nearest lengths (relative least
+                                 squares) whose every face has its longest edge at most
+                                 1 - margin times the sum of the other two (default 0.01;
+                                 < 0: embed them as they are); the report says how far */
     int blas_threads;         /* OpenBLAS threads during the solve, the caller's setting
                                  restored after; 0 leaves it alone (default 1: the
                                  factorizations' dense blocks are small, and 2 threads
@@ -128,6 +178,10 @@ typedef struct es_embed_opts {
 } es_embed_opts;
 
 ES_API void es_embed_opts_init(es_embed_opts *opts);
+/* The defaults for a slider or a walk that must answer at once: local-global
+ * alone (no Levenberg-Marquardt finish), to an RMS ratio of 1e-3 and a max
+ * relative error of 2e-2, at most 30 iterations. */
+ES_API void es_embed_opts_fast(es_embed_opts *opts);
 
 typedef struct es_embed_report {
     double closure_before;    /* E(alpha) (eq. 3) at the initial dihedrals */
@@ -136,10 +190,16 @@ typedef struct es_embed_report {
     int64_t dihedral_iters;   /* stage 1 LM iterations (AUTO: 1 first, the rest only
                                  if that one removed 99 % of the closure energy) */
     int64_t refine_iters;     /* stage 4 LM iterations (all continuation steps) */
+    int64_t lg_iters;         /* local-global iterations (solves from positions) */
+    int64_t n_projected;      /* target lengths replaced to form triangles (realize_margin) */
+    double projection_rms;    /* RMS and largest relative change of those lengths (0 if */
+    double projection_max;    /* none): how far from the asked lengths the solve had to go */
     int64_t continuation_steps; /* steps used (0: dihedral path) */
     int used_continuation;    /* 1 if the returned result came from continuation */
     int used_stage1;          /* 1 if stage 1's dihedrals were kept (AUTO may drop them) */
     double t_dihedral, t_frames, t_positions, t_refine, t_total;   /* seconds */
+    double t_local_global;    /* of t_refine, the local-global iterations' (with their
+                                 factorization); the rest is the Levenberg-Marquardt finish */
     double rms_ratio_linear;  /* RMS ratio after stage 3, before refinement */
     double rms_ratio;         /* RMS(l_out - l_target) / mean(l_target) */
     double max_rel;           /* max_e |l_out - l_target| / l_target */
@@ -165,6 +225,17 @@ typedef struct es_embed_report {
  * fails. */
 ES_API es_status es_embedder_new(es_ctx *ctx, const es_mesh *mesh, es_embedder **out);
 ES_API void es_embedder_free(es_embedder *emb);
+
+/* The same with the fill-reducing vertex order of an earlier embedder of
+ * this topology (es_embedder_ordering, V entries: a permutation of the
+ * vertices; ES_EINVAL otherwise), so that it is not computed again: the
+ * order is the costly part of an embedder's making on large meshes (METIS
+ * from 10K vertices), and the study layer keeps it in its cache file.
+ * order NULL: as es_embedder_new. */
+ES_API es_status es_embedder_new_ordered(es_ctx *ctx, const es_mesh *mesh, const int64_t *order,
+                                         es_embedder **out);
+/* The embedder's vertex order (V entries), borrowed for its lifetime. */
+ES_API const int64_t *es_embedder_ordering(const es_embedder *emb);
 
 /* Embed target lengths. ctx receives the message of a failure (the
  * embedder's own context, from es_embedder_new, provides its memory).
@@ -288,6 +359,17 @@ ES_API es_status es_embed_prior_from_rows(es_ctx *ctx, int64_t nverts, int64_t n
                                           const double *const *alpha_rows, const double *w,
                                           double *xyz, double *alpha, double *sd);
 
+/* The same with each row's cosines and sines of its dihedrals given
+ * (cos_rows[i], sin_rows[i]: E each), which saves the trigonometry: the
+ * circular mean of 90 rows of 27,871 dihedrals took 60 ms with it, 5 ms
+ * without (es_study_rows keeps them). */
+ES_API es_status es_embed_prior_from_rows_sc(es_ctx *ctx, int64_t nverts, int64_t nedges,
+                                             int64_t n, const double *const *aligned,
+                                             const double *const *alpha_rows,
+                                             const double *const *cos_rows,
+                                             const double *const *sin_rows, const double *w,
+                                             double *xyz, double *alpha, double *sd);
+
 /* Bytes an embedder of mesh and its solves need (an estimate from the
  * mesh's edges, measured against peak memory: embed_memory.c), and the
  * check es_embedder_new makes first: ES_ERANGE naming the need when it,
@@ -300,6 +382,43 @@ ES_API es_status es_embed_check_memory(es_ctx *ctx, const es_mesh *mesh, uint64_
 /* One-line and multi-line text of a report (for commands and notebooks):
  * writes at most n bytes with NUL, returns buf. */
 ES_API const char *es_embed_report_format(const es_embed_report *rep, char *buf, size_t n);
+
+/* ---- the published pipeline, for comparison (paper.c) ------------------------
+ * edge-length-interpolation Section 2 as published: stage 1 minimizes the
+ * closure energy E(alpha) (eq. 3) by L-BFGS from the initial dihedrals (the
+ * paper: SciPy's fmin_l_bfgs_b from the inputs' averaged dihedrals; here
+ * SciPy's default settings), stages 2-3 turn the minimizer into frames and
+ * positions by least squares, and nothing follows: no refinement against
+ * the lengths, no choice whether stage 1 helps (es_embed_solve's changes).
+ * On open meshes stage 1 works on the interior vertices' closure, as on
+ * closed ones. */
+typedef struct es_embed_paper_opts {
+    int history;            /* L-BFGS correction pairs, m (10) */
+    int max_iter;           /* iterations, and evaluations of E (15000); 0: no stage 1 */
+    double factr;           /* stop when E falls by <= factr x DBL_EPSILON x max(|E|, 1)
+                               in an iteration (1e7) ... */
+    double pgtol;           /* ... or when max |dE/dalpha| <= pgtol (1e-5) */
+    es_embed_opts embed;    /* alignment and report settings of stages 2-3
+                               (es_embed_opts_init); its stage-1, refinement, prior and
+                               continuation fields are not used */
+} es_embed_paper_opts;
+
+ES_API void es_embed_paper_opts_init(es_embed_paper_opts *opts);
+
+/* Embed target lengths (E; scale as es_embed_solve) by the published
+ * pipeline from init_alpha (E, the averaged dihedrals), or from the
+ * dihedrals of init_xyz when init_alpha is NULL; the output is aligned as
+ * es_embed_solve aligns it (to init_xyz when given). The report is
+ * es_embed_solve's for stages 2-3 with stage 1's figures put in:
+ * closure_before (E at the start), closure_stage1 (E at the L-BFGS
+ * minimizer: the "error" of the paper's Table 1), dihedral_iters (L-BFGS
+ * iterations), t_dihedral, and t_total for the whole. Errors as
+ * es_embed_solve, and ES_EINVAL for settings out of range. */
+ES_API es_status es_embed_paper_solve(es_ctx *ctx, es_embedder *emb, const double *target,
+                                      double scale, const double *init_alpha,
+                                      const double *init_xyz,
+                                      const es_embed_paper_opts *opts, double *xyz,
+                                      es_embed_report *report);
 
 #ifdef __cplusplus
 }

@@ -129,6 +129,9 @@ typedef struct es_lines_spec {
     const es_series *series;    /* coloured by es_palette_rgb(index) */
     int logy;                   /* log10 y axis; values <= 0 are skipped */
     int markers;                /* draw a dot at each point (0) */
+    const int *points_only;     /* nseries flags or NULL: a series flagged 1 is drawn as
+                                   dots without a line (a scatter among curves; its legend
+                                   key a dot) */
 } es_lines_spec;
 
 ES_API void es_lines_spec_init(es_lines_spec *spec);

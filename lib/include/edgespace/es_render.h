@@ -69,6 +69,9 @@ typedef struct es_render_mesh {
      * order, e.g. es_mesh_edges()); every face edge must be in it. */
     int64_t nedges;
     const int64_t *edges;
+    const double *rgb;         /* this mesh's surface colour without scalars (3 values in
+                                  [0, 1]), or NULL: the spec's base_rgb (inputs and
+                                  interpolated frames told apart in one picture) */
 } es_render_mesh;
 
 typedef struct es_render_spec {

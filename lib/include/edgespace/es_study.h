@@ -271,7 +271,23 @@ typedef struct es_study_model_opts {
     int64_t permutations;      /* 999 */
     es_contrasts contrasts;    /* treatment */
     const char *pairwise;      /* a categorical variable: its LS means compared, or NULL */
-    const char *edge_term;     /* a term: per-edge tests with FDR (edge-length space) */
+    const char *slopes;        /* with pairwise: compare the levels' slopes on this numeric
+                                  variable ("log(size)") instead of LS means */
+    const char *at;            /* LS means at "NAME=VALUE,...": NAME a variable label
+                                  ("log(size)") or the column a log() reads ("size", VALUE
+                                  then on the column's scale); VALUE a number or "mean" (of
+                                  what NAME names). Default: every numeric variable at its
+                                  mean as the formula uses it (mean of log(size)) */
+    const char *reference;     /* baseline levels "LEVEL" or "FACTOR=LEVEL", comma-separated
+                                  (LEVEL alone: the one factor of the formula that has it) */
+    const char *const *errors; /* nerrors "TERM=ERROR": TERM's F over ERROR's mean square
+                                  (nested designs: "population=population:colony") */
+    int64_t nerrors;
+    const char *null_formula;  /* compare the model with this nested one (RRPP's anova(null,
+                                  full)), or NULL */
+    const char *edge_term;     /* a term: per-variable tests with FDR: every edge in
+                                  edge-length space, every landmark's displacement (its d
+                                  coordinates together) in Procrustes space */
     int64_t edge_permutations; /* -1: permutations */
     const char *name;          /* store as model/<name> (NULL: store nothing) */
     const char *command;       /* provenance */
@@ -285,7 +301,12 @@ typedef struct es_study_model_result {
     es_design *design;
     es_model *model;
     es_model_pairwise *pairwise;   /* with opts->pairwise, else NULL */
-    double *edge_f, *edge_p, *edge_q;   /* E each with opts->edge_term, else NULL */
+    es_formula *null_formula;      /* with opts->null_formula, else NULL: */
+    es_design *null_design;
+    es_model *null_model;
+    es_model_comparison *comparison;
+    int64_t ntests;                /* with opts->edge_term: E edges or k landmarks */
+    double *edge_f, *edge_p, *edge_q;   /* ntests each with opts->edge_term, else NULL */
     double *cac, *cac_scores;      /* p and N when log(size) is a term, else NULL */
     int64_t nrows;
     int64_t *rows;                 /* N store rows, in model order */
@@ -295,16 +316,35 @@ ES_API void es_study_model_free(es_study_model_result *r);
 
 /* Fit and test the model (es_model_fit), then what opts asks for after it,
  * and store it when opts->name is given (the store open for writing; the
- * caller commits). Errors: ES_ENOTFOUND (a label column, the GPA result),
- * ES_EINVAL (no rows, per-edge tests in Procrustes space, a store without
- * edges in edge-length space), those of es_model.h. */
+ * caller commits). Terms the design leaves out as aliased are warned about
+ * (the context's log) and listed in design->dropped. Errors: ES_ENOTFOUND
+ * (a label column, the GPA result, an error term), ES_EINVAL (no rows, a
+ * store without edges in edge-length space, pairwise or per-variable tests
+ * of a dropped term, slopes or at without pairwise, a reference that is no
+ * factor's level, a null model not nested in the model), those of
+ * es_model.h. */
 ES_API es_status es_study_model(es_ctx *ctx, es_store *store, const es_study_model_opts *opts,
                                 es_study_model_result **out);
 
-/* The analysis-of-variance table as CSV: term, df, ss, ms, r2, f, p, then
- * the rows Residual (df, ss, ms) and Total (df, ss). */
+/* The analysis-of-variance table as CSV: term, df, ss, ms, r2, f, z, p,
+ * error (the term whose MS divides, "Residual" by default), then the rows
+ * Residual (df, ss, ms) and Total (df, ss); with a null model, a row "null
+ * model: FORMULA" (df, ss, ms, r2, f, z, p of the comparison). */
 ES_API es_status es_study_write_model_table(es_ctx *ctx, const es_study_model_result *r,
                                             const char *path);
+/* The pairwise table as CSV, a row per pair of levels: level_a, level_b,
+ * d, ucl, z, p (distances of LS means or of slopes), and for slopes r
+ * (vector correlation), angle (degrees), angle_ucl, angle_z, angle_p,
+ * dlength, dlength_ucl, dlength_z, dlength_p. ES_EINVAL without pairwise. */
+ES_API es_status es_study_write_pairwise_table(es_ctx *ctx, const es_study_model_result *r,
+                                               const char *path);
+/* The fit as `edgespace model` shows it: the ANOVA table with Z (and each
+ * term's error term), the terms left out and why, the comparison with the
+ * null model, the pairwise table with the values its LS means are taken at,
+ * the count of edges or landmarks with q < 0.05. *out: text, caller frees
+ * with es_free. */
+ES_API es_status es_study_model_summary(es_ctx *ctx, const es_study_model_result *r,
+                                        char **out);
 
 /* Coefficient `coef` (a design column name, e.g. "age" or "expression=happy")
  * of stored model `model` in edge-length space: its E values (vec) and its row
@@ -355,6 +395,52 @@ ES_API void es_study_rows_free(es_study_rows *rows);
 ES_API es_status es_study_prior(es_ctx *ctx, const es_study_rows *rows, const double *w,
                                 double *xyz, double *alpha, double *sd);
 
+typedef struct es_study_embed_result {
+    es_embed_report report;
+    double scale;           /* the sum of lengths embedded at */
+    char init[512];         /* what the embedding started from, in words */
+} es_study_embed_result;
+
+/* ---- an embedding session -----------------------------------------------------
+ * What every embedding of a store's points shares, made once: the mesh, the
+ * embedder and the rows made ready for priors. With use_cache, the
+ * embedder's vertex order and the rows are kept in a file beside the store
+ * (STORE.es-cache, datasets-spec/cache-format.md) and read back by the next
+ * session while the store's rows are the same: a command in a fresh process
+ * then skips the GPA of every row and the ordering (on face-study 0.6 s of
+ * CPU). A stale or damaged cache is made again; one that cannot be written
+ * (a read-only folder) only costs the time, and the log says so. The
+ * session borrows the store (it must outlive the session) and remembers its
+ * last output: a warm embedding starts from it instead of the prior's
+ * realization (a walk's next frame, a slider's next position). One thread
+ * at a time. */
+typedef struct es_study_embedder es_study_embedder;
+ES_API es_status es_study_embedder_open(es_ctx *ctx, es_store *store, int use_cache,
+                                        es_study_embedder **out);
+ES_API void es_study_embedder_free(es_study_embedder *se);
+ES_API const es_mesh *es_study_embedder_mesh(const es_study_embedder *se);
+ES_API es_embedder *es_study_embedder_embedder(es_study_embedder *se);
+ES_API const es_study_rows *es_study_embedder_rows(const es_study_embedder *se);
+ES_API es_store *es_study_embedder_store(const es_study_embedder *se);
+/* Forget the last output: the next warm embedding starts from its prior. */
+ES_API void es_study_embedder_forget(es_study_embedder *se);
+/* Embed lengths (E, any scale; embedded at `scale`, > 0) with row weights w
+ * (N) near their prior, as es_study_embed does by default; warm: from the
+ * last output when there is one; exact: the lengths are one real mesh's
+ * (es_embed_opts.prior_exact). xyz: 3 x V, in the store's frame. res->init
+ * says what the solve started from. */
+ES_API es_status es_study_embedder_solve(es_ctx *ctx, es_study_embedder *se,
+                                         const double *lengths, double scale, const double *w, const es_embed_opts *eo,
+                                         int warm, int exact, double *xyz,
+                                         es_study_embed_result *res);
+/* The same for a point expression (datasets-spec/point-syntax.md) at its own
+ * scale (scale 0) or the one given; a point that is one row or one mesh file
+ * is solved as exact. */
+ES_API es_status es_study_embedder_point(es_ctx *ctx, es_study_embedder *se, const char *point,
+                                         const char *pca_name, double scale,
+                                         const es_embed_opts *eo, int warm, double *xyz,
+                                         es_study_embed_result *res);
+
 /* What es_study_embed does: embed one point of the store's space. */
 typedef struct es_study_embed_opts {
     const char *point;      /* as es_study_point_lengths reads it (required) */
@@ -372,15 +458,22 @@ typedef struct es_study_embed_opts {
     const char *residuals;  /* CSV of per-vertex closure and edge error, or NULL */
     const char *name;       /* store as /analysis/embed/<name> and commit (NULL: no) */
     const char *command;    /* provenance of the stored result */
+    int cache;              /* 1 (the default): the session's cache beside the store
+                               (es_study_embedder_open) */
+    es_study_embedder *session;   /* an open session of this store to use (and leave
+                               open) instead of making one: repeated calls then cost
+                               only their solves (NULL: one for this call) */
+    int warm;               /* with a session: start from its last output's correction
+                               (es_study_embedder_solve; default 0: from the prior) */
     es_embed_opts embed;    /* solver options (es_embed_opts_init) */
+    int paper;              /* 1: the published pipeline (es_embed_paper_solve, default
+                               L-BFGS settings; embed's alignment and report settings)
+                               from the same start's dihedrals: the prior's weighted
+                               circular mean of the rows' (the paper: their average), or
+                               the explicit start's (0) */
 } es_study_embed_opts;
 ES_API void es_study_embed_opts_init(es_study_embed_opts *opts);
 
-typedef struct es_study_embed_result {
-    es_embed_report report;
-    double scale;           /* the sum of lengths embedded at */
-    char init[512];         /* what the embedding started from, in words */
-} es_study_embed_result;
 
 /* Embed a point: resolve it, initialize, solve, write the mesh and the
  * residuals, store the result with its provenance. The store must be open
@@ -411,17 +504,33 @@ typedef struct es_study_interp_opts {
                                base name without the conversion) */
     const char *command;    /* provenance; NULL: store nothing */
     es_embed_opts embed;
+    int cold;               /* 1: every frame from its own prior (as es_study_embed of
+                               the same point); 0 (default): each frame from the last
+                               one's output, which is nearer (a warm start) */
     es_morph_method method; /* ES_MORPH_EDGE_LENGTH (the default: the above); the other
                                papers' (es_morph.h) walk between two rows (from and to
                                "row:ID"): multiscale and shape-space put each frame
                                together themselves (positions in row A's frame);
                                data-driven follows a path through the store's rows
-                               (es_data_path on their edge-length PCA scores, frames
-                               evenly along it, t0 and t1 0 and 1) and embeds each
-                               frame as the point of its row weights, like the
-                               default */
+                               (es_data_path on their es_lri coordinates against row
+                               A, frames evenly along it, t0 and t1 0 and 1) and
+                               decodes each frame, placed between A and B by the
+                               interpolated rigid motion; data-driven-el the same
+                               path on the rows' edge-length PCA scores, each frame
+                               embedded as the point of its row weights, like the
+                               default; paper: the published pipeline
+                               (es_embed_paper_solve) from the rows' averaged
+                               dihedrals, aligned frame to frame; conformal: row
+                               `from` alone (to NULL) mapped to the sphere, t the
+                               factors' k (es_conformal_*; an open mesh is closed
+                               off: the frame files have the closed mesh, the
+                               stored results the store's vertices and edges) */
     es_study_frame_fn frame;   /* called after each frame (may be NULL) */
     void *userdata;
+    es_multiscale_opts multiscale; /* method multiscale: its hierarchy (es_morph.h;
+                                   its seeds from the context's) */
+    es_data_path_opts path; /* methods data-driven and data-driven-el: the path's K,
+                               sigma and the rest (es_data_path_opts_init) */
 } es_study_interp_opts;
 ES_API void es_study_interp_opts_init(es_study_interp_opts *opts);
 

@@ -1,0 +1,145 @@
+/* lib/study/embed_cache.c — the per-store work of embedding kept in a file
+ * beside the store, so that a command in a fresh process does not redo it:
+ * the embedder's fill-reducing vertex order and the rows made ready for
+ * priors (GPA-aligned positions and dihedrals: on face-study, 90 rows of
+ * 9,409 vertices, 0.6 s of CPU to make, 40 MB to read back).
+ *
+ * The file (datasets-spec/cache-format.md) is STORE.es-cache: a header of
+ * little-endian 64-bit words (magic, format version, key, V, E, N) and the
+ * arrays. The key hashes what the cached values depend on: the format and
+ * algorithm version, the topology fingerprint, the sizes, and every row's id
+ * with its content hash, or, when a row has none (rows appended through the
+ * API), its stored positions. A file whose key, sizes or length disagree is
+ * stale and made again; one that cannot be written (a read-only folder)
+ * only costs the time. Written whole or not at all (es__replace_begin).
+ */
+#include "study/study_pkg.h"
+#include "core/hash.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define CACHE_MAGIC 0x3165686361437365ull   /* "esCache1" */
+#define CACHE_VERSION 1                     /* bump when the cached values change meaning */
+
+/* The cache file's path: the store's with ".es-cache" appended. */
+static void cache_path(const es_store *s, char *buf, size_t n)
+{
+    snprintf(buf, n, "%s.es-cache", es_store_path(s));
+}
+
+es_status es__study_cache_key(es_ctx *ctx, es_store *s, uint64_t *key)
+{
+    int64_t n = es_store_nrows(s), nv = es_store_nverts(s), ne = es_store_nedges(s);
+    int64_t sizes[4] = {CACHE_VERSION, nv, ne, n};
+    uint64_t h = es__fnv1a64(0xcbf29ce484222325ull, "es-cache", 8);
+    double *xyz = NULL;
+    h = es__fnv1a64_i64(h, sizes, 4);
+    h = es__fnv1a64(h, es_store_fingerprint(s), strlen(es_store_fingerprint(s)));
+    for (int64_t i = 0; i < n; i++) {
+        const char *id = es_store_row_id(s, i), *ch = es_store_content_hash(s, i);
+        h = es__fnv1a64(h, id, strlen(id) + 1);
+        if (ch && *ch) {
+            h = es__fnv1a64(h, ch, strlen(ch) + 1);
+            continue;
+        }
+        if (!xyz && !(xyz = es__alloc_array(ctx, 3 * nv, sizeof *xyz))) return ES_ENOMEM;
+        es_status rc = es_store_read_positions(ctx, s, i, xyz);
+        if (rc != ES_OK) {
+            es__free(ctx, xyz);
+            return rc;
+        }
+        h = es__fnv1a64(h, xyz, (size_t)(3 * nv) * sizeof *xyz);
+    }
+    es__free(ctx, xyz);
+    *key = h;
+    return ES_OK;
+}
+
+static int read_all(FILE *f, void *p, size_t bytes)
+{
+    return fread(p, 1, bytes, f) == bytes;
+}
+
+es_status es__study_cache_load(es_ctx *ctx, es_store *s, uint64_t key, int64_t **order,
+                               es_study_rows **rows)
+{
+    char path[4200];
+    uint64_t head[6];
+    int64_t nv = es_store_nverts(s), ne = es_store_nedges(s), n = es_store_nrows(s);
+    double *aligned = NULL, *alpha = NULL;
+    es_study_rows *r = NULL;
+    int64_t *ord = NULL;
+    FILE *f;
+    *order = NULL;
+    *rows = NULL;
+    cache_path(s, path, sizeof path);
+    if (!(f = fopen(path, "rb"))) return ES_OK;   /* no cache: made afresh */
+    if (!read_all(f, head, sizeof head) || head[0] != CACHE_MAGIC || head[1] != CACHE_VERSION ||
+        head[2] != key || (int64_t)head[3] != nv || (int64_t)head[4] != ne ||
+        (int64_t)head[5] != n) {
+        fclose(f);
+        es__info(ctx, "embed: the cache %s is stale; made again", path);
+        return ES_OK;
+    }
+    es_status rc = es__study_rows_new(ctx, n, nv, ne, &r, &aligned, &alpha);
+    if (rc == ES_OK && !(ord = es__alloc_array(ctx, nv, sizeof *ord))) rc = ES_ENOMEM;
+    if (rc == ES_OK && (!read_all(f, ord, (size_t)nv * sizeof *ord) ||
+                        !read_all(f, aligned, (size_t)(3 * nv * n) * sizeof *aligned) ||
+                        !read_all(f, alpha, (size_t)(ne * n) * sizeof *alpha))) {
+        es__info(ctx, "embed: the cache %s is cut short; made again", path);
+        es__free(ctx, ord);
+        es_study_rows_free(r);
+        ord = NULL, r = NULL;
+    }
+    fclose(f);
+    for (int64_t i = 0; r && i < 3 * nv * n; i++)
+        if (!isfinite(aligned[i])) rc = ES_EFORMAT;
+    for (int64_t i = 0; r && i < ne * n; i++)
+        if (!isfinite(alpha[i])) rc = ES_EFORMAT;
+    if (rc == ES_EFORMAT) {   /* not what this code writes: made again */
+        es__info(ctx, "embed: the cache %s holds values that are not finite; made again", path);
+        rc = ES_OK;
+        es__free(ctx, ord);
+        es_study_rows_free(r);
+        return rc;
+    }
+    if (rc != ES_OK) {
+        es__free(ctx, ord);
+        es_study_rows_free(r);
+        return rc;
+    }
+    *order = ord;
+    *rows = r;
+    return ES_OK;
+}
+
+void es__study_cache_save(es_ctx *ctx, es_store *s, uint64_t key, const int64_t *order,
+                          const es_study_rows *rows)
+{
+    char path[4200];
+    int64_t nv = es_store_nverts(s), ne = es_store_nedges(s), n = es_store_nrows(s);
+    uint64_t head[6] = {CACHE_MAGIC, CACHE_VERSION, key, (uint64_t)nv, (uint64_t)ne, (uint64_t)n};
+    const double *aligned, *alpha;
+    es__file_replace w;
+    es_ctx *quiet;
+    cache_path(s, path, sizeof path);
+    es__study_rows_arrays(rows, &aligned, &alpha);
+    /* a cache that cannot be written is no failure of the command: its
+     * message goes to a context of its own and into the log */
+    if (es_ctx_new(&quiet) != ES_OK) return;
+    es_status rc = es__replace_begin(quiet, path, &w);
+    if (rc == ES_OK) {
+        int ok = fwrite(head, sizeof head, 1, w.f) == 1 &&
+                 fwrite(order, sizeof *order, (size_t)nv, w.f) == (size_t)nv &&
+                 fwrite(aligned, sizeof *aligned, (size_t)(3 * nv * n), w.f) == (size_t)(3 * nv * n) &&
+                 fwrite(alpha, sizeof *alpha, (size_t)(ne * n), w.f) == (size_t)(ne * n);
+        rc = es__replace_end(quiet, &w, ok ? ES_OK : es__fail(quiet, ES_EIO, "cannot write %s: %s",
+                                                             path, strerror(errno)));
+    }
+    if (rc != ES_OK)
+        es__info(ctx, "embed: no cache kept (%s)", es_ctx_errmsg(quiet));
+    es_ctx_free(quiet);
+}
