@@ -244,6 +244,12 @@ class Store:
                 raise ValueError("the store is closed")
             return fn(self._ptr, *args)
 
+    def _get_str(self, fn, *args):
+        """A string the store owns, copied while the lock is held (a close
+        from another thread frees it)."""
+        with self.ctx.hold():
+            return A.string(self._get(fn, *args))
+
     def _call(self, fn, *args):
         with self.ctx.hold():
             if self._ptr is None:
@@ -308,8 +314,8 @@ class Store:
     nedges = property(lambda self: int(self._get(lib.es_store_nedges)))
     nverts = property(lambda self: int(self._get(lib.es_store_nverts)))
     nfaces = property(lambda self: int(self._get(lib.es_store_nfaces)))
-    path = property(lambda self: A.string(self._get(lib.es_store_path)))
-    fingerprint = property(lambda self: A.string(self._get(lib.es_store_fingerprint)))
+    path = property(lambda self: self._get_str(lib.es_store_path))
+    fingerprint = property(lambda self: self._get_str(lib.es_store_fingerprint))
 
     @property
     def topology_kind(self):
@@ -342,13 +348,13 @@ class Store:
     @property
     def ids(self):
         """Row ids, an array of str (N,)."""
-        return np.array([A.string(self._get(lib.es_store_row_id, i)) for i in range(self.nrows)],
+        return np.array([self._get_str(lib.es_store_row_id, i) for i in range(self.nrows)],
                         dtype=object)
 
     @property
     def columns(self):
         """Label column names."""
-        return [A.string(self._get(lib.es_store_column_name, c))
+        return [self._get_str(lib.es_store_column_name, c)
                 for c in range(self._get(lib.es_store_ncolumns))]
 
     def label(self, column):
@@ -358,7 +364,7 @@ class Store:
             from ._errors import NotFoundError
             raise NotFoundError(f"no label column '{column}' in '{self.path}'",
                                 lib.ES_ENOTFOUND)
-        return np.array([A.string(self._get(lib.es_store_label, i, c)) for i in range(self.nrows)],
+        return np.array([self._get_str(lib.es_store_label, i, c) for i in range(self.nrows)],
                         dtype=object)
 
     def labels(self):
@@ -388,10 +394,10 @@ class Store:
         return np.array(A.view(rows[0], (n[0],), A.Freed(self.ctx, rows[0]), "i8"))
 
     def source_path(self, row):
-        return A.string(self._get(lib.es_store_source_path, A.index(row, "row")))
+        return self._get_str(lib.es_store_source_path, A.index(row, "row"))
 
     def content_hash(self, row):
-        return A.string(self._get(lib.es_store_content_hash, A.index(row, "row")))
+        return self._get_str(lib.es_store_content_hash, A.index(row, "row"))
 
     # -- data -------------------------------------------------------------
     def _rows(self, rows):
