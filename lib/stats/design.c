@@ -206,10 +206,7 @@ static double code_at(const es_design *d, int64_t v, const vcode *vc, int64_t i,
 /* The level a code column names: treatment k -> level k+1, else level k. */
 static int64_t code_level(const vcode *vc, int64_t k) { return vc->coding == 0 ? k + 1 : k; }
 
-/* Maximum columns of a whole design: 1024 terms (ES_FORMULA_MAX_TERMS) of
- * many-level factors could make N x 10^8 values, and the fit's QR costs N
- * q^2 (20,000 columns of 600 rows: 10^11 flops, a few minutes). */
-#define MAX_COLUMNS 20000
+#define MAX_COLUMNS ES__DESIGN_MAX_COLUMNS
 
 /* How design term j (formula term fj) codes each of its nv variables (vars,
  * vc) and how many columns that makes (*ncol, bounded). */
@@ -245,6 +242,41 @@ static es_status term_codes(es_ctx *ctx, es_design *d, const es_formula *f, int6
     return ES_OK;
 }
 
+/* Column c of a term coded by vc over vars (N values): the product of its
+ * variables' codes, the first variable varying fastest (mixed radix); k
+ * gets each variable's code index. */
+static void term_column(const es_design *d, const vcode *vc, const int64_t *vars, int64_t nv,
+                        int64_t c, int64_t *k, double *col)
+{
+    int64_t rem = c;
+    for (int64_t a = 0; a < nv; a++) {
+        k[a] = rem % vc[a].ncol;
+        rem /= vc[a].ncol;
+    }
+    for (int64_t i = 0; i < d->n; i++) {
+        double x = 1;
+        for (int64_t a = 0; a < nv; a++) x *= code_at(d, vars[a], &vc[a], i, k[a]);
+        col[i] = x;
+    }
+}
+
+es_status es__design_term_values(es_ctx *ctx, es_design *d, const es_formula *f, int64_t fj,
+                                 const int *skip, double **buf, int64_t *cap, int64_t *ncol)
+{
+    vcode vc[64];
+    int64_t vars[64], k[64], nv;
+    es_status rc = term_codes(ctx, d, f, fj, fj, skip, vc, vars, &nv, ncol);
+    if (rc != ES_OK) return rc;
+    if (*ncol > *cap) {
+        double *nb = es__realloc(ctx, *buf, (size_t)(d->n * *ncol) * sizeof *nb);
+        if (!nb) return ES_ENOMEM;
+        *buf = nb;
+        *cap = *ncol;
+    }
+    for (int64_t c = 0; c < *ncol; c++) term_column(d, vc, vars, nv, c, k, *buf + c * d->n);
+    return ES_OK;
+}
+
 /* Term j's columns from column q0 on (the arrays hold them all). */
 static es_status fill_term_columns(es_ctx *ctx, es_design *d, const es_formula *f, int64_t j,
                                    const vcode *vc, const int64_t *vars, int64_t nv,
@@ -252,18 +284,8 @@ static es_status fill_term_columns(es_ctx *ctx, es_design *d, const es_formula *
 {
     const int64_t n = d->n;
     for (int64_t c = 0; c < ncol; c++) {
-        /* mixed radix: the first variable varies fastest */
-        int64_t k[64], rem = c;
-        for (int64_t a = 0; a < nv; a++) {
-            k[a] = rem % vc[a].ncol;
-            rem /= vc[a].ncol;
-        }
-        double *col = d->x + (q0 + c) * n;
-        for (int64_t i = 0; i < n; i++) {
-            double x = 1;
-            for (int64_t a = 0; a < nv; a++) x *= code_at(d, vars[a], &vc[a], i, k[a]);
-            col[i] = x;
-        }
+        int64_t k[64];
+        term_column(d, vc, vars, nv, c, k, d->x + (q0 + c) * n);
         size_t len = 1;
         for (int64_t a = 0; a < nv; a++) {
             len += strlen(d->vars[vars[a]]) + 2;
@@ -425,23 +447,17 @@ es_status es_design_build(es_ctx *ctx, const es_formula *f, int64_t n,
     char **why = es__calloc(ctx, (size_t)(T > 0 ? T : 1), sizeof *why);
     es_design *d = NULL;
     es_status rc = skip && why ? ES_OK : ES_ENOMEM;
-    /* Build, find the first term that adds no rank, leave it out, rebuild
-     * (its absence can change how the terms after it are coded). */
-    while (rc == ES_OK) {
-        int64_t j = -1;
-        char msg[400];
-        if ((rc = build(ctx, f, n, columns, ncolumns, contrasts, skip, &d)) != ES_OK ||
-            (rc = es__design_first_aliased(ctx, d, &j, msg, sizeof msg)) != ES_OK || j < 0)
-            break;
-        int64_t fj = 0;
-        for (int64_t k = 0; fj < T; fj++)
-            if (!skip[fj] && k++ == j) break;
-        es__warn(ctx, "model: term '%s' %s (its columns are combinations of theirs): left out",
-                 d->terms[j], msg);
-        skip[fj] = 1;
-        if (!(why[fj] = es__strdup(ctx, msg))) rc = ES_ENOMEM;
+    int any = 0;
+    /* every term's design, the terms that add no rank found from it in one
+     * pass, then the design without them (their absence can change how the
+     * terms after them are coded) */
+    if (rc == ES_OK && (rc = build(ctx, f, n, columns, ncolumns, contrasts, skip, &d)) == ES_OK &&
+        (rc = es__design_find_aliased(ctx, d, f, skip, why)) == ES_OK)
+        for (int64_t fj = 0; fj < T; fj++) any |= skip[fj];
+    if (rc == ES_OK && any) {
         es_design_free(d);
         d = NULL;
+        rc = build(ctx, f, n, columns, ncolumns, contrasts, skip, &d);
     }
     for (int64_t fj = 0; rc == ES_OK && fj < T; fj++)
         if (skip[fj]) {
