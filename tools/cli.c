@@ -110,7 +110,20 @@ es_ctx *cli_ctx_new(const char *verb)
     state.tty = isatty(STDERR_FILENO);
     es_ctx_set_log(ctx, on_log, &state);
     es_ctx_set_progress(ctx, on_progress, &state);
+    /* the memory a command may plan to use (embeddings refuse above it) */
+    const char *limit = getenv("EDGESPACE_MAX_MEMORY");
+    uint64_t bytes;
+    if (limit && *limit) {
+        if (cli_parse_size(limit, &bytes) == 0) es_ctx_set_memory_limit(ctx, bytes);
+        else fprintf(stderr, "edgespace %s: warning: EDGESPACE_MAX_MEMORY='%s' is not a size "
+                     "(like 8G); ignored\n", verb, limit);
+    }
     return ctx;
+}
+
+FILE *cli_report_stream(const char *csv)
+{
+    return csv && !strcmp(csv, "-") ? stderr : stdout;
 }
 
 int cli_fail(const char *verb, es_ctx *ctx, es_status rc)
@@ -131,19 +144,50 @@ int cli_usage_error(const char *verb, const char *fmt, ...)
     return CLI_USAGE;
 }
 
+/* An argument as a POSIX shell reads it back: as it is when it holds only
+ * characters no shell treats specially, else in single quotes with each '
+ * written '\'' (a name like "a'; touch PWNED; echo '" was stored as a
+ * command that ran touch when replayed). */
+static size_t shell_quote(char *out, const char *arg)
+{
+    static const char safe[] = "@%+=:,./-_";
+    size_t n = 0;
+    int plain = *arg != '\0';
+    for (const char *p = arg; *p && plain; p++)
+        plain = ((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') ||
+                 (*p >= '0' && *p <= '9') || strchr(safe, *p));
+    if (plain) {
+        if (out) memcpy(out, arg, strlen(arg));
+        return strlen(arg);
+    }
+    if (out) out[n] = '\'';
+    n++;
+    for (const char *p = arg; *p; p++) {
+        if (*p == '\'') {
+            if (out) memcpy(out + n, "'\\''", 4);
+            n += 4;
+        } else {
+            if (out) out[n] = *p;
+            n++;
+        }
+    }
+    if (out) out[n] = '\'';
+    return n + 1;
+}
+
 char *cli_command_line(int argc, char **argv)
 {
-    size_t n = strlen("edgespace") + 1;
-    for (int i = 0; i < argc; i++) n += strlen(argv[i]) + 3;
+    size_t n = strlen("edgespace") + 1, k;
+    for (int i = 0; i < argc; i++) n += shell_quote(NULL, argv[i]) + 1;
     char *s = malloc(n);
     if (!s) return NULL;
     strcpy(s, "edgespace");
+    k = strlen(s);
     for (int i = 0; i < argc; i++) {
-        int quote = strpbrk(argv[i], " \t\"'") != NULL || !*argv[i];
-        strcat(s, quote ? " '" : " ");
-        strcat(s, argv[i]);
-        if (quote) strcat(s, "'");
+        s[k++] = ' ';
+        k += shell_quote(s + k, argv[i]);
     }
+    s[k] = '\0';
     return s;
 }
 
@@ -154,6 +198,26 @@ int cli_parse_i64(const char *s, int64_t *out)
     long long v = strtoll(s, &end, 10);
     if (errno || end == s || *end) return -1;
     *out = v;
+    return 0;
+}
+
+int cli_parse_size(const char *s, uint64_t *out)
+{
+    char *end;
+    double v, unit = 1;
+    errno = 0;
+    v = strtod(s, &end);
+    if (errno || end == s || !isfinite(v) || v <= 0) return -1;
+    switch (*end) {
+    case 'k': case 'K': unit = 1024.0; end++; break;
+    case 'm': case 'M': unit = 1024.0 * 1024; end++; break;
+    case 'g': case 'G': unit = 1024.0 * 1024 * 1024; end++; break;
+    case 't': case 'T': unit = 1024.0 * 1024 * 1024 * 1024; end++; break;
+    default: break;
+    }
+    if ((*end == 'B' || *end == 'b') && end[1] == '\0') end++;
+    if (*end || v * unit >= 1.8e19 || v * unit < 1) return -1;
+    *out = (uint64_t)(v * unit);
     return 0;
 }
 

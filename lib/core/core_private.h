@@ -41,8 +41,13 @@ void es__info(es_ctx *ctx, const char *fmt, ...) ES__PRINTF(2, 3);
  * input order) and restore it. */
 void es__ctx_get_log(const es_ctx *ctx, es_log_fn *fn, void **userdata);
 
-/* Progress callback (no-op without one). */
-void es__progress(es_ctx *ctx, const char *what, int64_t done, int64_t total);
+/* Progress callback (no-op without one), then the cancel check: ES_ECANCELED
+ * (recorded, naming `what`) once es_ctx_cancel was called, else ES_OK. A
+ * loop stops on it and returns it; loops of no work worth stopping may
+ * ignore it, since every store write refuses while the request stands. */
+es_status es__progress(es_ctx *ctx, const char *what, int64_t done, int64_t total);
+/* The cancel check alone (ES_OK, or ES_ECANCELED recorded). */
+es_status es__cancelled(es_ctx *ctx, const char *what);
 
 /* Allocation through the context; on failure they record ES_ENOMEM with a
  * message and return NULL. es__calloc checks n * size for overflow. */
@@ -75,6 +80,28 @@ typedef struct es__file_replace {
 } es__file_replace;
 es_status es__replace_begin(es_ctx *ctx, const char *path, es__file_replace *w);
 es_status es__replace_end(es_ctx *ctx, es__file_replace *w, es_status rc);
+/* Files that appear together or not at all (the frames of a walk): each
+ * written file's end is staged (closed, its part kept) instead of renamed;
+ * commit renames them all into place, abort removes the parts. A failed
+ * write (rc) is not staged and its part is removed. */
+typedef struct es__file_set {
+    es__file_replace *w;
+    int64_t n, cap;
+} es__file_set;
+es_status es__replace_end_staged(es_ctx *ctx, es__file_replace *w, es_status rc,
+                                 es__file_set *set);
+es_status es__file_set_commit(es_ctx *ctx, es__file_set *set);
+void es__file_set_abort(es_ctx *ctx, es__file_set *set);
+void es__file_set_clear(es_ctx *ctx, es__file_set *set);
+/* The base name of a temporary sibling: base itself, or, when base plus
+ * `extra` bytes of suffix would pass NAME_MAX (255), its first 120 bytes (at
+ * a UTF-8 boundary), '~' and 16 hex digits of its FNV-1a hash: a store or
+ * output named with 230 bytes could not be written. out: NAME_MAX + 1. */
+void es__short_base(const char *base, size_t extra, char *out, size_t n);
+/* Remove the entries of path's folder named prefix, a pid, '.' or '-',
+ * ..., suffix, whose process is gone (a killed writer's part files and
+ * working copies). */
+void es__remove_stale(const char *path, const char *prefix, const char *suffix);
 char *es__strdup(es_ctx *ctx, const char *s);
 
 /* The k-th smallest (0-based) of a[0..n-1], k < n, NaN-free; reorders a

@@ -174,14 +174,29 @@ es_status es__csv_read(es_ctx *ctx, const char *what, const char *path, unsigned
     return rc;
 }
 
+/* Spreadsheets run a cell that starts with = + - @ (or a tab or carriage
+ * return before one) as a formula: a label "=cmd|' /C calc'!A0" written as
+ * it is ran a command when the CSV was opened (CSV injection, OWASP). Such a
+ * field, unless it is a number ("-1.5"), is written quoted with a leading
+ * apostrophe, which spreadsheets show as text and do not evaluate. */
+static int formula_like(const char *s)
+{
+    double v;
+    if (!strchr("=+-@\t\r", *s) || !*s) return 0;
+    return es__parse_finite(s, &v) != 0;
+}
+
 void es_csv_write_field(FILE *f, const char *s)
 {
+    int guard;
     if (!s) s = "";
-    if (!strpbrk(s, ",\"\r\n")) {
+    guard = formula_like(s);
+    if (!guard && !strpbrk(s, ",\"\r\n")) {
         fputs(s, f);
         return;
     }
     fputc('"', f);
+    if (guard) fputc('\'', f);
     for (; *s; s++) {
         if (*s == '"') fputc('"', f);
         fputc(*s, f);

@@ -8,9 +8,12 @@
 #include "core/core_private.h"
 
 #include <math.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <stdint.h>
+#include <sys/resource.h>
+#include <unistd.h>
 #ifdef __linux__
 #include <sys/mman.h>
 #endif
@@ -30,6 +33,8 @@ struct es_ctx {
     uint64_t seed;
     es_allocator alloc;
     bool has_alloc;
+    atomic_int cancel;     /* es_ctx_cancel: set from anywhere, read at progress reports */
+    uint64_t memory_limit; /* bytes, 0: the machine's */
 };
 
 const char *es_version(void) { return ES_VERSION_STRING; }
@@ -49,6 +54,7 @@ const char *es_strerror(es_status code)
     case ES_EEXIST: return "already exists";
     case ES_EMISMATCH: return "inputs do not correspond";
     case ES_ETOPOLOGY: return "not an oriented 2-manifold";
+    case ES_ECANCELED: return "cancelled";
     }
     return "unknown status";
 }
@@ -165,9 +171,48 @@ void es__info(es_ctx *ctx, const char *fmt, ...)
     va_end(ap);
 }
 
-void es__progress(es_ctx *ctx, const char *what, int64_t done, int64_t total)
+es_status es__progress(es_ctx *ctx, const char *what, int64_t done, int64_t total)
 {
     if (ctx && ctx->progress_fn) ctx->progress_fn(ctx->progress_ud, what, done, total);
+    return es__cancelled(ctx, what);
+}
+
+es_status es__cancelled(es_ctx *ctx, const char *what)
+{
+    if (!ctx || !atomic_load(&ctx->cancel)) return ES_OK;
+    ES_FAIL(ctx, ES_ECANCELED, "cancelled during %s; nothing stored", what);
+}
+
+void es_ctx_set_memory_limit(es_ctx *ctx, uint64_t bytes)
+{
+    if (ctx) ctx->memory_limit = bytes;
+}
+
+uint64_t es_ctx_memory_limit(const es_ctx *ctx)
+{
+    long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGESIZE);
+    uint64_t phys = pages > 0 && size > 0 ? (uint64_t)pages * (uint64_t)size : UINT64_MAX;
+    struct rlimit rl;
+    if (ctx && ctx->memory_limit) return ctx->memory_limit;
+    if (getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY &&
+        (uint64_t)rl.rlim_cur < phys)
+        phys = (uint64_t)rl.rlim_cur;
+    return phys;
+}
+
+void es_ctx_cancel(es_ctx *ctx)
+{
+    if (ctx) atomic_store(&ctx->cancel, 1);
+}
+
+void es_ctx_cancel_clear(es_ctx *ctx)
+{
+    if (ctx) atomic_store(&ctx->cancel, 0);
+}
+
+int es_ctx_cancelled(const es_ctx *ctx)
+{
+    return ctx && atomic_load(&((es_ctx *)ctx)->cancel);
 }
 
 void *es__malloc(es_ctx *ctx, size_t size)

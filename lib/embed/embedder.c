@@ -417,6 +417,7 @@ es_status es_embedder_new_ordered(es_ctx *ctx, const es_mesh *mesh, const int64_
     *out = NULL;
     if (!mesh) ES_FAIL(ctx, ES_EINVAL, "embed: NULL mesh");
     if (es_mesh_nfaces(mesh) <= 0) ES_FAIL(ctx, ES_EINVAL, "embed: mesh has no faces");
+    if ((rc = es_embed_check_memory(ctx, mesh, 0, NULL)) != ES_OK) return rc;
     emb = es__calloc(ctx, 1, sizeof *emb);
     if (!emb) return ES_ENOMEM;
     emb->ctx = ctx;

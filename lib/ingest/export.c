@@ -78,7 +78,7 @@ es_status es_export_lengths_csv(es_ctx *ctx, es_store *s, const int64_t *rows, i
         es_mat m = {len, E, 1, E};
         const char *id = es_store_row_id(s, list[j]);
         double sc = scales[list[j]];
-        es__progress(ctx, "exporting lengths", j, n);
+        if ((rc = es__progress(ctx, "exporting lengths", j, n))) goto done;
         if ((rc = es_store_read_lengths(ctx, s, list[j], 1, m))) goto done;
         es_csv_write_field(f, id);
         fprintf(f, ",%.17g", sc);
@@ -122,7 +122,7 @@ es_status es_export_meshes(es_ctx *ctx, es_store *s, const int64_t *rows, int64_
         const char *id = es_store_row_id(s, list[j]);
         size_t len = strlen(dir) + strlen(id) + 8;
         char *path;
-        es__progress(ctx, "exporting meshes", j, n);
+        if ((rc = es__progress(ctx, "exporting meshes", j, n))) goto done;
         if (strchr(id, '/') || !strcmp(id, ".") || !strcmp(id, "..")) {
             rc = es__fail(ctx, ES_EINVAL, "export: id '%s' cannot be a file name", id);
             goto done;

@@ -379,7 +379,7 @@ static void *work(void *arg)
         if ((rc = process_one(w, i, &buf, &cap, &md)))
             record_error(j, i, rc, es_ctx_errmsg(w->ctx));
         atomic_fetch_add(&j->done, 1);
-        if (w->main)
+        if (w->main)   /* (a cancel is seen after the block) */
             es__progress(w->main_ctx, "reading meshes", (int64_t)atomic_load(&j->done), j->ntotal);
     }
     es__free(w->ctx, buf);
@@ -548,6 +548,9 @@ static es_status ingest(es_ctx *ctx, const char *store_path, int64_t n, const in
     memset(rep, 0, sizeof *rep);
     if (!store_path || !*store_path) ES_FAIL(ctx, ES_EINVAL, "ingest: no store path");
     if (n < 1) ES_FAIL(ctx, ES_EINVAL, "ingest: no meshes to ingest");
+    if (ncols > ES_STORE_MAX_COLUMNS)   /* (the store's refusal, before any mesh is read) */
+        ES_FAIL(ctx, ES_ERANGE, "ingest: %lld label columns; a store holds at most %d",
+                (long long)ncols, ES_STORE_MAX_COLUMNS);
     exists = access(store_path, F_OK) == 0;
     created = !exists;
     if (!exists && !o->create)
@@ -669,8 +672,8 @@ static es_status ingest(es_ctx *ctx, const char *store_path, int64_t n, const in
         }
         j.nnotes = 0;
         rep->bytes_read = j.bytes_read;
-        if (rc || (rc = keep_block(ctx, store_path, &st, &r, in, b0, b1, ncols, colnames, &b,
-                                   &k, rep)))
+        if (rc || (rc = es__cancelled(ctx, "ingest")) ||
+            (rc = keep_block(ctx, store_path, &st, &r, in, b0, b1, ncols, colnames, &b, &k, rep)))
             goto done;
     }
     es__progress(ctx, "reading meshes", n, n);

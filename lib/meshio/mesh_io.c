@@ -185,9 +185,10 @@ es_status es_meshdata_read(es_ctx *ctx, const char *path, es_mesh_format format,
     return rc;
 }
 
-es_status es__meshdata_write(es_ctx *ctx, const char *path, es_mesh_format format,
-                             int64_t nverts, int64_t nfaces, const int64_t *faces,
-                             const double *xyz, const uint8_t *rgb)
+/* set: NULL to replace path at once, else staged in the set */
+static es_status meshdata_write(es_ctx *ctx, const char *path, es_mesh_format format,
+                                int64_t nverts, int64_t nfaces, const int64_t *faces,
+                                const double *xyz, const uint8_t *rgb, es__file_set *set)
 {
     es__file_replace w;
     FILE *f;
@@ -215,7 +216,22 @@ es_status es__meshdata_write(es_ctx *ctx, const char *path, es_mesh_format forma
     case ES_FORMAT_AUTO:
     default: rc = es__fail(ctx, ES_EINVAL, "'%s': unknown format %d", path, (int)format);
     }
-    return es__replace_end(ctx, &w, rc);
+    return set ? es__replace_end_staged(ctx, &w, rc, set) : es__replace_end(ctx, &w, rc);
+}
+
+es_status es__meshdata_write(es_ctx *ctx, const char *path, es_mesh_format format,
+                             int64_t nverts, int64_t nfaces, const int64_t *faces,
+                             const double *xyz, const uint8_t *rgb)
+{
+    return meshdata_write(ctx, path, format, nverts, nfaces, faces, xyz, rgb, NULL);
+}
+
+es_status es__mesh_write_staged(es_ctx *ctx, const char *path, es_mesh_format format,
+                                const es_mesh *mesh, const double *xyz, es__file_set *set)
+{
+    if (!mesh || !xyz) ES_FAIL(ctx, ES_EINVAL, "mesh write: no mesh or positions");
+    return meshdata_write(ctx, path, format, es_mesh_nverts(mesh), es_mesh_nfaces(mesh),
+                          es_mesh_faces(mesh), xyz, NULL, set);
 }
 
 /* ---------------------------------------------------------------- meshes */

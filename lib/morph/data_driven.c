@@ -313,7 +313,7 @@ es_status es_data_path(es_ctx *ctx, int64_t dim, int64_t n, const double *x, int
         p = q, q = t;
         inf.iterations = it + 1;
         inf.converged = move < o.eps * inf.scale;
-        es__progress(ctx, "data-driven path", it + 1, o.max_iter);
+        rc = es__progress(ctx, "data-driven path", it + 1, o.max_iter);
     }
     if (rc == ES_OK) {
         inf.length = resample(dim, m, p, nframes, frames);

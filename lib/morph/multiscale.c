@@ -74,8 +74,8 @@ es_status es_multiscale_new(es_ctx *ctx, const es_mesh *mesh, const es_multiscal
                                                               sizeof *ms->alt)))
         rc = ES_ENOMEM;
     for (int i = 1; rc == ES_OK && i < o.tries; i++) {
-        es__progress(ctx, "multiscale: hierarchies", i, o.tries);
-        rc = new_one(ctx, mesh, &o, seed + (uint64_t)i, &ms->alt[i - 1]);
+        if ((rc = es__progress(ctx, "multiscale: hierarchies", i, o.tries)) == ES_OK)
+            rc = new_one(ctx, mesh, &o, seed + (uint64_t)i, &ms->alt[i - 1]);
     }
     if (rc != ES_OK) {
         es_multiscale_free(ms);

@@ -138,7 +138,9 @@ es_status es_compare_mantel(es_ctx *ctx, int64_t n, const double *d1, const doub
 {
     es_status rc;
     if ((rc = check_n(ctx, n)) != ES_OK) return rc;
-    if (permutations < 0) ES_FAIL(ctx, ES_EINVAL, "compare: negative permutation count");
+    if (permutations < 0 || permutations > ES_MAX_PERMUTATIONS)
+        ES_FAIL(ctx, ES_EINVAL, "compare: %lld permutations (0 to %d)", (long long)permutations,
+                ES_MAX_PERMUTATIONS);
     int64_t m = n * (n - 1) / 2;
     double *r1 = es__alloc_array(ctx, 2 * m + n * n, sizeof *r1);
     int64_t *perm = es__alloc_array(ctx, n, sizeof *perm);
@@ -184,7 +186,7 @@ es_status es_compare_mantel(es_ctx *ctx, int64_t n, const double *d1, const doub
                 for (int64_t i = 0; i < j; i++, t++) cc += r1[t] * col[perm[i]];
             }
             if (cc / denom >= thr) ge++;
-            if ((q & 255) == 0) es__progress(ctx, "mantel", q, permutations);
+            if ((q & 255) == 0 && (rc = es__progress(ctx, "mantel", q, permutations))) goto done;
         }
         es__progress(ctx, "mantel", permutations, permutations);
         if (p) *p = (double)(1 + ge) / (double)(1 + permutations);
@@ -305,7 +307,9 @@ es_status es_compare_groups(es_ctx *ctx, int64_t n, const double *dist, const in
     if ((rc = check_n(ctx, n)) != ES_OK) return rc;
     if (g < 2 || g > n) ES_FAIL(ctx, ES_EINVAL, "compare: %lld groups for %lld specimens",
                                 (long long)g, (long long)n);
-    if (permutations < 0) ES_FAIL(ctx, ES_EINVAL, "compare: negative permutation count");
+    if (permutations < 0 || permutations > ES_MAX_PERMUTATIONS)
+        ES_FAIL(ctx, ES_EINVAL, "compare: %lld permutations (0 to %d)", (long long)permutations,
+                ES_MAX_PERMUTATIONS);
     double *d2 = es__alloc_array(ctx, n * n + 4 * g * g, sizeof *d2);
     int64_t *lab = es__alloc_array(ctx, n + g, sizeof *lab);
     if (!d2 || !lab) { es__free(ctx, d2); es__free(ctx, lab); return ES_ENOMEM; }
@@ -358,7 +362,8 @@ es_status es_compare_groups(es_ctx *ctx, int64_t n, const double *dist, const in
             if (isfinite(f) && fq >= f - 1e-12 * fabs(f)) fge++;
             for (int64_t t = 0; t < g * g; t++)
                 if (pm[t] >= md2[t] * (1 - 1e-12)) cntge[t] += 1;
-            if ((q & 255) == 0) es__progress(ctx, "group permutations", q, permutations);
+            if ((q & 255) == 0 && (rc = es__progress(ctx, "group permutations", q, permutations)))
+                goto done;
         }
         es__progress(ctx, "group permutations", permutations, permutations);
     }

@@ -351,7 +351,7 @@ es_status es_gpa_align(es_ctx *ctx, int64_t k, int d, es_mat x, const es_gpa_opt
         if (o.scale &&
             (rc = scaling_step(&st, total, o.tol, scale_acc, &rep.scale_change, exact)) != ES_OK)
             goto done;
-        es__progress(ctx, "gpa", rep.iterations, o.max_iter);
+        if ((rc = es__progress(ctx, "gpa", rep.iterations, o.max_iter))) goto done;
         if (rep.rot_change <= o.tol && rep.scale_change <= o.tol) {
             rep.converged = 1;
             break;

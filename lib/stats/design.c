@@ -206,12 +206,16 @@ static double code_at(const es_design *d, int64_t v, const vcode *vc, int64_t i,
 /* The level a code column names: treatment k -> level k+1, else level k. */
 static int64_t code_level(const vcode *vc, int64_t k) { return vc->coding == 0 ? k + 1 : k; }
 
-static es_status add_term_columns(es_ctx *ctx, es_design *d, const es_formula *f, int64_t fj,
-                                  int64_t j, const int *skip, int64_t *q)
+#define MAX_COLUMNS ES__DESIGN_MAX_COLUMNS
+
+/* How design term j (formula term fj) codes each of its nv variables (vars,
+ * vc) and how many columns that makes (*ncol, bounded). */
+static es_status term_codes(es_ctx *ctx, es_design *d, const es_formula *f, int64_t fj,
+                            int64_t j, const int *skip, vcode *vc, int64_t *vars,
+                            int64_t *nv_out, int64_t *ncol_out)
 {
     const uint64_t mask = es__formula_term_mask(f, fj);
-    vcode vc[64];
-    int64_t vars[64], nv = 0, ncol = 1;
+    int64_t nv = 0, ncol = 1;
     for (int64_t v = 0; v < d->nvars; v++) {
         if (!(mask >> v & 1)) continue;
         vcode *c = &vc[nv];
@@ -229,66 +233,125 @@ static es_status add_term_columns(es_ctx *ctx, es_design *d, const es_formula *f
             c->coding = 0;
             c->ncol = 1;
         }
-        if (!es__mul_i64(ncol, c->ncol, &ncol) || ncol > 100000)
+        if (!es__mul_i64(ncol, c->ncol, &ncol) || ncol > MAX_COLUMNS)
             ES_FAIL(ctx, ES_ERANGE, "model: the term '%s' has too many columns", d->terms[j]);
         nv++;
     }
-    int64_t q0 = *q, n = d->n;
-    double *nx = es__realloc(ctx, d->x, (size_t)(n * (q0 + ncol)) * sizeof *nx);
-    if (!nx) return ES_ENOMEM;
-    d->x = nx;
-    char **nn = es__realloc(ctx, d->colnames, (size_t)(q0 + ncol) * sizeof *nn);
-    if (!nn) return ES_ENOMEM;
-    d->colnames = nn;
-    int64_t *na = es__realloc(ctx, d->assign, (size_t)(q0 + ncol) * sizeof *na);
-    if (!na) return ES_ENOMEM;
-    d->assign = na;
-    int64_t *nl = es__realloc(ctx, d->col_level,
-                              (size_t)((q0 + ncol) * (d->nvars > 0 ? d->nvars : 1)) * sizeof *nl);
-    if (!nl) return ES_ENOMEM;
-    d->col_level = nl;
+    *nv_out = nv;
+    *ncol_out = ncol;
+    return ES_OK;
+}
+
+/* Column c of a term coded by vc over vars (N values): the product of its
+ * variables' codes, the first variable varying fastest (mixed radix); k
+ * gets each variable's code index. */
+static void term_column(const es_design *d, const vcode *vc, const int64_t *vars, int64_t nv,
+                        int64_t c, int64_t *k, double *col)
+{
+    int64_t rem = c;
+    for (int64_t a = 0; a < nv; a++) {
+        k[a] = rem % vc[a].ncol;
+        rem /= vc[a].ncol;
+    }
+    for (int64_t i = 0; i < d->n; i++) {
+        double x = 1;
+        for (int64_t a = 0; a < nv; a++) x *= code_at(d, vars[a], &vc[a], i, k[a]);
+        col[i] = x;
+    }
+}
+
+es_status es__design_term_values(es_ctx *ctx, es_design *d, const es_formula *f, int64_t fj,
+                                 const int *skip, double **buf, int64_t *cap, int64_t *ncol)
+{
+    vcode vc[64];
+    int64_t vars[64], k[64], nv;
+    es_status rc = term_codes(ctx, d, f, fj, fj, skip, vc, vars, &nv, ncol);
+    if (rc != ES_OK) return rc;
+    if (*ncol > *cap) {
+        double *nb = es__realloc(ctx, *buf, (size_t)(d->n * *ncol) * sizeof *nb);
+        if (!nb) return ES_ENOMEM;
+        *buf = nb;
+        *cap = *ncol;
+    }
+    for (int64_t c = 0; c < *ncol; c++) term_column(d, vc, vars, nv, c, k, *buf + c * d->n);
+    return ES_OK;
+}
+
+/* Term j's columns from column q0 on (the arrays hold them all). */
+static es_status fill_term_columns(es_ctx *ctx, es_design *d, const es_formula *f, int64_t j,
+                                   const vcode *vc, const int64_t *vars, int64_t nv,
+                                   int64_t ncol, int64_t q0)
+{
+    const int64_t n = d->n;
     for (int64_t c = 0; c < ncol; c++) {
-        /* mixed radix: the first variable varies fastest */
-        int64_t k[64], rem = c;
-        for (int64_t a = 0; a < nv; a++) {
-            k[a] = rem % vc[a].ncol;
-            rem /= vc[a].ncol;
-        }
-        double *col = d->x + (q0 + c) * n;
-        for (int64_t i = 0; i < n; i++) {
-            double x = 1;
-            for (int64_t a = 0; a < nv; a++) x *= code_at(d, vars[a], &vc[a], i, k[a]);
-            col[i] = x;
-        }
+        int64_t k[64];
+        term_column(d, vc, vars, nv, c, k, d->x + (q0 + c) * n);
         size_t len = 1;
         for (int64_t a = 0; a < nv; a++) {
             len += strlen(d->vars[vars[a]]) + 2;
             if (vc[a].factor) len += strlen(d->levels[vars[a]][code_level(&vc[a], k[a])]) + 1;
         }
-        char *s = es__malloc(ctx, len);
+        char *s = es__malloc(ctx, len), *e;
         if (!s) return ES_ENOMEM;
-        s[0] = '\0';
+        e = s;
+        *e = '\0';
         for (int64_t a = 0; a < nv; a++) {
-            if (a) strcat(s, ":");
+            if (a) *e++ = ':';
             if (vc[a].factor) {
                 /* factor(x) names its levels as x=level */
-                const char *lab = d->vars[vars[a]];
                 es_var_kind kind;
                 const char *name = es_formula_var(f, vars[a], &kind);
-                strcat(s, kind == ES_VAR_FACTOR ? name : lab);
-                strcat(s, "=");
-                strcat(s, d->levels[vars[a]][code_level(&vc[a], k[a])]);
+                e = stpcpy(e, kind == ES_VAR_FACTOR ? name : d->vars[vars[a]]);
+                *e++ = '=';
+                e = stpcpy(e, d->levels[vars[a]][code_level(&vc[a], k[a])]);
             } else {
-                strcat(s, d->vars[vars[a]]);
+                e = stpcpy(e, d->vars[vars[a]]);
             }
         }
+        *e = '\0';
         d->colnames[q0 + c] = s;
         d->assign[q0 + c] = j;
         int64_t *lev = d->col_level + (q0 + c) * d->nvars;
         for (int64_t v = 0; v < d->nvars; v++) lev[v] = -1;
         for (int64_t a = 0; a < nv; a++)
             if (vc[a].factor) lev[vars[a]] = code_level(&vc[a], k[a]);
-        *q = q0 + c + 1;
+        d->ncols = q0 + c + 1;
+    }
+    return ES_OK;
+}
+
+/* Every kept term's columns after the intercept: counted (and bounded)
+ * first, so that the arrays are allocated once. */
+static es_status build_columns(es_ctx *ctx, es_design *d, const es_formula *f, const int *skip)
+{
+    vcode vc[64];
+    int64_t vars[64], nv, ncol, total = 1, nvars = d->nvars > 0 ? d->nvars : 1;
+    const int64_t T = es_formula_nterms(f);
+    es_status rc;
+    for (int64_t fj = 0, j = 0; fj < T; fj++) {
+        if (skip[fj]) continue;
+        if ((rc = term_codes(ctx, d, f, fj, j, skip, vc, vars, &nv, &ncol)) != ES_OK) return rc;
+        if ((total += ncol) > MAX_COLUMNS)
+            ES_FAIL(ctx, ES_ERANGE, "model: the design has more than %d columns at the term "
+                    "'%s'", MAX_COLUMNS, d->terms[j]);
+        j++;
+    }
+    if (!(d->x = es__alloc_array(ctx, d->n * total, sizeof *d->x)) ||
+        !(d->colnames = es__calloc(ctx, (size_t)total, sizeof *d->colnames)) ||
+        !(d->assign = es__alloc_array(ctx, total, sizeof *d->assign)) ||
+        !(d->col_level = es__alloc_array(ctx, total * nvars, sizeof *d->col_level)))
+        return ES_ENOMEM;
+    for (int64_t i = 0; i < d->n; i++) d->x[i] = 1.0;
+    for (int64_t v = 0; v < d->nvars; v++) d->col_level[v] = -1;
+    if (!(d->colnames[0] = es__strdup(ctx, "intercept"))) return ES_ENOMEM;
+    d->assign[0] = -1;
+    d->ncols = 1;
+    for (int64_t fj = 0, j = 0; fj < T; fj++) {
+        if (skip[fj]) continue;
+        if ((rc = term_codes(ctx, d, f, fj, j, skip, vc, vars, &nv, &ncol)) != ES_OK ||
+            (rc = fill_term_columns(ctx, d, f, j, vc, vars, nv, ncol, d->ncols)) != ES_OK)
+            return rc;
+        j++;
     }
     return ES_OK;
 }
@@ -315,13 +378,9 @@ static es_status build(es_ctx *ctx, const es_formula *f, int64_t n, const es_mod
     d->values = es__calloc(ctx, (size_t)(n * nv), sizeof *d->values);
     d->terms = es__calloc(ctx, (size_t)(nt > 0 ? nt : 1), sizeof *d->terms);
     d->term_vars = es__calloc(ctx, (size_t)(nt * nv > 0 ? nt * nv : 1), sizeof *d->term_vars);
-    d->x = es__alloc_array(ctx, n, sizeof *d->x);
-    d->colnames = es__calloc(ctx, 1, sizeof *d->colnames);
-    d->assign = es__alloc_array(ctx, 1, sizeof *d->assign);
     d->term_coding = es__alloc_array(ctx, nt * nv > 0 ? nt * nv : 1, sizeof *d->term_coding);
-    d->col_level = es__alloc_array(ctx, nv > 0 ? nv : 1, sizeof *d->col_level);
-    if (!d->term_coding || !d->col_level || !d->vars || !d->var_factor || !d->nlevels ||
-        !d->levels || !d->codes || !d->values || !d->terms || !d->term_vars || !d->x || !d->colnames || !d->assign) {
+    if (!d->term_coding || !d->vars || !d->var_factor || !d->nlevels || !d->levels ||
+        !d->codes || !d->values || !d->terms || !d->term_vars) {
         rc = ES_ENOMEM;
         goto done;
     }
@@ -354,17 +413,7 @@ static es_status build(es_ctx *ctx, const es_formula *f, int64_t n, const es_mod
         j++;
     }
     for (int64_t k = 0; k < nt * nv; k++) d->term_coding[k] = -1;
-    for (int64_t v = 0; v < nv; v++) d->col_level[v] = -1;
-    for (int64_t i = 0; i < n; i++) d->x[i] = 1.0;
-    if (!(d->colnames[0] = es__strdup(ctx, "intercept"))) {
-        rc = ES_ENOMEM;
-        goto done;
-    }
-    d->assign[0] = -1;
-    d->ncols = 1;
-    for (int64_t fj = 0, j = 0; fj < es_formula_nterms(f) && rc == ES_OK; fj++)
-        if (!skip[fj]) rc = add_term_columns(ctx, d, f, fj, j++, skip, &d->ncols);
-    if (rc != ES_OK) goto done;
+    if ((rc = build_columns(ctx, d, f, skip)) != ES_OK) goto done;
     *out = d;
     d = NULL;
 done:
@@ -398,23 +447,17 @@ es_status es_design_build(es_ctx *ctx, const es_formula *f, int64_t n,
     char **why = es__calloc(ctx, (size_t)(T > 0 ? T : 1), sizeof *why);
     es_design *d = NULL;
     es_status rc = skip && why ? ES_OK : ES_ENOMEM;
-    /* Build, find the first term that adds no rank, leave it out, rebuild
-     * (its absence can change how the terms after it are coded). */
-    while (rc == ES_OK) {
-        int64_t j = -1;
-        char msg[400];
-        if ((rc = build(ctx, f, n, columns, ncolumns, contrasts, skip, &d)) != ES_OK ||
-            (rc = es__design_first_aliased(ctx, d, &j, msg, sizeof msg)) != ES_OK || j < 0)
-            break;
-        int64_t fj = 0;
-        for (int64_t k = 0; fj < T; fj++)
-            if (!skip[fj] && k++ == j) break;
-        es__warn(ctx, "model: term '%s' %s (its columns are combinations of theirs): left out",
-                 d->terms[j], msg);
-        skip[fj] = 1;
-        if (!(why[fj] = es__strdup(ctx, msg))) rc = ES_ENOMEM;
+    int any = 0;
+    /* every term's design, the terms that add no rank found from it in one
+     * pass, then the design without them (their absence can change how the
+     * terms after them are coded) */
+    if (rc == ES_OK && (rc = build(ctx, f, n, columns, ncolumns, contrasts, skip, &d)) == ES_OK &&
+        (rc = es__design_find_aliased(ctx, d, f, skip, why)) == ES_OK)
+        for (int64_t fj = 0; fj < T; fj++) any |= skip[fj];
+    if (rc == ES_OK && any) {
         es_design_free(d);
         d = NULL;
+        rc = build(ctx, f, n, columns, ncolumns, contrasts, skip, &d);
     }
     for (int64_t fj = 0; rc == ES_OK && fj < T; fj++)
         if (skip[fj]) {

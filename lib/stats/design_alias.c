@@ -4,10 +4,11 @@
  * adds no rank: its sum of squares would be 0 on 0 df, its F NaN, and with
  * type III the term it copies would lose its own test. R's lm keeps such a
  * term and prints NA; a referee reads that as a bug. The design finds them
- * by the rank of its leading columns, from a pivoted QR (LAPACKE dgeqp3 on
- * unit-norm columns, rank at R's qr tolerance 1e-7), and names what each
+ * by the rank of its leading columns, grown a column at a time (the model's
+ * Gram-Schmidt basis, R's qr tolerance 1e-7), and names what each
  * duplicates from the basic least-squares solution of its columns on the
- * columns before it: the terms with a non-zero coefficient.
+ * columns before it (a pivoted QR, LAPACKE dgeqp3 on unit-norm columns):
+ * the terms with a non-zero coefficient.
  */
 #include "stats/stats_pkg.h"
 
@@ -18,16 +19,15 @@
 
 #define RANK_TOL 1e-7
 
-/* Copy columns cols[0..k) of d->x, each scaled to unit norm, into a (N x k). */
-static void gather(const es_design *d, const int64_t *cols, int64_t k, double *a)
+/* Columns x (N x k) each scaled to unit norm into a. */
+static void gather(int64_t n, const double *x, int64_t k, double *a)
 {
-    const int64_t n = d->n;
     for (int64_t c = 0; c < k; c++) {
-        const double *x = d->x + cols[c] * n;
+        const double *xc = x + c * n;
         double s = 0;
-        for (int64_t i = 0; i < n; i++) s += x[i] * x[i];
+        for (int64_t i = 0; i < n; i++) s += xc[i] * xc[i];
         s = s > 0 ? 1.0 / sqrt(s) : 0.0;
-        for (int64_t i = 0; i < n; i++) a[i + c * n] = x[i] * s;
+        for (int64_t i = 0; i < n; i++) a[i + c * n] = xc[i] * s;
     }
 }
 
@@ -51,13 +51,13 @@ static es_status pivoted_qr(es_ctx *ctx, int64_t n, int64_t k, double *a, lapack
     return ES_OK;
 }
 
-/* The terms (flags, nterms) whose columns the basic solution of b on the
- * factored columns cols (a, jpvt, tau of rank k) uses. b is overwritten. */
-static es_status used_terms(es_ctx *ctx, const es_design *d, const int64_t *cols, const double *a,
+/* The terms (flags used, by formula term) whose columns the basic solution
+ * of b on the factored columns (a, jpvt, tau of rank k; term_of gives each
+ * column's formula term, -1 the intercept) uses. b is overwritten. */
+static es_status used_terms(es_ctx *ctx, int64_t n, const int64_t *term_of, const double *a,
                             const lapack_int *jpvt, const double *tau, int64_t k, double *b,
                             int *used)
 {
-    const int64_t n = d->n;
     double nb = 0;
     for (int64_t i = 0; i < n; i++) nb += b[i] * b[i];
     nb = sqrt(nb);
@@ -71,76 +71,132 @@ static es_status used_terms(es_ctx *ctx, const es_design *d, const int64_t *cols
         b[i] = s / a[i + i * n];
     }
     for (int64_t i = 0; i < k; i++) {
-        const int64_t t = d->assign[cols[jpvt[i] - 1]];
+        const int64_t t = term_of[jpvt[i] - 1];
         if (t >= 0 && fabs(b[i]) > 1e-8 * nb) used[t] = 1;
     }
     return ES_OK;
 }
 
-/* Say which terms term j duplicates: "duplicates 'sex'", "is a combination
- * of 'a', 'b'", "is constant". */
-static void describe(const es_design *d, int64_t j, const int *used, char *why, size_t len)
+/* Say which terms (formula terms before fj, flagged in used) term fj
+ * duplicates: "duplicates 'sex'", "is a combination of 'a', 'b'", "is
+ * constant". */
+static void describe(const es_formula *f, int64_t fj, const int *used, char *why, size_t len)
 {
     int64_t nu = 0;
-    for (int64_t t = 0; t < j; t++) nu += used[t];
+    for (int64_t t = 0; t < fj; t++) nu += used[t];
     if (nu == 0) {
         snprintf(why, len, "is constant (a multiple of the intercept)");
         return;
     }
     size_t at = (size_t)snprintf(why, len, nu == 1 ? "duplicates " : "is a combination of ");
     int64_t k = 0;
-    for (int64_t t = 0; t < j && at < len; t++)
+    for (int64_t t = 0; t < fj && at < len; t++)
         if (used[t])
-            at += (size_t)snprintf(why + at, len - at, "%s'%s'", k++ ? ", " : "", d->terms[t]);
+            at += (size_t)snprintf(why + at, len - at, "%s'%s'", k++ ? ", " : "",
+                                   es_formula_term(f, t));
 }
 
-es_status es__design_first_aliased(es_ctx *ctx, const es_design *d, int64_t *term, char *why,
-                                   size_t whylen)
+/* Room for need kept columns (N values and a term each; *cap now). */
+static es_status grow(es_ctx *ctx, int64_t n, double **x, int64_t **term_of, int64_t *cap,
+                      int64_t need)
 {
-    const int64_t n = d->n, q = d->ncols, T = d->nterms;
-    *term = -1;
-    double *a = es__alloc_array(ctx, n * q, sizeof *a);
-    double *tau = es__alloc_array(ctx, q, sizeof *tau);
+    if (need <= *cap) return ES_OK;
+    int64_t c = *cap * 2 > need ? *cap * 2 : need;
+    double *nx = es__realloc(ctx, *x, (size_t)(n * c) * sizeof *nx);
+    if (!nx) return ES_ENOMEM;
+    *x = nx;
+    int64_t *nt = es__realloc(ctx, *term_of, (size_t)c * sizeof *nt);
+    if (!nt) return ES_ENOMEM;
+    *term_of = nt;
+    *cap = c;
+    return ES_OK;
+}
+
+/* Term fj adds nothing to the kept columns x (N x k, their terms term_of):
+ * why (allocated) says what its columns (tc, N x ncol) come from, from
+ * the basic least-squares solution of each on the columns before. */
+static es_status explain(es_ctx *ctx, const es_formula *f, int64_t n, const double *x,
+                         const int64_t *term_of, int64_t k, int64_t fj, const double *tc,
+                         int64_t ncol, char **why)
+{
+    const int64_t T = es_formula_nterms(f);
+    double *a = es__alloc_array(ctx, n * k, sizeof *a);
+    double *tau = es__alloc_array(ctx, k, sizeof *tau);
     double *b = es__alloc_array(ctx, n, sizeof *b);
-    lapack_int *jpvt = es__alloc_array(ctx, q, sizeof *jpvt);
-    int64_t *cols = es__alloc_array(ctx, q, sizeof *cols);
-    int *used = es__calloc(ctx, (size_t)(T > 0 ? T : 1), sizeof *used);
-    es_status rc = ES_OK;
-    if (!a || !tau || !b || !jpvt || !cols || !used) {
-        rc = ES_ENOMEM;
-        goto done;
+    lapack_int *jpvt = es__alloc_array(ctx, k, sizeof *jpvt);
+    int *used = es__calloc(ctx, (size_t)T, sizeof *used);
+    char msg[400];
+    int64_t kr = 0;
+    es_status rc = a && tau && b && jpvt && used ? ES_OK : ES_ENOMEM;
+    if (rc == ES_OK) {
+        gather(n, x, k, a);
+        rc = pivoted_qr(ctx, n, k, a, jpvt, tau, &kr);
     }
-    /* columns in term order: the intercept, then term 0, term 1, ... */
-    int64_t k = 0, rank_before = 1;
-    cols[k++] = 0;
-    for (int64_t j = 0; j < T && *term < 0; j++) {
-        const int64_t k0 = k;
-        for (int64_t c = 0; c < q; c++)
-            if (d->assign[c] == j) cols[k++] = c;
-        int64_t rank = 0;
-        gather(d, cols, k, a);
-        if ((rc = pivoted_qr(ctx, n, k, a, jpvt, tau, &rank)) != ES_OK) goto done;
-        if (rank > rank_before || k == k0) {
-            rank_before = rank;
-            continue;
-        }
-        /* term j adds nothing: what do its columns come from? */
-        *term = j;
-        int64_t kr = 0;
-        gather(d, cols, k0, a);
-        if ((rc = pivoted_qr(ctx, n, k0, a, jpvt, tau, &kr)) != ES_OK) goto done;
-        for (int64_t c = k0; c < k; c++) {
-            memcpy(b, d->x + cols[c] * n, (size_t)n * sizeof *b);
-            if ((rc = used_terms(ctx, d, cols, a, jpvt, tau, kr, b, used)) != ES_OK) goto done;
-        }
-        describe(d, j, used, why, whylen);
+    for (int64_t c = 0; rc == ES_OK && c < ncol; c++) {
+        memcpy(b, tc + c * n, (size_t)n * sizeof *b);
+        rc = used_terms(ctx, n, term_of, a, jpvt, tau, kr, b, used);
     }
-done:
+    if (rc == ES_OK) {
+        describe(f, fj, used, msg, sizeof msg);
+        es__warn(ctx, "model: term '%s' %s (its columns are combinations of theirs): left out",
+                 es_formula_term(f, fj), msg);
+        if (!(*why = es__strdup(ctx, msg))) rc = ES_ENOMEM;
+    }
     es__free(ctx, a);
     es__free(ctx, tau);
     es__free(ctx, b);
     es__free(ctx, jpvt);
-    es__free(ctx, cols);
     es__free(ctx, used);
+    return rc;
+}
+
+/* One pass in term order (a term's codes depend only on the kept terms
+ * before it: its margins are of lower degree, and terms are ordered by
+ * degree, so this is what leaving out the first such term, rebuilding and
+ * looking again would find). The rank of the columns so far grows a column
+ * at a time in an orthonormal basis (es__basis_add, the model's own rank
+ * rule): a pivoted QR of all leading columns for every term, and the
+ * design rebuilt after each term left out, took over a minute for "~ v1*...
+ * *v7*d*e*f" on 8 rows (found by fuzz_formula). */
+es_status es__design_find_aliased(es_ctx *ctx, es_design *d, const es_formula *f, int *skip,
+                                  char **why)
+{
+    const int64_t n = d->n, T = es_formula_nterms(f);
+    const int64_t cap = n < ES__DESIGN_MAX_COLUMNS ? n : ES__DESIGN_MAX_COLUMNS;
+    int64_t k = 1, xcap = 64, tcap = 0, ncol = 0, m = 0;
+    double *x = es__alloc_array(ctx, n * xcap, sizeof *x), *tc = NULL;
+    int64_t *term_of = es__alloc_array(ctx, xcap, sizeof *term_of);
+    /* room for min(n, max columns) directions and the slot es__basis_add works in */
+    double *basis = es__alloc_array(ctx, n * (cap + 1), sizeof *basis);
+    es_status rc = x && term_of && basis ? ES_OK : ES_ENOMEM;
+    if (rc == ES_OK) {
+        for (int64_t i = 0; i < n; i++) x[i] = 1.0;   /* the intercept */
+        term_of[0] = -1;
+        es__basis_add(n, basis, &m, x, NULL);
+    }
+    for (int64_t fj = 0; rc == ES_OK && fj < T; fj++) {
+        int added = 0;
+        if ((rc = es__design_term_values(ctx, d, f, fj, skip, &tc, &tcap, &ncol)) != ES_OK) break;
+        if (k + ncol > ES__DESIGN_MAX_COLUMNS) {
+            rc = es__fail(ctx, ES_ERANGE, "model: the design has more than %d columns at the "
+                          "term '%s'", ES__DESIGN_MAX_COLUMNS, es_formula_term(f, fj));
+            break;
+        }
+        for (int64_t c = 0; c < ncol && m < cap; c++)
+            added |= es__basis_add(n, basis, &m, tc + c * n, NULL);
+        if (!added && ncol > 0) {
+            skip[fj] = 1;
+            rc = explain(ctx, f, n, x, term_of, k, fj, tc, ncol, &why[fj]);
+            continue;
+        }
+        if ((rc = grow(ctx, n, &x, &term_of, &xcap, k + ncol)) != ES_OK) break;
+        memcpy(x + k * n, tc, (size_t)(n * ncol) * sizeof *x);
+        for (int64_t c = 0; c < ncol; c++) term_of[k + c] = fj;
+        k += ncol;
+    }
+    es__free(ctx, x);
+    es__free(ctx, tc);
+    es__free(ctx, term_of);
+    es__free(ctx, basis);
     return rc;
 }

@@ -12,6 +12,12 @@
  * NAME is letters, digits, '_' and '.', or any text in double quotes. The
  * terms are then ordered by degree, written order within a degree, as R's
  * terms() orders them, so that sequential sums of squares follow R's.
+ *
+ * Products expand exponentially (a*b*...*r, 18 names, is 262,143 terms,
+ * which took minutes to expand term by term): each expansion is bounded
+ * before it is made (ES_FORMULA_MAX_TERMS), and a caller that knows the
+ * columns has each name checked as it is read (es_formula_parse_checked),
+ * so a misspelt or missing column is said before anything is expanded.
  */
 #include "stats/stats_pkg.h"
 
@@ -49,6 +55,8 @@ typedef struct fparser {
     size_t pos;
     es_formula *f;
     int depth;
+    es_formula_column_fn known;   /* or NULL: names are not checked */
+    void *known_ud;
 } fparser;
 
 static es_status ferr(fparser *p, size_t at, const char *fmt, ...) ES__PRINTF(3, 4);
@@ -154,6 +162,32 @@ static es_status var_index(fparser *p, size_t at, const char *w, size_t len, es_
     return ES_OK;
 }
 
+/* The caller's check of a column name (es_formula_parse_checked). */
+static es_status check_column(fparser *p, size_t at, const char *w, size_t len)
+{
+    char name[512], why[512] = "";
+    if (!p->known) return ES_OK;
+    if (len >= sizeof name) return ferr(p, at, "a column name of %zu bytes (at most %zu)", len,
+                                        sizeof name - 1);
+    memcpy(name, w, len);
+    name[len] = '\0';
+    if (p->known(p->known_ud, name, why, sizeof why)) return ES_OK;
+    es__fail(p->ctx, ES_ENOTFOUND, "formula: column %zu: %s", at + 1,
+             *why ? why : "no such label column");
+    return ES_ENOTFOUND;
+}
+
+/* Expanding a product or interaction of a and b terms makes (at most) the
+ * given count: refused, naming where, when it passes the bound. */
+static es_status check_expansion(fparser *p, size_t at, int64_t a, int64_t b, int with_mains)
+{
+    int64_t n = a * b + (with_mains ? a + b : 0);   /* a, b <= the bound: no overflow */
+    if (n <= ES_FORMULA_MAX_TERMS) return ES_OK;
+    return ferr(p, at, "the formula expands to more than %d terms (%lld here): write the "
+                "interactions wanted, or group main effects with ( )", ES_FORMULA_MAX_TERMS,
+                (long long)n);
+}
+
 static es_status parse_sum(fparser *p, tset *out);
 
 static es_status parse_atom(fparser *p, tset *out)
@@ -202,7 +236,9 @@ static es_status parse_atom(fparser *p, tset *out)
         p->pos = after;
     }
     int64_t v = 0;
-    if ((rc = var_index(p, at, w, len, kind, &v)) != ES_OK) return rc;
+    if ((rc = check_column(p, at, w, len)) != ES_OK ||
+        (rc = var_index(p, at, w, len, kind, &v)) != ES_OK)
+        return rc;
     p->depth--;
     return tset_add(p->ctx, out, (uint64_t)1 << v);
 }
@@ -222,9 +258,11 @@ static es_status parse_inter(fparser *p, tset *out)
     while (rc == ES_OK) {
         ws(p);
         if (p->s[p->pos] != ':') break;
-        p->pos++;
+        size_t at = p->pos++;
         tset b = {0}, c = {0};
-        if ((rc = parse_atom(p, &b)) == ES_OK && (rc = cross(p->ctx, out, &b, &c)) == ES_OK) {
+        if ((rc = parse_atom(p, &b)) == ES_OK &&
+            (rc = check_expansion(p, at, out->n, b.n, 0)) == ES_OK &&
+            (rc = cross(p->ctx, out, &b, &c)) == ES_OK) {
             tset_clear(p->ctx, out);
             *out = c;
             c.m = NULL;
@@ -241,9 +279,10 @@ static es_status parse_product(fparser *p, tset *out)
     while (rc == ES_OK) {
         ws(p);
         if (p->s[p->pos] != '*') break;
-        p->pos++;
+        size_t at = p->pos++;
         tset b = {0}, c = {0};
-        if ((rc = parse_inter(p, &b)) == ES_OK) {
+        if ((rc = parse_inter(p, &b)) == ES_OK &&
+            (rc = check_expansion(p, at, out->n, b.n, 1)) == ES_OK) {
             for (int64_t i = 0; rc == ES_OK && i < out->n; i++) rc = tset_add(p->ctx, &c, out->m[i]);
             for (int64_t i = 0; rc == ES_OK && i < b.n; i++) rc = tset_add(p->ctx, &c, b.m[i]);
             if (rc == ES_OK) rc = cross(p->ctx, out, &b, &c);
@@ -269,9 +308,10 @@ static es_status parse_sum(fparser *p, tset *out)
             return ferr(p, p->pos, "removing terms with '-' is not supported; list the terms "
                         "to keep");
         if (c != '+') break;
-        p->pos++;
+        size_t at = p->pos++;
         tset b = {0};
-        if ((rc = parse_product(p, &b)) == ES_OK)
+        if ((rc = parse_product(p, &b)) == ES_OK &&
+            (rc = check_expansion(p, at, out->n + b.n, 1, 0)) == ES_OK)
             for (int64_t i = 0; rc == ES_OK && i < b.n; i++) rc = tset_add(p->ctx, out, b.m[i]);
         tset_clear(p->ctx, &b);
     }
@@ -320,12 +360,18 @@ static es_status finish(es_ctx *ctx, es_formula *f, const tset *t)
 
 es_status es_formula_parse(es_ctx *ctx, const char *text, es_formula **out)
 {
+    return es_formula_parse_checked(ctx, text, NULL, NULL, out);
+}
+
+es_status es_formula_parse_checked(es_ctx *ctx, const char *text, es_formula_column_fn known,
+                                   void *userdata, es_formula **out)
+{
     *out = NULL;
     if (!text) ES_FAIL(ctx, ES_EINVAL, "formula: no formula");
     es_formula *f = es__calloc(ctx, 1, sizeof *f);
     if (!f) return ES_ENOMEM;
     f->ctx = ctx;
-    fparser p = {ctx, text, 0, f, 0};
+    fparser p = {ctx, text, 0, f, 0, known, userdata};
     tset t = {0};
     es_status rc;
     ws(&p);

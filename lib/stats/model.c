@@ -297,7 +297,8 @@ static es_status permute_term(es_ctx *ctx, es_model *m, int64_t j, const double 
             m->ssperm[(b0 + k) + j * B] = ss;
             if (f >= fobs - TIE_EPS * fmax(1.0, fabs(fobs))) count++;
         }
-        es__progress(ctx, "model: permutations", j * B + b0 + nb, m->nterms * B);
+        if ((rc = es__progress(ctx, "model: permutations", j * B + b0 + nb, m->nterms * B)))
+            goto done;
     }
     m->pval[j] = (double)(count + 1) / (double)(B + 1);
 done:
@@ -419,8 +420,9 @@ es_status es_model_fit(es_ctx *ctx, const es_design *d, const es_source *src,
     if (src->nrows != d->n)
         ES_FAIL(ctx, ES_EINVAL, "model: %lld rows of data, %lld of design", (long long)src->nrows,
                 (long long)d->n);
-    if (o.permutations < 0 || o.permutations > 100000000)
-        ES_FAIL(ctx, ES_EINVAL, "model: %lld permutations", (long long)o.permutations);
+    if (o.permutations < 0 || o.permutations > ES_MAX_PERMUTATIONS)
+        ES_FAIL(ctx, ES_EINVAL, "model: %lld permutations (0 to %d)", (long long)o.permutations,
+                ES_MAX_PERMUTATIONS);
     if (o.ss_type < ES_SS_TYPE_I || o.ss_type > ES_SS_TYPE_III)
         ES_FAIL(ctx, ES_EINVAL, "model: unknown sums-of-squares type %d", (int)o.ss_type);
     const int64_t n = d->n, T = d->nterms, B = o.permutations;

@@ -193,7 +193,7 @@ static es_status permute(es_ctx *ctx, const es_model *m, const int *use, es_mode
             pair_stats(L, r, ak, L * batch, pw->slopes, vals + (b0 + k) * nstat,
                        b0 + k == 0 ? cosine : NULL);
         }
-        es__progress(ctx, "pairwise: permutations", b0 + nb - 1, B);
+        if ((rc = es__progress(ctx, "pairwise: permutations", b0 + nb - 1, B))) goto done;
     }
 done:
     es__perm_clear(ctx, &g);

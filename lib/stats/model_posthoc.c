@@ -68,6 +68,9 @@ es_status es_model_group_tests(es_ctx *ctx, const es_model *m, const char *term,
                 "model", term, why);
     if (j < 0) ES_FAIL(ctx, ES_ENOTFOUND, "variable tests: the model has no term '%s'",
                        term ? term : "");
+    if (permutations > ES_MAX_PERMUTATIONS)
+        ES_FAIL(ctx, ES_EINVAL, "variable tests: %lld permutations (0 to %d)",
+                (long long)permutations, ES_MAX_PERMUTATIONS);
     const int64_t B = permutations < 0 ? m->permutations : permutations;
     const int64_t n = m->n, p = m->p, r = m->priv->r, rk = m->rank;
     if (group) {
@@ -157,7 +160,8 @@ es_status es_model_group_tests(es_ctx *ctx, const es_model *m, const char *term,
                     if (fx >= f[x] - TIE_EPS * fmax(1.0, f[x])) count[x]++;
                 }
             }
-            es__progress(ctx, "variable tests: permutations", b0 + nb, B);
+            if ((rc = es__progress(ctx, "variable tests: permutations", b0 + nb, B)))
+                goto done;
         }
         for (int64_t x = 0; x < ng; x++)
             if (isfinite(f[x])) pval[x] = (double)(count[x] + 1) / (double)(B + 1);

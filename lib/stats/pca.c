@@ -202,9 +202,9 @@ static es_status fit_gram(es_ctx *ctx, const es_source *src, int64_t K, es_pca *
             cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, (int)bi, (int)bj, ne,
                         1.0, outer, ne, inner, ne, 0.0, G + i0 + j0 * N, nn);
             nread += bj;
-            es__progress(ctx, "pca: Gram matrix", nread, total_reads);
+            if ((rc = es__progress(ctx, "pca: Gram matrix", nread, total_reads))) goto done;
         }
-        es__progress(ctx, "pca: Gram matrix", nread, total_reads);
+        if ((rc = es__progress(ctx, "pca: Gram matrix", nread, total_reads))) goto done;
     }
     /* symmetrize, then double-centre: Gc = J G J with J = I - 11^T/N */
     for (int64_t j = 0; j < N; j++)
@@ -243,7 +243,7 @@ static es_status fit_gram(es_ctx *ctx, const es_source *src, int64_t K, es_pca *
             if ((rc = read_minus(ctx, src, j0, bj, p->mean, outer)) != ES_OK) goto done;
             cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, ne, (int)r, (int)bj,
                         1.0, outer, ne, V + j0, nn, 1.0, p->components, ne);
-            es__progress(ctx, "pca: components", j0 + bj, N);
+            if ((rc = es__progress(ctx, "pca: components", j0 + bj, N))) goto done;
         }
         for (int64_t k = 0; k < r; k++) {
             double *u = p->components + k * E;
@@ -304,7 +304,7 @@ static es_status fit_covariance(es_ctx *ctx, const es_source *src, int64_t K, es
             for (int64_t e = 0; e < E; e++) ysum[e] += buf[e + j * E];
         cblas_dsyrk(CblasColMajor, CblasUpper, CblasNoTrans, ne, (int)n, 1.0, buf, ne, 1.0,
                     C, ne);
-        es__progress(ctx, "pca: covariance", r0 + n, N);
+        if ((rc = es__progress(ctx, "pca: covariance", r0 + n, N))) goto done;
     }
     /* Cc = Y^T Y - N ybar ybar^T, upper triangle */
     double trace = 0;
@@ -328,7 +328,7 @@ static es_status fit_covariance(es_ctx *ctx, const es_source *src, int64_t K, es
         if ((rc = read_minus(ctx, src, r0, n, p->mean, buf)) != ES_OK) goto done;
         cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, (int)n, (int)r, ne, 1.0, buf, ne,
                     p->components, ne, 0.0, p->scores + r0, (int)N);
-        es__progress(ctx, "pca: scores", r0 + n, N);
+        if ((rc = es__progress(ctx, "pca: scores", r0 + n, N))) goto done;
     }
     es__pca_finish(p);
     *out = p;

@@ -127,7 +127,7 @@ es_status es__pca_fit_randomized(es_ctx *ctx, const es_source *src, const es_pca
                 cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, ne, (int)l, (int)n, 1.0,
                             buf, ne, Z + r0, nn, 1.0, Y, ne);
         }
-        es__progress(ctx, "pca: randomized", it + 2, opts->power_iters + 2);
+        if ((rc = es__progress(ctx, "pca: randomized", it + 2, opts->power_iters + 2))) goto done;
     }
 
     /* Z = A^T Q = W S V^T: components Q V, scores W S */

@@ -110,7 +110,7 @@ es_status es_group_means(es_ctx *ctx, const es_source *src, const int64_t *group
             for (int64_t e = 0; e < E; e++) m[e] += x[e];
             counts[g]++;
         }
-        es__progress(ctx, "mean", r0 + n, N);
+        if ((rc = es__progress(ctx, "mean", r0 + n, N))) goto done;
     }
     for (int64_t g = 0; g < ngroups; g++)
         for (int64_t e = 0; e < E; e++)
@@ -321,7 +321,7 @@ es_status es_diff_paired(es_ctx *ctx, const es_source *src, const char *const *k
             d->mean[e] += delta / (double)(p + 1);
             d->sd[e] += delta * (x - d->mean[e]);
         }
-        es__progress(ctx, "diff", p + 1, P);
+        if ((rc = es__progress(ctx, "diff", p + 1, P))) goto fail;
     }
     for (int64_t e = 0; e < E; e++) {
         d->sd[e] = P > 1 ? sqrt(d->sd[e] / (double)(P - 1)) : NAN;

@@ -64,10 +64,24 @@ void es__perm_clear(es_ctx *ctx, es__perm *g);
  * NULL) gets x's coordinates: x = Q r. Returns 1 if appended. */
 int es__basis_add(int64_t n, double *q, int64_t *m, const double *x, double *r);
 
-/* The first term of d (in order) that adds no rank to the intercept and the
- * terms before it, or *term = -1; why gets "duplicates 'sex'" (design_alias.c). */
-es_status es__design_first_aliased(es_ctx *ctx, const es_design *d, int64_t *term, char *why,
-                                   size_t whylen);
+/* Maximum columns of a whole design: 1024 terms (ES_FORMULA_MAX_TERMS) of
+ * many-level factors could make N x 10^8 values, and the fit's QR costs N
+ * q^2 (20,000 columns of 600 rows: 10^11 flops, a few minutes). */
+#define ES__DESIGN_MAX_COLUMNS 20000
+
+/* The columns formula term fj has in a design of f keeping the terms not
+ * flagged in skip (its codes follow from the kept terms before it): N x
+ * *ncol values into *buf, grown (*cap columns) as needed. d: the design of
+ * every term of f (variables read; its term codings are scratch). */
+es_status es__design_term_values(es_ctx *ctx, es_design *d, const es_formula *f, int64_t fj,
+                                 const int *skip, double **buf, int64_t *cap, int64_t *ncol);
+
+/* The terms of f that add no rank to the intercept and the kept terms
+ * before them, in one pass in term order: each flagged in skip, why[fj]
+ * (allocated) says what it duplicates ("duplicates 'sex'"), and a warning
+ * names it (design_alias.c). d as for es__design_term_values. */
+es_status es__design_find_aliased(es_ctx *ctx, es_design *d, const es_formula *f, int *skip,
+                                  char **why);
 
 /* p-value, Z and UCL of the observed statistic s[0] among s[0..n) (s[1..n)
  * permuted; effect_size.c): p = #{s_b >= s_0 - tie} / n, NULL outputs skipped. */

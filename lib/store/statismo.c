@@ -265,8 +265,10 @@ es_status es_statismo_write(es_ctx *ctx, const char *path, const es_statismo_mod
             rc = put_modelinfo(ctx, file, m);
         }
         es__h5_close(ver);
-        if (file >= 0 && H5Fclose(file) < 0 && rc == ES_OK)
-            rc = es__h5_fail(ctx, ES_EIO, "statismo: cannot write '%s'", path);
+        /* the store's full-disk-safe close: a failed write or flush never
+         * reaches libhdf5's crash at exit */
+        if (es__h5_file_close(ctx, file, rc == ES_OK, path) != ES_OK && rc == ES_OK)
+            rc = es__fail(ctx, ES_EIO, "statismo: %s", es_ctx_errmsg(ctx));
         es__h5_close(fapl);
     } H5E_END_TRY
     return es__replace_end(ctx, &w, rc);

@@ -9,9 +9,13 @@
  * datasets chunked with an unlimited first dimension so that appending a
  * shape appends a row (datasets-spec/store-format.md).
  */
+#define _GNU_SOURCE   /* memfd_create, fallocate */
 #include "store/store_pkg.h"
 
+#include <errno.h>
+#include <fcntl.h>
 #include <pthread.h>
+#include <sys/mman.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <stdio.h>
@@ -371,6 +375,74 @@ done:
     es__h5_close(sp);
     es__h5_close(dcpl);
     return rc;
+}
+
+/* A file thrown away (an aborted or failed write) is closed into a memory
+ * file. Closing flushes HDF5's caches, and when that write fails too (the
+ * disk is full: the very failure being handled) libhdf5 1.10.8 frees the
+ * file but keeps its identifier, then crashes at exit closing it again
+ * (HDFFV-11052, fixed in 1.10.10). What the flush writes into the memory
+ * file is deleted with it. A file size limit (RLIMIT_FSIZE) applies to
+ * memory files too, so only that fault still reaches the bug. */
+static void close_discarded(hid_t file)
+{
+#if defined(__linux__) && defined(MFD_CLOEXEC)
+    void *h = NULL;
+    int sink = memfd_create("edgespace-discarded", MFD_CLOEXEC);
+    if (sink >= 0 && H5Fget_vfd_handle(file, H5P_DEFAULT, &h) >= 0 && h)
+        dup2(sink, *(int *)h);
+    if (sink >= 0) close(sink);
+#endif
+    H5Fclose(file);
+}
+
+/* A flush that fails leaves libhdf5 1.10.8's metadata cache unable to
+ * flush again ("slist already enabled?"), so the file can then be neither
+ * kept nor discarded: its close fails and the crash above follows at exit
+ * (`export --statismo` onto a nearly full disk printed its error, then
+ * segfaulted). So the flush must not meet a full disk: the blocks of the
+ * whole file, and a margin for what the flush appends, are reserved first
+ * (fallocate, keeping the size), and a disk without them is found here,
+ * where the file can still be discarded. 0, or the errno that refused. */
+static int reserve_space(hid_t file)
+{
+#if defined(__linux__) && defined(FALLOC_FL_KEEP_SIZE)
+    hid_t fapl = H5Fget_access_plist(file);
+    int sec2 = fapl >= 0 && H5Pget_driver(fapl) == H5FD_SEC2;
+    hsize_t size = 0;
+    void *h = NULL;
+    es__h5_close(fapl);
+    if (!sec2 || H5Fget_filesize(file, &size) < 0 ||
+        H5Fget_vfd_handle(file, H5P_DEFAULT, &h) < 0 || !h)
+        return 0;
+    if (fallocate(*(int *)h, FALLOC_FL_KEEP_SIZE, 0, (off_t)size + (4 << 10)) != 0 &&
+        (errno == ENOSPC || errno == EDQUOT || errno == EFBIG))
+        return errno;
+#else
+    (void)file;
+#endif
+    return 0;   /* reserved, or a file system without fallocate: best effort */
+}
+
+es_status es__h5_file_close(es_ctx *ctx, hid_t file, bool keep, const char *path)
+{
+    int e;
+    if (file < 0) return ES_OK;
+    if (!keep) {
+        close_discarded(file);
+        return ES_OK;
+    }
+    if ((e = reserve_space(file)) != 0) {
+        close_discarded(file);
+        ES_FAIL(ctx, ES_EIO, "cannot write '%s': %s", path, strerror(e));
+    }
+    if (H5Fflush(file, H5F_SCOPE_GLOBAL) < 0) {
+        es_status rc = es__h5_fail(ctx, ES_EIO, "cannot write '%s'", path);
+        close_discarded(file);
+        return rc;
+    }
+    if (H5Fclose(file) < 0) return es__h5_fail(ctx, ES_EIO, "cannot write '%s'", path);
+    return ES_OK;
 }
 
 hid_t es__h5_file_access(void)

@@ -31,6 +31,7 @@ static es_status check_ds(es_store *s, es__h5_raw *raw, const char *name, H5T_cl
     es_status rc = ES_OK;
     uint64_t elem = 0, need = 1, have;
     *rows = -1;
+    if ((rc = es__h5_check_named(raw, s->file, name))) return rc;
     if ((ds = H5Dopen2(s->file, name, H5P_DEFAULT)) < 0)
         return es__h5_fail(ctx, ES_EFORMAT, "store: '%s': %s is missing or unreadable", s->path, name);
     if ((sp = H5Dget_space(ds)) < 0 || (t = H5Dget_type(ds)) < 0 ||
@@ -166,7 +167,7 @@ static es_status load_columns(es_store *s, es__h5_raw *raw)
     }
     for (int64_t c = 0; c < n; c++) {
         char full[600];
-        if (es__h5_bad_name(names[c]) || strlen(names[c]) > 500) {
+        if (es__h5_bad_name(names[c]) || strlen(names[c]) > ES__MAX_COLUMN_NAME) {
             rc = es__fail(ctx, ES_EFORMAT, "store: '%s': /labels column %lld has the bad name "
                           "'%.40s'", s->path, (long long)c, names[c]);
             goto done;
@@ -311,19 +312,20 @@ static es_status check_shapes(es_store *s, es__h5_raw *raw, int64_t *n)
 }
 
 /* The groups every open looks names up in: the root, then each of the
- * store's groups, each checked before HDF5 searches it or decodes its
- * attributes (store_groups.c). */
+ * store's groups, each header and symbol table checked before HDF5
+ * searches the group, opens it or decodes its attributes (store_headers.c,
+ * store_groups.c). */
 static es_status check_groups(es_store *s, es__h5_raw *raw)
 {
     static const char *const names[] = {"/topology", "/shapes", "/labels", "/analysis"};
-    es_status rc = es__h5_check_group(raw, s->file, "/");
-    if (rc == ES_OK) rc = es__h5_check_attrs(raw, s->file, "the root group");
+    es_status rc = es__h5_check_object(raw, s->file, "the root group");
+    if (rc == ES_OK) rc = es__h5_check_group(raw, s->file, "/");
     for (size_t i = 0; rc == ES_OK && i < sizeof names / sizeof names[0]; i++) {
         hid_t g;
         if (H5Lexists(s->file, names[i], H5P_DEFAULT) <= 0) continue;   /* said later */
+        if ((rc = es__h5_check_named(raw, s->file, names[i]))) break;
         if ((g = H5Gopen2(s->file, names[i], H5P_DEFAULT)) < 0) continue;
-        if ((rc = es__h5_check_group(raw, g, names[i])) == ES_OK)
-            rc = es__h5_check_attrs(raw, g, names[i]);
+        rc = es__h5_check_group(raw, g, names[i]);
         H5Gclose(g);
     }
     return rc;

@@ -12,49 +12,44 @@
  * Every public entry point runs with HDF5's error printing off
  * (H5E_BEGIN_TRY/H5E_END_TRY).
  */
-#define _GNU_SOURCE   /* memfd_create */
 #include "store/store_pkg.h"
 
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
-
-/* A working copy that is thrown away (an aborted or failed write) is closed
- * into a memory file. Closing flushes HDF5's caches, and when that write
- * fails too (the disk is full: the very failure being handled) libhdf5
- * 1.10.8 frees the file but keeps its identifier, then crashes at exit
- * closing it again (HDFFV-11052, fixed in 1.10.10). What the flush writes
- * into the memory file is deleted with it. A file size limit (RLIMIT_FSIZE)
- * applies to memory files too, so only that fault still reaches the bug. */
-static void close_discarded(hid_t file)
-{
-#if defined(__linux__) && defined(MFD_CLOEXEC)
-    void *h = NULL;
-    int sink = memfd_create("edgespace-discarded", MFD_CLOEXEC);
-    if (sink >= 0 && H5Fget_vfd_handle(file, H5P_DEFAULT, &h) >= 0 && h)
-        dup2(sink, *(int *)h);
-    if (sink >= 0) close(sink);
-#endif
-    H5Fclose(file);
-}
 
 static void release(es_store *s, bool keep_work)
 {
     if (!s) return;
     es_ctx *ctx = s->ctx;
-    if (s->file >= 0 && s->work && !keep_work) close_discarded(s->file);
-    else if (s->file >= 0) H5Fclose(s->file);
+    if (s->file >= 0) es__h5_file_close(ctx, s->file, !(s->work && !keep_work), s->path);
     s->file = -1;
     if (s->work && !keep_work) unlink(s->work);
     es__store_free_rows(s);
     es__free(ctx, s->work);
     es__free(ctx, s->path);
+    es__free(ctx, s->target);
     es__free(ctx, s);
+}
+
+/* Through a symbolic link writes replace its target (resolved now: the
+ * link is what the user named, the file what changes). */
+static es_status resolve_link(es_store *s)
+{
+    struct stat st;
+    char *real;
+    if (lstat(s->path, &st) != 0 || !S_ISLNK(st.st_mode)) return ES_OK;
+    if (!(real = realpath(s->path, NULL)))
+        ES_FAIL(s->ctx, errno == ENOENT ? ES_ENOTFOUND : ES_EIO, "store: '%s' is a symbolic "
+                "link to a missing file", s->path);
+    s->target = es__strdup(s->ctx, real);
+    free(real);
+    return s->target ? ES_OK : ES_ENOMEM;
 }
 
 static es_status open_impl(es_ctx *ctx, const char *path, es_store_mode mode, es_store **out)
@@ -74,11 +69,14 @@ static es_status open_impl(es_ctx *ctx, const char *path, es_store_mode mode, es
         if (is < 0) return es__h5_fail(ctx, ES_EIO, "store: cannot read '%s'", path);
         ES_FAIL(ctx, ES_EFORMAT, "store: '%s' is not an HDF5 file", path);
     }
+    /* what HDF5 decodes while opening (the root group's header) */
+    if ((rc = es__h5_check_file(ctx, path)) != ES_OK) return rc;
     if (!(s = es__calloc(ctx, 1, sizeof *s))) return ES_ENOMEM;
     s->ctx = ctx;
     s->file = -1;
     s->mode = mode;
     if (!(s->path = es__strdup(ctx, path))) { rc = ES_ENOMEM; goto fail; }
+    if (mode != ES_STORE_READ && (rc = resolve_link(s))) goto fail;
     /* Before opening: if another writer replaces the file in between, the
      * first write sees a different identity and refuses (never stale rows). */
     if (stat(path, &s->opened) != 0) {
@@ -153,6 +151,12 @@ static es_status create_impl(es_ctx *ctx, const char *path, int64_t nverts, int6
     }
     if (access(path, F_OK) == 0)
         ES_FAIL(ctx, ES_EEXIST, "store: '%s' exists already", path);
+    {
+        struct stat st;
+        if (lstat(path, &st) == 0)
+            ES_FAIL(ctx, ES_EEXIST, "store: '%s' is a symbolic link to a missing file; "
+                    "name the file itself", path);
+    }
     if (!(s = es__calloc(ctx, 1, sizeof *s))) return ES_ENOMEM;
     s->ctx = ctx;
     s->file = -1;
@@ -255,6 +259,52 @@ void es_store_abort(es_store *store)
     if (!store) return;
     H5E_BEGIN_TRY { release(store, false); } H5E_END_TRY
 }
+
+/* Back to the published store: the working copy is thrown away (as abort
+ * does) and the handle reopens and reloads the file, as open does. */
+static es_status rollback_impl(es_ctx *ctx, es_store *s)
+{
+    hid_t fapl;
+    es_status rc;
+    if (!s->work) return ES_OK;
+    if (s->is_new)
+        ES_FAIL(ctx, ES_EINVAL, "store: '%s' was never committed; abort it instead of rolling "
+                "back", s->path);
+    es__h5_file_close(ctx, s->file, false, s->work);
+    s->file = -1;
+    unlink(s->work);
+    es__free(s->ctx, s->work);
+    s->work = NULL;
+    s->broken = false;
+    es__store_free_rows(s);
+    if (stat(s->path, &s->opened) != 0) {
+        s->broken = true;
+        ES_FAIL(ctx, ES_EIO, "store: cannot reopen '%s': %s", s->path, strerror(errno));
+    }
+    fapl = es__h5_file_access();
+    s->file = H5Fopen(s->path, H5F_ACC_RDONLY, fapl);
+    es__h5_close(fapl);
+    if (s->file < 0) {
+        s->broken = true;
+        return es__h5_fail(ctx, ES_EIO, "store: cannot reopen '%s'", s->path);
+    }
+    if ((rc = es__store_load(s)) != ES_OK) {
+        s->broken = true;
+        if (ctx != s->ctx) es__fail(ctx, rc, "%s", es_ctx_errmsg(s->ctx));
+    }
+    return rc;
+}
+
+es_status es_store_rollback(es_ctx *ctx, es_store *store)
+{
+    es_status rc;
+    if (!store) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    H5E_BEGIN_TRY { rc = rollback_impl(ctx, store); } H5E_END_TRY
+    store->generation++;   /* what was read from the discarded writes is stale */
+    return rc;
+}
+
+int es_store_pending(const es_store *store) { return store && store->work; }
 
 void es_store_close(es_store *store)
 {

@@ -28,6 +28,13 @@
 #define ES__FORMAT_VERSION 1
 #define ES__FORMAT_VERSION_KIND 2
 
+/* Label column names are at most this many bytes (checked at open and
+ * append); coordinates at most ES__MAX_COORD in magnitude over an extent of
+ * at least ES__MIN_EXTENT (store_rows.c). */
+#define ES__MAX_COLUMN_NAME 500
+#define ES__MAX_COORD 1e30
+#define ES__MIN_EXTENT 1e-30
+
 /* faces: 3 x nfaces, edges: 2 x nedges (as es_mesh_faces/es_mesh_edges),
  * fingerprint: 16 hex digits (es_mesh_fingerprint) or "". */
 es_status es__store_create_raw(es_ctx *ctx, const char *path, int64_t nverts, int64_t nfaces,
@@ -37,6 +44,7 @@ es_status es__store_create_raw(es_ctx *ctx, const char *path, int64_t nverts, in
 struct es_store {
     es_ctx *ctx;
     char *path;            /* the store as named by the user */
+    char *target;          /* path's target when path is a symbolic link, or NULL */
     char *work;            /* working copy (writes) or NULL */
     hid_t file;
     es_store_mode mode;
@@ -72,6 +80,12 @@ void es__h5_close(hid_t id);
 hid_t es__h5_str_type(void);
 /* File access: HDF5 1.8-readable format, file locking where supported. */
 hid_t es__h5_file_access(void);
+/* Close a file this process opened, the one way every HDF5 writer closes
+ * (the store, statismo files): keep (flushed, then closed; a failed flush
+ * makes it a discarded file and returns ES_EIO naming path) or discard
+ * (closed into a memory file, so that a full disk cannot crash libhdf5
+ * 1.10.8 at exit). Negative ids are ignored. */
+es_status es__h5_file_close(es_ctx *ctx, hid_t file, bool keep, const char *path);
 /* Open a dataset with a 16 MiB chunk cache, or without any (for appends
  * and block reads, which move whole chunks). */
 hid_t es__h5_open_ds(hid_t loc, const char *name);
@@ -104,6 +118,11 @@ es_status es__h5_read_attr_i64(es_ctx *ctx, hid_t obj, const char *objname, cons
  * names the store in messages (borrowed). */
 typedef struct es__h5_raw es__h5_raw;
 es_status es__h5_raw_open(es_ctx *ctx, hid_t obj, const char *path, es__h5_raw **out);
+/* A raw reader of a file HDF5 has not opened: fd (the caller's, closed by
+ * the caller after es__h5_raw_close), the superblock's base address and
+ * sizes of addresses and lengths. */
+es_status es__h5_raw_open_fd(es_ctx *ctx, int fd, const char *path, uint64_t base, unsigned sa,
+                             unsigned ss, es__h5_raw **out);
 void es__h5_raw_close(es__h5_raw *raw);
 /* A whole 1-D string dataset (variable or fixed length) of exactly n rows
  * into out[0..n) (allocated through ctx; the caller frees what is non-NULL,
@@ -128,9 +147,11 @@ unsigned es__h5_raw_addr_size(const es__h5_raw *raw);
 unsigned es__h5_raw_length_size(const es__h5_raw *raw);
 es_ctx *es__h5_raw_ctx(const es__h5_raw *raw);
 const char *es__h5_raw_path(const es__h5_raw *raw);
-/* Each message of an object header: return 0 to go on, 1 to stop (ES_OK),
- * -1 if it is malformed (ES_EFORMAT). ES_ENOTFOUND when no call stopped. */
-typedef int (*es__h5_msg_fn)(void *ud, unsigned type, const uint8_t *msg, uint64_t n);
+/* Each message of an object header (its type, flags and bytes): return 0
+ * to go on, 1 to stop (ES_OK), -1 if it is malformed (ES_EFORMAT).
+ * ES_ENOTFOUND when no call stopped. */
+typedef int (*es__h5_msg_fn)(void *ud, unsigned type, unsigned flags, const uint8_t *msg,
+                             uint64_t n);
 es_status es__h5_raw_messages(es__h5_raw *raw, uint64_t oaddr, es__h5_msg_fn fn, void *ud);
 /* The object header address of an open object (group, dataset, file: its
  * root group). */
@@ -141,11 +162,20 @@ es_status es__h5_object_addr(es_ctx *ctx, hid_t obj, uint64_t *addr);
  * runs out (24 GB for three changed bytes) and B-tree children without
  * bound. A group with links in its header (new style) has nothing to check. */
 es_status es__h5_check_group(es__h5_raw *raw, hid_t group, const char *name);
-/* Check every attribute message of obj (name: for messages) before HDF5
- * decodes them (store_groups.c): libhdf5 1.10 copies an attribute's value
- * at the size its dataspace and datatype claim, past the message if they
- * claim more. */
-es_status es__h5_check_attrs(es__h5_raw *raw, hid_t obj, const char *name);
+/* Check every message of an object header before HDF5 decodes any of it
+ * (store_headers.c): the header at oaddr, of the open object obj, or of
+ * the object `name` under loc (found without decoding its header); name
+ * names it in messages. libhdf5 1.10 decodes what a header says with few
+ * checks (a layout message's version byte changed made H5Dopen divide by
+ * zero); a store object is opened only once its header passed. */
+es_status es__h5_check_header(es__h5_raw *raw, uint64_t oaddr, const char *name);
+es_status es__h5_check_object(es__h5_raw *raw, hid_t obj, const char *name);
+es_status es__h5_check_named(es__h5_raw *raw, hid_t loc, const char *name);
+/* Before HDF5 opens path at all: its superblock (versions 0 to 2) and the
+ * headers HDF5 decodes while opening (the root group's, a version 2
+ * superblock's extension), read raw (libhdf5 1.10 allocates what the root
+ * header's chunks claim, 2 GB and more, before it refuses them). */
+es_status es__h5_check_file(es_ctx *ctx, const char *path);
 /* A string attribute, or one integer or real as text, into buf[n],
  * truncated; ES_ENOTFOUND if absent. */
 es_status es__h5_read_attr_text(es_ctx *ctx, es__h5_raw *raw, hid_t obj, const char *key,

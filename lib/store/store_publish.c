@@ -22,7 +22,7 @@
 #include "store/store_pkg.h"
 #include "core/files.h"
 
-#include <dirent.h>
+#include <limits.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <signal.h>
@@ -35,47 +35,34 @@
 #include <time.h>
 #include <unistd.h>
 
-/* kill(pid, 0) failing with ESRCH is the only proof that the writer is
- * gone: EPERM means alive under another user, so its copy is kept. */
+/* Working copies are ".<base>.tmp-<pid>-<unique>" (the base shortened when
+ * long: core/file_replace.c): the next writer removes those whose process
+ * is gone. */
 void es__store_clean_stale(const char *path)
 {
-    char dirbuf[4096], prefix[512];
-    const char *base = es__path_base(path);
-    size_t dn = (size_t)(base - path);
-    DIR *d;
-    struct dirent *e;
-    if (dn >= sizeof dirbuf) return;
-    if (dn == 0) snprintf(dirbuf, sizeof dirbuf, ".");
-    else {
-        memcpy(dirbuf, path, dn);
-        dirbuf[dn] = '\0';
-    }
-    snprintf(prefix, sizeof prefix, ".%s.tmp-", base);
-    if (!(d = opendir(dirbuf))) return;
-    while ((e = readdir(d))) {
-        size_t pn = strlen(prefix);
-        char *end, full[4608];
-        long pid;
-        if (strncmp(e->d_name, prefix, pn)) continue;
-        pid = strtol(e->d_name + pn, &end, 10);
-        if (end == e->d_name + pn || *end != '-' || pid <= 0) continue;
-        if (pid == (long)getpid() || kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue;
-        snprintf(full, sizeof full, "%s/%s", dirbuf, e->d_name);
-        unlink(full);
-    }
-    closedir(d);
+    char sb[NAME_MAX + 1], prefix[NAME_MAX + 8];
+    es__short_base(es__path_base(path), 56, sb, sizeof sb);
+    snprintf(prefix, sizeof prefix, ".%s.tmp-", sb);
+    es__remove_stale(path, prefix, "");
 }
+
+/* The file the store's writes replace: the path given, or through a
+ * symbolic link its target (a commit renames over the target and keeps the
+ * link; it used to replace the link by a file and leave the target as it
+ * was). */
+static const char *target_of(const es_store *s) { return s->target ? s->target : s->path; }
 
 char *es__store_temp_name(es_store *s)
 {
-    const char *base = es__path_base(s->path);
-    size_t dn = (size_t)(base - s->path), n = strlen(s->path) + 64;
-    char *t = es__malloc(s->ctx, n);
+    const char *tp = target_of(s), *base = es__path_base(tp);
+    size_t dn = (size_t)(base - tp), n = strlen(tp) + 64;
+    char sb[NAME_MAX + 1], *t = es__malloc(s->ctx, n);
     struct timespec ts;
     clock_gettime(CLOCK_REALTIME, &ts);
+    es__short_base(base, 56, sb, sizeof sb);
     /* pid first (stale copies are recognized by it), then enough to keep
      * two handles of one process apart. */
-    if (t) snprintf(t, n, "%.*s.%s.tmp-%ld-%lx%lx%u", (int)dn, s->path, base, (long)getpid(),
+    if (t) snprintf(t, n, "%.*s.%s.tmp-%ld-%lx%lx%u", (int)dn, tp, sb, (long)getpid(),
                     (unsigned long)(uintptr_t)s, (unsigned long)ts.tv_nsec, s->tmp_counter++);
     return t;
 }
@@ -155,12 +142,14 @@ es_status es__store_begin_write(es_store *s)
     if (s->broken)
         ES_FAIL(ctx, ES_EIO, "store: an earlier write to '%s' failed; reopen the store",
                 s->path);
+    /* cancelled work stores nothing (es_ctx_cancel) */
+    if ((rc = es__cancelled(ctx, "a write"))) return rc;
     /* whatever is about to be written: values read before are stale */
     s->generation++;
     if (s->work) return ES_OK;
-    es__store_clean_stale(s->path);
+    es__store_clean_stale(target_of(s));
     if (!(s->work = es__store_temp_name(s))) return ES_ENOMEM;
-    if ((rc = copy_file(ctx, s->path, s->work, &s->orig))) goto fail;
+    if ((rc = copy_file(ctx, target_of(s), s->work, &s->orig))) goto fail;
     if (!same_identity(&s->orig, &s->opened)) {
         /* Rows, ids and columns in memory are those of the file we opened;
          * writing them onto another writer's newer store would corrupt it. */
@@ -197,16 +186,15 @@ es_status es__store_publish(es_ctx *ctx, es_store *s)
     if (s->broken)
         ES_FAIL(ctx, ES_EIO, "store: an earlier write to '%s' failed; nothing committed",
                 s->path);
-    if (H5Fflush(s->file, H5F_SCOPE_GLOBAL) < 0) {
-        rc = es__h5_fail(ctx, ES_EIO, "store: cannot flush '%s'", s->work);
-        goto fail;
-    }
-    if (H5Fclose(s->file) < 0) {
-        s->file = -1;
-        rc = es__h5_fail(ctx, ES_EIO, "store: cannot close '%s'", s->work);
-        goto fail;
-    }
+    if ((rc = es__cancelled(ctx, "a commit")) || (rc = es__cancelled(s->ctx, "a commit")))
+        return rc;
+    /* flushed, then closed; a failed flush (a full disk) discards it safely */
+    rc = es__h5_file_close(ctx, s->file, true, s->path);
     s->file = -1;
+    if (rc != ES_OK) {
+        rc = es__fail(ctx, rc, "store: %s", es_ctx_errmsg(ctx));
+        goto fail;
+    }
     if ((rc = fsync_path(ctx, s->work, false))) goto fail;
     /* the identity the published file will have (link and rename keep the
      * inode): taken now, a commit landing right after ours is not mistaken
@@ -233,16 +221,16 @@ es_status es__store_publish(es_ctx *ctx, es_store *s)
          * this folder (an advisory lock on the folder): otherwise another
          * commit landing between them would be replaced unseen. */
         int dfd = -1;
-        if ((dir = es__path_dir(ctx, s->path)) &&
+        if ((dir = es__path_dir(ctx, target_of(s))) &&
             (dfd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC)) >= 0)
             while (flock(dfd, LOCK_EX) != 0 && errno == EINTR) {
             }
         /* a folder that cannot be opened or locked (unreadable, some network
          * file systems) leaves the commit unlocked: the identity check alone */
-        if (stat(s->path, &now) != 0 || !same_identity(&now, &s->orig)) {
+        if (stat(target_of(s), &now) != 0 || !same_identity(&now, &s->orig)) {
             rc = es__fail(ctx, ES_EIO, "store: '%s' was changed by another writer since it "
                           "was opened; nothing written", s->path);
-        } else if (rename(s->work, s->path) != 0) {
+        } else if (rename(s->work, target_of(s)) != 0) {
             rc = es__fail(ctx, ES_EIO, "store: cannot replace '%s': %s", s->path,
                           strerror(errno));
         }
@@ -252,7 +240,7 @@ es_status es__store_publish(es_ctx *ctx, es_store *s)
         if (rc != ES_OK) goto fail;
     }
     s->opened = done;
-    if ((dir = es__path_dir(ctx, s->path))) {
+    if ((dir = es__path_dir(ctx, target_of(s)))) {
         fsync_path(ctx, dir, true);
         es__free(ctx, dir);
     }

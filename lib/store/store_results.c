@@ -39,10 +39,11 @@ static int split_path(es_ctx *ctx, const char *path, char parts[8][128], es_stat
     return n;
 }
 
-/* Whether every component of full exists. Each group below /analysis is
- * checked (store_groups.c) before HDF5 looks the next name up in it: a
- * result's groups come from the file like everything else. ES_OK with
- * *exists, or the check's refusal. */
+/* Whether every component of full exists. Each object below /analysis is
+ * checked (its header by store_headers.c, a group's symbol table by
+ * store_groups.c) before HDF5 looks the next name up in it or opens it: a
+ * result's groups and datasets come from the file like everything else.
+ * ES_OK with *exists, or the check's refusal. */
 static es_status find_link(es_ctx *ctx, es_store *s, const char *full, bool *exists)
 {
     char buf[1200];
@@ -58,17 +59,20 @@ static es_status find_link(es_ctx *ctx, es_store *s, const char *full, bool *exi
         char save = *p;
         *p = '\0';
         if (H5Lexists(s->file, buf, H5P_DEFAULT) <= 0) break;
+        if (++depth >= 2) {   /* /analysis itself was checked at open */
+            if ((raw || (rc = es__h5_raw_open(ctx, s->file, s->path, &raw)) == ES_OK) &&
+                (rc = es__h5_check_named(raw, s->file, buf)) == ES_OK && save) {
+                hid_t g = H5Gopen2(s->file, buf, H5P_DEFAULT);
+                if (g >= 0) {
+                    rc = es__h5_check_group(raw, g, buf);
+                    H5Gclose(g);
+                }
+            }
+            if (rc != ES_OK) break;
+        }
         if (!save) {
             *exists = true;
             break;
-        }
-        if (++depth >= 2) {   /* /analysis itself was checked at open */
-            hid_t g = H5Gopen2(s->file, buf, H5P_DEFAULT);
-            if (g >= 0) {
-                if (raw || (rc = es__h5_raw_open(ctx, g, s->path, &raw)) == ES_OK)
-                    rc = es__h5_check_group(raw, g, buf);
-                H5Gclose(g);
-            }
         }
         *p = save;
     }
@@ -309,17 +313,6 @@ typedef struct attr_value {
     int64_t i;
 } attr_value;
 
-/* The attribute messages of obj checked (store_groups.c) before HDF5
- * decodes any of them. */
-static es_status check_attrs_of(es_ctx *ctx, es_store *s, hid_t obj, const char *full)
-{
-    es__h5_raw *raw = NULL;
-    es_status rc = es__h5_raw_open(ctx, obj, s->path, &raw);
-    if (rc == ES_OK) rc = es__h5_check_attrs(raw, obj, full);
-    es__h5_raw_close(raw);
-    return rc;
-}
-
 static es_status put_attr_impl(es_ctx *ctx, es_store *s, const char *path, const char *key,
                                const attr_value *v)
 {
@@ -335,11 +328,10 @@ static es_status put_attr_impl(es_ctx *ctx, es_store *s, const char *path, const
     full_path(full, sizeof full, path);
     if ((rc = find_link(ctx, s, full, &e))) return rc;
     if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
+    /* (find_link checked its header: every attribute HDF5 decodes) */
     if ((obj = H5Oopen(s->file, full, H5P_DEFAULT)) < 0)
         return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
-    rc = check_attrs_of(ctx, s, obj, full);
-    if (rc == ES_OK)
-        rc = v->type == 1 ? es__h5_write_attr_f64(ctx, obj, key, v->d)
+    rc = v->type == 1 ? es__h5_write_attr_f64(ctx, obj, key, v->d)
              : v->type == 2 ? es__h5_write_attr_i64(ctx, obj, key, v->i)
                             : es__h5_write_attr_str(ctx, obj, key, v->s);
     H5Oclose(obj);
@@ -558,13 +550,10 @@ static es_status get_attr_impl(es_ctx *ctx, es_store *s, const char *path, const
     full_path(full, sizeof full, path);
     if ((rc = find_link(ctx, s, full, &e))) return rc;
     if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
+    /* HDF5 decodes every attribute of the object to find one: find_link
+     * checked them all */
     if ((obj = H5Oopen(s->file, full, H5P_DEFAULT)) < 0)
         return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
-    /* HDF5 decodes every attribute of the object to find one: checked first */
-    if ((rc = check_attrs_of(ctx, s, obj, full))) {
-        H5Oclose(obj);
-        return rc;
-    }
     if (H5Aexists(obj, key) <= 0) {
         H5Oclose(obj);
         ES_FAIL(ctx, ES_ENOTFOUND, "store: %s has no attribute '%s'", full, key);
@@ -690,13 +679,9 @@ static es_status attrs_impl(es_ctx *ctx, es_store *s, const char *path, char ***
     bool e;
     if ((rc = find_link(ctx, s, full, &e))) return rc;
     if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
+    /* (its header, every attribute message, checked by find_link) */
     hid_t obj = H5Oopen(s->file, full, H5P_DEFAULT);
     if (obj < 0) return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
-    /* the attribute messages checked before HDF5 decodes them */
-    if ((rc = check_attrs_of(ctx, s, obj, full))) {
-        H5Oclose(obj);
-        return rc;
-    }
     if (H5Aiterate2(obj, H5_INDEX_NAME, H5_ITER_INC, NULL, attr_cb, &l) < 0) {
         rc = l.rc ? l.rc : es__h5_fail(ctx, ES_EIO, "store: cannot list the attributes of %s",
                                        full);

@@ -112,6 +112,29 @@ done:
     return ES_OK;
 }
 
+es_status es__h5_raw_open_fd(es_ctx *ctx, int fd, const char *path, uint64_t base, unsigned sa,
+                             unsigned ss, es__h5_raw **out)
+{
+    es__h5_raw *r;
+    struct stat st;
+    *out = NULL;
+    if (fstat(fd, &st) != 0)
+        ES_FAIL(ctx, ES_EIO, "store: cannot read '%s': %s", path, strerror(errno));
+    if ((sa != 4 && sa != 8) || (ss != 4 && ss != 8))
+        ES_FAIL(ctx, ES_EFORMAT, "store: '%s': %u-byte addresses and %u-byte lengths (edgespace "
+                "reads 4 or 8)", path, sa, ss);
+    if (!(r = es__calloc(ctx, 1, sizeof *r))) return ES_ENOMEM;
+    r->ctx = ctx;
+    r->path = path;
+    r->fd = fd;
+    r->sa = sa;
+    r->ss = ss;
+    r->base = base;
+    r->eof = (uint64_t)st.st_size;
+    *out = r;
+    return ES_OK;
+}
+
 unsigned es__h5_raw_vlen_size(const es__h5_raw *r) { return 8 + r->sa; }
 
 es_status es__h5_object_addr(es_ctx *ctx, hid_t obj, uint64_t *addr)
@@ -515,16 +538,18 @@ es_status es__h5_raw_messages(es__h5_raw *r, uint64_t oaddr, es__h5_msg_fn fn, v
         }
         for (;;) {
             uint64_t hsz = v2 ? 4u + 2u * (unsigned)crt : 8u, type, msz;
+            unsigned flags;
             int k;
             if (end - p < hsz) break;
             type = v2 ? b[p] : le(b + p, 2);
             msz = le(b + p + (v2 ? 1 : 2), 2);
+            flags = b[p + (v2 ? 3 : 4)];
             p += hsz;
             if (msz > end - p) { es__free(r->ctx, b); goto corrupt; }
             if (type == 0x10) {                  /* continuation */
                 if (msz < (uint64_t)r->sa + r->ss || nq == 64) { es__free(r->ctx, b); goto corrupt; }
                 q[nq++] = (ochunk){le(b + p, r->sa), le(b + p + r->sa, r->ss)};
-            } else if ((k = fn(ud, (unsigned)type, b + p, msz)) != 0) {
+            } else if ((k = fn(ud, (unsigned)type, flags, b + p, msz)) != 0) {
                 es__free(r->ctx, b);
                 if (k < 0) goto corrupt;
                 return ES_OK;
@@ -570,12 +595,13 @@ typedef struct attr_find {
     int nomem;
 } attr_find;
 
-static int find_attr(void *ud, unsigned type, const uint8_t *m, uint64_t n)
+static int find_attr(void *ud, unsigned type, unsigned flags, const uint8_t *m, uint64_t n)
 {
     attr_find *a = ud;
     const uint8_t *d;
     uint64_t dl;
     int k;
+    (void)flags;
     if (type != 0x0C) return 0;
     if ((k = attr_value(m, n, a->key, &d, &dl)) <= 0) return k;
     if (!(a->val = es__malloc(a->r->ctx, (size_t)dl + 1))) a->nomem = 1;

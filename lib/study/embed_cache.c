@@ -5,13 +5,15 @@
  * 9,409 vertices, 0.6 s of CPU to make, 40 MB to read back).
  *
  * The file (datasets-spec/cache-format.md) is STORE.es-cache: a header of
- * little-endian 64-bit words (magic, format version, key, V, E, N) and the
- * arrays. The key hashes what the cached values depend on: the format and
- * algorithm version, the topology fingerprint, the sizes, and every row's id
- * with its content hash, or, when a row has none (rows appended through the
- * API), its stored positions. A file whose key, sizes or length disagree is
- * stale and made again; one that cannot be written (a read-only folder)
- * only costs the time. Written whole or not at all (es__replace_begin).
+ * little-endian 64-bit words (magic, format version, key, V, E, N, the
+ * body's check word) and the arrays. The key hashes what the cached values
+ * depend on: the format and algorithm version, the topology fingerprint,
+ * the sizes, and every row's id with its content hash, or, when a row has
+ * none (rows appended through the API), its stored positions. A file whose
+ * key, sizes or length disagree is stale and made again, as is one whose
+ * body fails its check word or whose vertex order is not a permutation; one
+ * that cannot be written (a read-only folder) only costs the time. Written
+ * whole or not at all (es__replace_begin).
  */
 #include "study/study_pkg.h"
 #include "core/hash.h"
@@ -22,7 +24,8 @@
 #include <string.h>
 
 #define CACHE_MAGIC 0x3165686361437365ull   /* "esCache1" */
-#define CACHE_VERSION 1                     /* bump when the cached values change meaning */
+#define CACHE_VERSION 2                     /* bump when the cached values change meaning */
+#define CACHE_HEAD 7                        /* header words */
 
 /* The cache file's path: the store's with ".es-cache" appended. */
 static void cache_path(const es_store *s, char *buf, size_t n)
@@ -58,16 +61,54 @@ es_status es__study_cache_key(es_ctx *ctx, es_store *s, uint64_t *key)
     return ES_OK;
 }
 
+/* The body's check word: FNV-1a's step over whole 64-bit words (h ^ w,
+ * times the FNV prime). Both steps are bijections, so a body that differs
+ * in any one word always gives another check; a changed value that stays
+ * finite (a flipped sign) would otherwise be taken as a row's. */
+static uint64_t check_words(uint64_t h, const void *p, int64_t nwords)
+{
+    const uint64_t *w = p;
+    for (int64_t i = 0; i < nwords; i++) h = (h ^ w[i]) * ES__FNV_PRIME;
+    return h;
+}
+
+static uint64_t body_check(int64_t nv, int64_t ne, int64_t n, const int64_t *order,
+                           const double *aligned, const double *alpha)
+{
+    uint64_t h = check_words(ES__FNV_OFFSET, order, nv);
+    h = check_words(h, aligned, 3 * nv * n);
+    return check_words(h, alpha, ne * n);
+}
+
 static int read_all(FILE *f, void *p, size_t bytes)
 {
     return fread(p, 1, bytes, f) == bytes;
+}
+
+/* Whether order is a permutation of 0 .. nv-1 (a corrupt cache's would be
+ * refused by es_embedder_new_ordered and fail the command; the cache is
+ * made again instead). *rc: ES_ENOMEM when it cannot tell. */
+static int is_permutation(es_ctx *ctx, const int64_t *order, int64_t nv, es_status *rc)
+{
+    unsigned char *seen = es__calloc(ctx, (size_t)nv + 1, 1);
+    int ok = 1;
+    if (!seen) {
+        *rc = ES_ENOMEM;
+        return 0;
+    }
+    for (int64_t j = 0; ok && j < nv; j++) {
+        ok = order[j] >= 0 && order[j] < nv && !seen[order[j]];
+        if (ok) seen[order[j]] = 1;
+    }
+    es__free(ctx, seen);
+    return ok;
 }
 
 es_status es__study_cache_load(es_ctx *ctx, es_store *s, uint64_t key, int64_t **order,
                                es_study_rows **rows)
 {
     char path[4200];
-    uint64_t head[6];
+    uint64_t head[CACHE_HEAD];
     int64_t nv = es_store_nverts(s), ne = es_store_nedges(s), n = es_store_nrows(s);
     double *aligned = NULL, *alpha = NULL;
     es_study_rows *r = NULL;
@@ -95,6 +136,20 @@ es_status es__study_cache_load(es_ctx *ctx, es_store *s, uint64_t key, int64_t *
         ord = NULL, r = NULL;
     }
     fclose(f);
+    if (r && body_check(nv, ne, n, ord, aligned, alpha) != head[6]) {
+        es__info(ctx, "embed: the cache %s does not match its check word (changed since it "
+                 "was written); made again", path);
+        es__free(ctx, ord);
+        es_study_rows_free(r);
+        return ES_OK;
+    }
+    if (r && !is_permutation(ctx, ord, nv, &rc)) {
+        es__info(ctx, "embed: the cache %s holds a vertex order that is not a permutation; "
+                 "made again", path);
+        es__free(ctx, ord);
+        es_study_rows_free(r);
+        return rc;
+    }
     for (int64_t i = 0; r && i < 3 * nv * n; i++)
         if (!isfinite(aligned[i])) rc = ES_EFORMAT;
     for (int64_t i = 0; r && i < ne * n; i++)
@@ -121,12 +176,13 @@ void es__study_cache_save(es_ctx *ctx, es_store *s, uint64_t key, const int64_t 
 {
     char path[4200];
     int64_t nv = es_store_nverts(s), ne = es_store_nedges(s), n = es_store_nrows(s);
-    uint64_t head[6] = {CACHE_MAGIC, CACHE_VERSION, key, (uint64_t)nv, (uint64_t)ne, (uint64_t)n};
     const double *aligned, *alpha;
     es__file_replace w;
     es_ctx *quiet;
     cache_path(s, path, sizeof path);
     es__study_rows_arrays(rows, &aligned, &alpha);
+    uint64_t head[CACHE_HEAD] = {CACHE_MAGIC, CACHE_VERSION, key, (uint64_t)nv, (uint64_t)ne,
+                                 (uint64_t)n, body_check(nv, ne, n, order, aligned, alpha)};
     /* a cache that cannot be written is no failure of the command: its
      * message goes to a context of its own and into the log */
     if (es_ctx_new(&quiet) != ES_OK) return;

@@ -5,6 +5,7 @@
  * files, and the stored result with its provenance. */
 #include "study/study_pkg.h"
 #include "edgespace/es_io.h"
+#include "meshio/meshio_private.h"
 
 #include <errno.h>
 #include <math.h>
@@ -68,7 +69,7 @@ static es_status choose_start(es_ctx *ctx, es_store *s, const es_mesh *mesh, con
  * closure comes first because render --scalars colours by the first
  * column. */
 static es_status write_residuals(es_ctx *ctx, const char *path, const es_embedder *emb,
-                                 int64_t nv)
+                                 int64_t nv, es__file_set *set)
 {
     const double *closure = es_embedder_vertex_closure(emb);
     const double *edge_error = es_embedder_vertex_edge_error(emb);
@@ -76,6 +77,7 @@ static es_status write_residuals(es_ctx *ctx, const char *path, const es_embedde
     es__table_out t;
     es_status rc = es__table_begin(ctx, path, &t);
     if (rc != ES_OK) return rc;
+    t.set = set;
     fputs(dev ? "closure,edge_error,deviation\n" : "closure,edge_error\n", t.f);
     for (int64_t v = 0; v < nv; v++) {
         fprintf(t.f, "%.17g,%.17g", closure[v], edge_error[v]);
@@ -110,7 +112,7 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
     double own;
     int64_t init_row = -1, *sel = NULL, nsel = 0, ne, nv, n = es_store_nrows(s);
     const int prior = !o || !o->init || !strcmp(o->init, "prior");
-    char stage_out[4200] = "", stage_res[4200] = "";
+    es__file_set files = {0};   /* the mesh and residuals, renamed into place together */
     es_status rc;
     memset(res, 0, sizeof *res);
     if (!o || !o->point) ES_FAIL(ctx, ES_EINVAL, "embed: no point given");
@@ -175,17 +177,10 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
     /* with a stored result the files are staged beside their targets and
      * renamed into place after the commit: a failed store write leaves no
      * mesh behind, and an old file as it was */
-    if (o->name) {
-        snprintf(stage_out, sizeof stage_out, "%s.%ld.staged", o->output ? o->output : "",
-                 (long)getpid());
-        snprintf(stage_res, sizeof stage_res, "%s.%ld.staged",
-                 o->residuals ? o->residuals : "", (long)getpid());
-    }
-    if ((o->output && (rc = es_mesh_write(ctx, o->name ? stage_out : o->output,
-                                          es_mesh_format_from_path(o->output), mesh, xyz,
-                                          NULL)) != ES_OK) ||
-        (o->residuals && (rc = write_residuals(ctx, o->name ? stage_res : o->residuals, emb,
-                                               nv)) != ES_OK))
+    if ((o->output && (rc = es__mesh_write_staged(ctx, o->output,
+                                                  es_mesh_format_from_path(o->output), mesh,
+                                                  xyz, &files)) != ES_OK) ||
+        (o->residuals && (rc = write_residuals(ctx, o->residuals, emb, nv, &files)) != ES_OK))
         goto done;
     if (o->name) {
         /* the rows whose positions started the embedding (none for a mesh:
@@ -199,18 +194,14 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
                                            &res->report, res->init)) != ES_OK ||
             (rc = es_store_commit(ctx, s)) != ES_OK)
             goto done;
-        if (o->output && rename(stage_out, o->output) != 0)
-            rc = es__fail(ctx, ES_EIO, "embed: stored as embed/%s, but cannot write '%s': %s",
-                          o->name, o->output, strerror(errno));
-        else if (o->residuals && rename(stage_res, o->residuals) != 0)
-            rc = es__fail(ctx, ES_EIO, "embed: stored as embed/%s, but cannot write '%s': %s",
-                          o->name, o->residuals, strerror(errno));
+    }
+    if ((rc = es__file_set_commit(ctx, &files)) != ES_OK && o->name) {
+        char msg[1024];
+        snprintf(msg, sizeof msg, "%s", es_ctx_errmsg(ctx));
+        rc = es__fail(ctx, rc, "embed: stored as embed/%s, but %s", o->name, msg);
     }
 done:
-    if (o->name && rc != ES_OK) {
-        if (o->output) remove(stage_out);
-        if (o->residuals) remove(stage_res);
-    }
+    es__file_set_abort(ctx, &files);   /* what is left of it: nothing after a commit */
     if (se) emb = NULL;   /* the session's */
     es_embedder_free(emb);
     if (se != o->session) es_study_embedder_free(se);

@@ -70,6 +70,7 @@ es_status es_study_embedder_open(es_ctx *ctx, es_store *store, int use_cache,
     se->nv = es_mesh_nverts(se->mesh);
     se->ne = es_mesh_nedges(se->mesh);
     se->n = es_store_nrows(store);
+    if ((rc = es__study_rows_check_memory(ctx, se->mesh, se->n)) != ES_OK) goto fail;
     se->target = es__alloc_array(ctx, se->ne, sizeof *se->target);
     se->w = es__alloc_array(ctx, se->n, sizeof *se->w);
     se->prior = es__alloc_array(ctx, 3 * se->nv + 2 * se->ne, sizeof *se->prior);

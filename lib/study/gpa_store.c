@@ -58,7 +58,7 @@ es_status es_study_gpa(es_ctx *ctx, es_store *store, const char *name, const int
         if ((rc = es_store_read_positions(ctx, store, r, b.row)) != ES_OK) goto done;
         es_procrustes_from_xyz(k, b.row, b.x + j * kd3);
         for (int64_t v = 0; v < k && planar; v++) planar = b.x[j * kd3 + 2 * k + v] == 0.0;
-        es__progress(ctx, "reading positions", j + 1, n);
+        if ((rc = es__progress(ctx, "reading positions", j + 1, n))) goto done;
     }
     int d = planar ? 2 : 3;
     int64_t kd = k * d;

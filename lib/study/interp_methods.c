@@ -22,6 +22,7 @@
 #include "study/study_pkg.h"
 #include "edgespace/es_io.h"
 #include "edgespace/es_geom.h"
+#include "meshio/meshio_private.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -34,6 +35,7 @@ typedef struct mwalk {
     const es_mesh *mesh;
     const char *name;
     int64_t ra, rb;
+    es__file_set files;     /* the frames, renamed into place at the end */
     const es_mesh *file_mesh;   /* the frame files' topology, when not mesh's (an open
                                    store's meshes closed off for the conformal morph) */
     const double *file_xyz;
@@ -63,8 +65,9 @@ static es_status emit(mwalk *w, int64_t i, const char *heading, const double *ta
     int64_t rows[2] = {w->ra, w->rb};
     es_status rc;
     es__study_frame_names(o, w->name, i, fname, sizeof fname, rname, sizeof rname);
-    if ((rc = es_mesh_write(w->ctx, fname, ES_FORMAT_AUTO, w->file_mesh ? w->file_mesh : w->mesh,
-                            w->file_mesh ? w->file_xyz : xyz, NULL)) != ES_OK)
+    if ((rc = es__mesh_write_staged(w->ctx, fname, ES_FORMAT_AUTO,
+                                    w->file_mesh ? w->file_mesh : w->mesh,
+                                    w->file_mesh ? w->file_xyz : xyz, &w->files)) != ES_OK)
         return rc;
     if (o->frame) o->frame(o->userdata, i, o->steps, fname, heading, rep);
     if (!o->command) return ES_OK;
@@ -132,7 +135,7 @@ static es_status geometric(mwalk *w, const double *xa, const double *xb)
         snprintf(params, sizeof params, "method=%s; from=%s; to=%s; t=%.17g",
                  es_morph_method_name(o->method), o->from, o->to, t);
         rc = emit(w, i, heading, len, xyz, &rep, NULL, vc, ve, params);
-        es__progress(ctx, "interp", i + 1, o->steps);
+        if (rc == ES_OK) rc = es__progress(ctx, "interp", i + 1, o->steps);
     }
     es_multiscale_free(ms);
     es_shape_space_free(ss);
@@ -175,7 +178,7 @@ static es_status paper(mwalk *w, const double *xa, const double *xb)
                  t);
         rc = emit(w, i, heading, len, xyz, &rep, emb, NULL, NULL, params);
         memcpy(prev, xyz, 3 * (size_t)nv * sizeof *prev);
-        es__progress(ctx, "interp", i + 1, o->steps);
+        if (rc == ES_OK) rc = es__progress(ctx, "interp", i + 1, o->steps);
     }
     es_embedder_free(emb);
     es__free(ctx, buf);
@@ -229,7 +232,7 @@ static es_status conformal(mwalk *w, const double *xa)
         rc = emit(w, i, heading, target, xyz, &rep, NULL, es_embedder_vertex_closure(emb),
                   es_embedder_vertex_edge_error(emb), params);
         memcpy(prev, xyz, 3 * (size_t)cv * sizeof *prev);
-        es__progress(ctx, "interp", i + 1, o->steps);
+        if (rc == ES_OK) rc = es__progress(ctx, "interp", i + 1, o->steps);
     }
     w->file_mesh = NULL;
     es_embedder_free(emb);
@@ -305,7 +308,7 @@ static es_status data_driven(mwalk *w, int lri)
         }
         for (int64_t r = 0; rc == ES_OK && r < n; r++) {
             rc = es_lri_encode(ctx, L, X + 3 * nv * r, feat + dim * r);
-            es__progress(ctx, "interp: shape coordinates", r + 1, n);
+            if (rc == ES_OK) rc = es__progress(ctx, "interp: shape coordinates", r + 1, n);
         }
     }
     if (rc == ES_OK) rc = es_data_path_coords(ctx, dim, n, lri ? feat : l, dim, coords, &nc);
@@ -350,7 +353,7 @@ static es_status data_driven(mwalk *w, int lri)
         rc = lri ? emit(w, i, heading, tl, xyz, &rep, NULL, vc, ve, params)
                  : emit(w, i, heading, v, xyz, &rep, es_study_embedder_embedder(se), NULL, NULL,
                         params);
-        es__progress(ctx, "interp", i + 1, m);
+        if (rc == ES_OK) rc = es__progress(ctx, "interp", i + 1, m);
     }
     es_lri_free(L);
     es_study_embedder_free(se);
@@ -373,9 +376,9 @@ static es_status end_row(es_ctx *ctx, es_store *s, const es_study_interp_opts *o
 }
 
 es_status es__study_interp_method(es_ctx *ctx, es_store *store, const es_study_interp_opts *o,
-                                  const es_mesh *mesh, const char *name)
+                                  const es_mesh *mesh, const char *name, int was_pending)
 {
-    mwalk w = {ctx, store, o, mesh, name, -1, -1, NULL, NULL};
+    mwalk w = {ctx, store, o, mesh, name, -1, -1, {0}, NULL, NULL};
     double *xa = NULL, *xb = NULL;
     es_status rc;
     if (!es_morph_method_name(o->method))
@@ -402,6 +405,5 @@ es_status es__study_interp_method(es_ctx *ctx, es_store *store, const es_study_i
                                                  : geometric(&w, xa, xb);
         es__free(ctx, xa);
     }
-    if (rc == ES_OK && o->command) rc = es_store_commit(ctx, store);
-    return rc;
+    return es__study_frames_done(ctx, store, o, rc, was_pending, &w.files);
 }

@@ -12,10 +12,14 @@
  * interpolation of the rows' (the shortest arc, as es_interp_targets). A
  * weighted combination of rows is one such point. Every frame is checked
  * before the first is written: a walk that leaves edge-length space is
- * refused and leaves nothing behind. */
+ * refused and leaves nothing behind. The frame files appear all together
+ * once the walk is complete (and stored), or none of them: each is staged
+ * beside its name and renamed into place at the end (a full disk used to
+ * leave new and old frames mixed). */
 #include "study/study_pkg.h"
 #include "edgespace/es_io.h"
 #include "core/files.h"
+#include "meshio/meshio_private.h"
 
 #include <ctype.h>
 #include <math.h>
@@ -91,6 +95,7 @@ typedef struct walk {
     es_embedder *emb;
     es_study_embedder *se;   /* the embedder and the rows for priors (cached) */
     char name[256];
+    es__file_set files;     /* the frames, renamed into place at the end */
 } walk;
 
 /* Frame i: its mesh file (the pattern expanded), the caller's callback,
@@ -104,12 +109,31 @@ static es_status emit_frame(walk *wk, int64_t i, const char *heading, const doub
     char fname[4096], rname[300];
     es_status rc;
     es__study_frame_names(o, wk->name, i, fname, sizeof fname, rname, sizeof rname);
-    if ((rc = es_mesh_write(wk->ctx, fname, ES_FORMAT_AUTO, wk->mesh, xyz, NULL)) != ES_OK)
+    if ((rc = es__mesh_write_staged(wk->ctx, fname, ES_FORMAT_AUTO, wk->mesh, xyz,
+                                    &wk->files)) != ES_OK)
         return rc;
     if (o->frame) o->frame(o->userdata, i, o->steps, fname, heading, rep);
     if (!o->command) return ES_OK;
     return es_study_store_embedding(wk->ctx, wk->store, rname, prov, wk->emb, target, xyz, rep,
                                     init);
+}
+
+es_status es__study_frames_done(es_ctx *ctx, es_store *store, const es_study_interp_opts *o,
+                                es_status rc, int was_pending, es__file_set *files)
+{
+    if (rc == ES_OK && o->command) rc = es_store_commit(ctx, store);
+    if (rc != ES_OK) {
+        char msg[1024];
+        es__file_set_abort(ctx, files);
+        /* frames already stored in the working copy go with the files */
+        snprintf(msg, sizeof msg, "%s", es_ctx_errmsg(ctx));
+        if (o->command && !was_pending && es_store_pending(store) &&
+            es_store_rollback(ctx, store) != ES_OK)
+            es__warn(ctx, "%s", es_ctx_errmsg(ctx));
+        es__fail(ctx, rc, "%s", msg);
+        return rc;
+    }
+    return es__file_set_commit(ctx, files);
 }
 
 const char *es_study_interp_name(const es_study_interp_opts *o, char *buf, size_t n)
@@ -222,6 +246,8 @@ static es_status walk_frames(walk *wk, double *res)
     wk->emb = es_study_embedder_embedder(wk->se);
     for (int64_t i = 0; rc == ES_OK && i < o->steps; i++) {
         double t = frame_t(o, i);
+        /* the embedder reports its progress; a cancel stops the walk here */
+        if ((rc = es__cancelled(ctx, "interp"))) break;
         lerp_frame(ctx, ne, nr, a, b, sa, sb, wa, wb, t, v, &scale, w);
         rc = embed_frame(wk, i, t, v, scale, w, res);
     }
@@ -232,7 +258,8 @@ done:
 
 es_status es_study_interp(es_ctx *ctx, es_store *store, const es_study_interp_opts *o)
 {
-    walk wk = {ctx, store, o, NULL, NULL, NULL, {0}};
+    walk wk = {ctx, store, o, NULL, NULL, NULL, {0}, {0}};
+    const int was_pending = es_store_pending(store);
     es_study_interp_opts one;
     es_mesh *mesh = NULL;
     double *res = NULL;
@@ -262,14 +289,14 @@ es_status es_study_interp(es_ctx *ctx, es_store *store, const es_study_interp_op
     }
     if ((rc = es_store_mesh(ctx, store, &mesh)) != ES_OK) return rc;
     if (o->method != ES_MORPH_EDGE_LENGTH) {   /* the other papers' (interp_methods.c) */
-        rc = es__study_interp_method(ctx, store, o, mesh, wk.name);
+        rc = es__study_interp_method(ctx, store, o, mesh, wk.name, was_pending);
         es_mesh_free(mesh);
         return rc;
     }
     wk.mesh = mesh;
     if (!(res = es__alloc_array(ctx, 3 * es_mesh_nverts(mesh), sizeof *res))) rc = ES_ENOMEM;
     if (rc == ES_OK) rc = walk_frames(&wk, res);
-    if (rc == ES_OK && o->command) rc = es_store_commit(ctx, store);
+    rc = es__study_frames_done(ctx, store, o, rc, was_pending, &wk.files);
     es_study_embedder_free(wk.se);
     es_mesh_free(mesh);
     es__free(ctx, res);

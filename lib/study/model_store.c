@@ -200,6 +200,18 @@ static es_status blocks_of(es_ctx *ctx, es_store *s, const es_study_model_result
     return rc;
 }
 
+/* A formula's name is a label column, or `size` (each row's scale, or the
+ * GPA's centroid size) when no column has that name. */
+static int known_column(void *ud, const char *name, char *why, size_t n)
+{
+    es_store *s = ud;
+    char hint[400];
+    if (es_store_find_column(s, name) >= 0 || !strcmp(name, "size")) return 1;
+    es_store_column_hint(s, name, hint, sizeof hint);
+    snprintf(why, n, "no label column '%s' in '%s'%s", name, es_store_path(s), hint);
+    return 0;
+}
+
 /* The fit's companions: a null model to compare with, pairwise comparisons,
  * per-variable tests, the common allometric component. */
 static es_status after_fit(es_ctx *ctx, es_store *store, const es_study_model_opts *o,
@@ -210,7 +222,8 @@ static es_status after_fit(es_ctx *ctx, es_store *store, const es_study_model_op
     if (o->null_formula) {
         const char **lab[64] = {NULL};
         es_model_column cols[64];
-        if ((rc = es_formula_parse(ctx, o->null_formula, &r->null_formula)) == ES_OK &&
+        if ((rc = es_formula_parse_checked(ctx, o->null_formula, known_column, store,
+                                           &r->null_formula)) == ES_OK &&
             (rc = columns(ctx, store, r, r->null_formula, rp, cols, lab)) == ES_OK &&
             (rc = es_design_build(ctx, r->null_formula, r->nrows, cols,
                                   es_formula_nvars(r->null_formula), r->design->contrasts,
@@ -284,7 +297,9 @@ es_status es_study_model(es_ctx *ctx, es_store *store, const es_study_model_opts
     es_status rc;
     if (!r) return ES_ENOMEM;
     r->ctx = ctx;
-    if ((rc = es_formula_parse(ctx, o.formula, &r->formula)) != ES_OK) goto done;
+    /* the columns are checked as the formula is read, before it is expanded */
+    if ((rc = es_formula_parse_checked(ctx, o.formula, known_column, store, &r->formula)) != ES_OK)
+        goto done;
     if ((o.where || !o.gpa) && (rc = es_store_select(ctx, store, o.where, &sel, &nsel)) != ES_OK)
         goto done;
     if (o.gpa) {

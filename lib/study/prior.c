@@ -86,6 +86,18 @@ done:
     return rc;
 }
 
+es_status es__study_rows_check_memory(es_ctx *ctx, const es_mesh *mesh, int64_t n)
+{
+    /* each row's aligned positions and dihedrals, and the cosines and sines
+     * of its dihedrals once a prior uses it (make_trig) */
+    char what[64];
+    uint64_t per = 8 * (3 * (uint64_t)es_mesh_nverts(mesh) + 3 * (uint64_t)es_mesh_nedges(mesh));
+    uint64_t bytes;
+    if (__builtin_mul_overflow((uint64_t)n, per, &bytes)) bytes = UINT64_MAX;
+    snprintf(what, sizeof what, " for the prior's %llu rows", (unsigned long long)n);
+    return es_embed_check_memory(ctx, mesh, bytes, what);
+}
+
 es_status es__study_rows_new(es_ctx *ctx, int64_t n, int64_t nv, int64_t ne, es_study_rows **out,
                              double **aligned, double **alpha)
 {
@@ -129,6 +141,7 @@ es_status es_study_rows_load(es_ctx *ctx, es_store *store, const es_mesh *mesh,
     *out = NULL;
     if (!mesh) ES_FAIL(ctx, ES_EINVAL, "prior: the store has no faces");
     if (es_store_nrows(store) < 1) ES_FAIL(ctx, ES_EINVAL, "prior: the store has no rows");
+    if ((rc = es__study_rows_check_memory(ctx, mesh, es_store_nrows(store))) != ES_OK) return rc;
     if ((rc = es__study_rows_new(ctx, es_store_nrows(store), es_mesh_nverts(mesh),
                                  es_mesh_nedges(mesh), &r, &aligned, &alpha)) != ES_OK)
         return rc;
@@ -140,7 +153,7 @@ es_status es_study_rows_load(es_ctx *ctx, es_store *store, const es_mesh *mesh,
         double *x = aligned + 3 * r->nv * j;
         if ((rc = es_store_read_positions(ctx, store, j, x)) == ES_OK)
             rc = es_dihedral_angles(ctx, mesh, x, alpha + r->ne * j);
-        es__progress(ctx, "prior: rows", j + 1, r->n);
+        if (rc == ES_OK) rc = es__progress(ctx, "prior: rows", j + 1, r->n);
     }
     if (rc == ES_OK) memcpy(orig0, r->aligned, (size_t)(3 * r->nv) * sizeof *orig0);
     if (rc == ES_OK && r->n > 1) rc = align_rows(ctx, r, orig0);

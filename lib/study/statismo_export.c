@@ -111,7 +111,7 @@ static es_status edge_length_model(es_ctx *ctx, es_store *s, const es_study_stat
         int64_t k = (j - 1) / 2;
         double c = j == 0 ? 0 : (j % 2 ? -o->sd : o->sd);
         double *out = j == 0 ? bufs[0] : j % 2 ? D + V3 * k : xp;
-        es__progress(ctx, "statismo: embedding", j, 2 * K + 1);
+        if ((rc = es__progress(ctx, "statismo: embedding", j, 2 * K + 1))) break;
         if (j == 0) snprintf(spec, sizeof spec, "%s", mspec);
         else snprintf(spec, sizeof spec, "%s + %.17g*pc:%lld", mspec, c, (long long)k + 1);
         /* each point from its own prior, as es_study_embed starts it: a model

@@ -16,6 +16,7 @@ typedef struct es__table_out {
     es__file_replace w;
     FILE *f;
     const char *path;
+    es__file_set *set;   /* non-NULL: the file is staged there, not renamed at end */
 } es__table_out;
 es_status es__table_begin(es_ctx *ctx, const char *path, es__table_out *t);
 /* Finish (rc ES_OK) or abandon (rc != ES_OK: the old file stays); returns
@@ -89,6 +90,10 @@ es_status es__model_save(es_ctx *ctx, es_store *s, const es_study_model_opts *o,
 
 /* An es_study_rows of n rows with its arrays (3V x n aligned positions, E x n
  * dihedrals) for the caller to fill. */
+/* The rows of a prior (n of them) and the embedder of mesh that uses them
+ * against the context's memory limit (es_embed_check_memory), before
+ * either is allocated. */
+es_status es__study_rows_check_memory(es_ctx *ctx, const es_mesh *mesh, int64_t n);
 es_status es__study_rows_new(es_ctx *ctx, int64_t n, int64_t nv, int64_t ne, es_study_rows **out,
                              double **aligned, double **alpha);
 void es__study_rows_arrays(const es_study_rows *r, const double **aligned, const double **alpha);
@@ -148,9 +153,17 @@ es_status es__study_store_mesh_result(es_ctx *ctx, es_store *store, const char *
 void es__study_frame_names(const es_study_interp_opts *o, const char *name, int64_t i,
                            char *fname, size_t nf, char *rname, size_t nr);
 
+/* The end of a walk (every interpolation method): with rc ES_OK, the
+ * store committed (with a command), then the staged frame files renamed
+ * into place; otherwise the files discarded and, unless writes were
+ * pending before the walk (was_pending), what it stored rolled back (the
+ * message of rc kept). */
+es_status es__study_frames_done(es_ctx *ctx, es_store *store, const es_study_interp_opts *o,
+                                es_status rc, int was_pending, es__file_set *files);
+
 /* es_study_interp for opts->method other than edge-length, between two rows
  * (interp_methods.c); name: the result name (without the frame suffix). */
 es_status es__study_interp_method(es_ctx *ctx, es_store *store, const es_study_interp_opts *o,
-                                  const es_mesh *mesh, const char *name);
+                                  const es_mesh *mesh, const char *name, int was_pending);
 
 #endif

@@ -36,7 +36,8 @@ es_status es__table_end(es_ctx *ctx, es__table_out *t, es_status rc)
         return rc;
     }
     t->f = NULL;
-    return es__replace_end(ctx, &t->w, rc);
+    return t->set ? es__replace_end_staged(ctx, &t->w, rc, t->set)
+                  : es__replace_end(ctx, &t->w, rc);
 }
 
 void es__table_number(FILE *f, double v)

@@ -237,7 +237,7 @@ es_status es_synth_write(es_ctx *ctx, const es_synth_set *s, const char *dir)
         rc = es__meshdata_write(ctx, path, ES_FORMAT_OBJ, s->nverts, s->nfaces, s->faces,
                                 s->xyz + 3 * s->nverts * i, NULL);
         if (rc != ES_OK) return rc;
-        es__progress(ctx, "synth write", i + 1, s->nmembers);
+        if ((rc = es__progress(ctx, "synth write", i + 1, s->nmembers))) return rc;
     }
     if (snprintf(path, sizeof path, "%s/manifest.csv", dir) >= (int)sizeof path)
         ES_FAIL(ctx, ES_ERANGE, "synth: path too long in '%s'", dir);

@@ -24,9 +24,9 @@ import numpy as _np
 
 from . import _arrays as _A
 from ._context import Context, EdgespaceWarning, default_context
-from ._errors import (ConvergenceError, Error, ExistsError, FormatError, InvalidError,
-                      IOFailure, MismatchError, NoMemoryError, NotFoundError, NumericError,
-                      RangeError, TopologyError)
+from ._errors import (CancelledError, ConvergenceError, Error, ExistsError, FormatError,
+                      InvalidError, IOFailure, MismatchError, NoMemoryError, NotFoundError,
+                      NumericError, RangeError, TopologyError)
 from ._native import INCLUDE_DIR, LIBRARY_PATH, LoadError, ffi, lib
 from .mesh import (Embedder, Embedding, Mesh, embed, embed_opts, normalize_lengths,
                    read_mesh)
@@ -38,6 +38,7 @@ __all__ = [
     "Context", "EdgespaceWarning", "default_context", "Error", "NoMemoryError",
     "InvalidError", "RangeError", "IOFailure", "FormatError", "NumericError",
     "ConvergenceError", "NotFoundError", "ExistsError", "MismatchError", "TopologyError",
+    "CancelledError",
     "LoadError", "Mesh", "Embedder", "Embedding", "embed", "embed_opts",
     "normalize_lengths", "read_mesh", "render", "plot_scatter", "plot_scree", "auto_view",
     "Image", "FiguresUnavailable", "Store", "StudyEmbedder", "PCA", "ingest", "synth", "pca",
@@ -72,8 +73,9 @@ def pca(X, ncomp=0, method="auto", oversample=10, power_iters=4, ctx=None):
     srcp = ffi.new("es_source *", src)
     o = ffi.new("es_pca_opts *")
     lib.es_pca_opts_init(o)
-    o.ncomp, o.method = int(ncomp), _pca_method(method)
-    o.oversample, o.power_iters = int(oversample), int(power_iters)
+    o.ncomp, o.method = _A.index(ncomp, "ncomp"), _pca_method(method)
+    o.oversample = _A.index(oversample, "oversample")
+    o.power_iters = _A.index(power_iters, "power_iters")
     out = ffi.new("es_pca **")
     ctx.call(lib.es_pca_fit, srcp, o, out)
     return PCA(ctx, out[0])
@@ -87,15 +89,16 @@ def synth(family="face", n=0, resolution=0, noise=-1.0, directory=None, ctx=None
     from ._context import ctx_of
     ctx = ctx_of(ctx)
     fam = ffi.new("es_synth_family *")
-    ctx.call(lib.es_synth_family_from_name, family.encode(), fam)
+    ctx.call(lib.es_synth_family_from_name, _A.cbytes(family, "family"), fam)
     o = ffi.new("es_synth_opts *")
     lib.es_synth_opts_init(o)
-    o.n, o.resolution, o.noise = int(n), int(resolution), float(noise)
+    o.n, o.resolution = _A.index(n, "n"), _A.index(resolution, "resolution")
+    o.noise = float(noise)
     st = ffi.new("es_synth_set *")
     ctx.call(lib.es_synth_generate, fam[0], o, st)
     try:
         if directory is not None:
-            ctx.call(lib.es_synth_write, st, str(directory).encode())
+            ctx.call(lib.es_synth_write, st, _A.cbytes(directory, "directory"))
         V, F, N, L = int(st.nverts), int(st.nfaces), int(st.nmembers), int(st.nlabels)
         cols = [_A.string(st.label_names[j]) for j in range(L)]
         return {

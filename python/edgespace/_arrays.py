@@ -11,6 +11,8 @@ the library straight into fresh numpy arrays, and arrays the library
 allocated (results read back, fitted PCAs) become read-only numpy views that
 keep their owner alive.
 """
+import operator
+
 import numpy as np
 
 from ._native import ffi, lib
@@ -28,6 +30,39 @@ def i64(a, shape=None, name="array"):
     arr = np.ascontiguousarray(a, dtype=np.int64)
     _check_shape(arr, shape, name)
     return arr
+
+
+def index(x, name="index"):
+    """x as a Python int if it is an integer (int, numpy integer, anything
+    with __index__); a TypeError naming it otherwise: 2.7 is not row 2."""
+    if isinstance(x, (bool, np.bool_)):
+        raise TypeError(f"{name} must be an integer, not a bool")
+    try:
+        return operator.index(x)
+    except TypeError:
+        raise TypeError(f"{name} must be an integer, not {type(x).__name__} {x!r}") from None
+
+
+def indices(a, shape=(None,), name="indices"):
+    """An int64 array of integer indices; floats (and bools, a mask here
+    would be read as rows 0 and 1) are refused rather than truncated."""
+    arr = np.asarray(a)
+    if arr.size and arr.dtype.kind not in "iu":
+        raise TypeError(f"{name} must be integers, not {arr.dtype}")
+    return i64(arr, shape, name)
+
+
+def out_array(out, shape, name="out"):
+    """out, checked to be an array the library may write shape float64
+    elements into: a writable, C-contiguous float64 numpy array (bytes, a
+    read-only array or memory map, a view of another dtype are refused)."""
+    if not isinstance(out, np.ndarray):
+        raise TypeError(f"{name} must be a numpy array, not {type(out).__name__}")
+    if not out.flags.writeable:
+        raise ValueError(f"{name} is read-only")
+    if out.shape != tuple(shape) or out.dtype != np.float64 or not out.flags.c_contiguous:
+        raise ValueError(f"{name} must be a C-contiguous float64 array of shape {tuple(shape)}")
+    return out
 
 
 def _check_shape(arr, shape, name):
@@ -51,12 +86,13 @@ def iptr(arr):
     return ffi.from_buffer("int64_t[]", arr)
 
 
-def mat(arr):
+def mat(arr, writable=False):
     """An es_mat over a C-order (cols, rows) float64 array: the rows x cols
-    column-major matrix in the same memory (ld = rows)."""
+    column-major matrix in the same memory (ld = rows); writable: the
+    library writes it (cffi refuses a read-only buffer then)."""
     m = ffi.new("es_mat *")
     cols, rows = arr.shape
-    buf = ffi.from_buffer("double[]", arr)
+    buf = ffi.from_buffer("double[]", arr, require_writable=writable)
     m.data = buf
     m.rows, m.cols, m.ld = rows, cols, rows
     return m, buf   # the struct only points: keep buf alive with it
@@ -110,22 +146,33 @@ def string(p):
     return ffi.string(p).decode("utf-8", "replace")
 
 
+def cbytes(s, name="string"):
+    """str (or path) -> UTF-8 bytes for a C string; None stays None. A NUL
+    inside would cut the string short where C reads it: refused."""
+    if s is None:
+        return None
+    b = s if isinstance(s, bytes) else str(s).encode("utf-8")
+    if b"\0" in b:
+        raise ValueError(f"{name} {s!r} contains a NUL character")
+    return b
+
+
 class CStrings:
     """A list of str as const char *const * (kept alive with the object)."""
 
-    def __init__(self, items):
-        self._bufs = [ffi.new("char[]", s.encode("utf-8")) for s in items]
+    def __init__(self, items, name="string"):
+        self._bufs = [ffi.new("char[]", cbytes(s, name)) for s in items]
         self.ptr = ffi.new("const char *[]", self._bufs) if self._bufs else ffi.NULL
 
     def __len__(self):
         return len(self._bufs)
 
 
-def cstr(s):
+def cstr(s, name="string"):
     """str -> char[] (None: NULL)."""
     if s is None:
         return ffi.NULL
-    return ffi.new("char[]", str(s).encode("utf-8"))
+    return ffi.new("char[]", cbytes(s, name))
 
 
 def struct_dict(cdata, ctype):

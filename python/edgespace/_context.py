@@ -11,7 +11,18 @@ progress(what, done, total), True or "auto" (a tqdm bar per stage when tqdm
 is installed, else nothing), or None/False (silent); the default context's
 is "auto". Warnings the library logs become EdgespaceWarning
 (warnings.warn); notes go to the logging logger "edgespace" at INFO.
+
+An exception raised in a callback (a progress function, a warning turned
+into an error, Ctrl-C arriving while the library works) cancels the work
+(es_ctx_cancel): the call returns at the library's next progress report
+having stored nothing, and the exception is raised from it. The progress
+callback is installed even without a progress function, so that Ctrl-C
+reaches long work. One context is used by one thread at a time (the
+library's rule): its calls hold a lock, so that threads sharing an object
+(a store, an embedder) take turns instead of corrupting it, and a call made
+from inside a callback of a running call on the same context is refused.
 """
+import contextlib
 import logging
 import sys
 import threading
@@ -101,10 +112,16 @@ class Context:
         if status:
             raise MemoryError("es_ctx_new failed")
         self._ptr = ffi.gc(p[0], lib.es_ctx_free)
+        self._lock = threading.RLock()
+        self._depth = 0
         self._progress_fn = None
-        self._progress_cb = None
         self._callback_error = None
-        self._log_cb = ffi.callback("es_log_fn", self._on_log)
+        # onerror: an exception escaping a callback (Ctrl-C is raised at the
+        # callback's first instruction) is kept and cancels the work
+        self._progress_cb = ffi.callback("es_progress_fn", self._on_progress,
+                                         onerror=self._on_callback_error)
+        lib.es_ctx_set_progress(self._ptr, self._progress_cb, ffi.NULL)
+        self._log_cb = ffi.callback("es_log_fn", self._on_log, onerror=self._on_callback_error)
         lib.es_ctx_set_log(self._ptr, self._log_cb, ffi.NULL)
         if seed is not None:
             self.seed = seed
@@ -135,48 +152,67 @@ class Context:
             raise TypeError("progress must be a callable(what, done, total), True, 'auto' "
                             "or None")
         self._progress_fn = fn
-        if fn is None:
-            lib.es_ctx_set_progress(self._ptr, ffi.NULL, ffi.NULL)
-            self._progress_cb = None
-        else:
-            self._progress_cb = ffi.callback("es_progress_fn", self._on_progress)
-            lib.es_ctx_set_progress(self._ptr, self._progress_cb, ffi.NULL)
 
     # The C side cannot take a Python exception: one raised in a callback is
-    # kept and raised once the library call returns (call()).
+    # kept, cancels the work, and is raised once the library call returns
+    # (call()).
     def _on_progress(self, userdata, what, done, total):
-        if self._callback_error is not None:
-            return
-        try:
-            self._progress_fn(ffi.string(what).decode("utf-8", "replace"), int(done),
-                              int(total))
-        except BaseException as e:   # noqa: B036 (re-raised after the C call)
-            self._callback_error = e
+        fn = self._progress_fn
+        if fn is not None and self._callback_error is None:
+            fn(ffi.string(what).decode("utf-8", "replace"), int(done), int(total))
 
     def _on_log(self, userdata, level, msg):
         text = ffi.string(msg).decode("utf-8", "replace")
-        try:
-            if level == lib.ES_LOG_WARNING:
-                warnings.warn(text, EdgespaceWarning, stacklevel=2)
-            else:
-                _log.info(text)
-        except BaseException as e:   # noqa: B036 (warnings raised as errors)
-            if self._callback_error is None:
-                self._callback_error = e
+        if level == lib.ES_LOG_WARNING:
+            warnings.warn(text, EdgespaceWarning, stacklevel=2)
+        else:
+            _log.info(text)
+
+    def _on_callback_error(self, exc_type, exc, tb):
+        if self._callback_error is None:
+            self._callback_error = exc if exc is not None else exc_type()
+        lib.es_ctx_cancel(self._ptr)
 
     def call(self, fn, *args):
         """Call a library function taking this context first; raise its
-        error, or an exception a callback raised meanwhile."""
-        self._callback_error = None
-        status = fn(self._ptr, *args)
-        err, self._callback_error = self._callback_error, None
-        if isinstance(self._progress_fn, _TqdmProgress):
-            self._progress_fn.close()
-        if status:
-            check(self._ptr, status)
-        if err is not None:
-            raise err
-        return status
+        error, or an exception a callback raised meanwhile (which cancelled
+        the work: the library stored nothing)."""
+        with self._lock:
+            if self._depth:
+                raise RuntimeError("edgespace: a library call from a callback of a call "
+                                   "running on the same context (use another Context)")
+            self._depth += 1
+            self._callback_error = None
+            lib.es_ctx_cancel_clear(self._ptr)
+            try:
+                status = fn(self._ptr, *args)
+            finally:
+                self._depth -= 1
+                lib.es_ctx_cancel_clear(self._ptr)
+                err, self._callback_error = self._callback_error, None
+                if isinstance(self._progress_fn, _TqdmProgress):
+                    self._progress_fn.close()
+            if err is not None:
+                raise err
+            if status:
+                check(self._ptr, status)
+            return status
+
+    def hold(self):
+        """The lock this context's calls take: held around a block of calls
+        or reads of one object, so that another thread's close of it waits."""
+        return self._lock
+
+    @contextlib.contextmanager
+    def closing(self):
+        """Hold the lock to close or free an object: waits for another
+        thread's running call; refused from a callback of a call running on
+        this context (the object is in use below it)."""
+        with self._lock:
+            if self._depth:
+                raise RuntimeError("edgespace: an object cannot be closed from a callback "
+                                   "of a call running on it")
+            yield
 
     @property
     def ptr(self):

@@ -63,12 +63,16 @@ class TopologyError(Error, ValueError):
     """ES_ETOPOLOGY: a face list is not an oriented 2-manifold."""
 
 
+class CancelledError(Error):
+    """ES_ECANCELED: the work was cancelled (es_ctx_cancel); nothing was stored."""
+
+
 _CLASSES = {
     lib.ES_ENOMEM: NoMemoryError, lib.ES_EINVAL: InvalidError, lib.ES_ERANGE: RangeError,
     lib.ES_EIO: IOFailure, lib.ES_EFORMAT: FormatError, lib.ES_ENUMERIC: NumericError,
     lib.ES_ENOCONV: ConvergenceError, lib.ES_ENOTFOUND: NotFoundError,
     lib.ES_EEXIST: ExistsError, lib.ES_EMISMATCH: MismatchError,
-    lib.ES_ETOPOLOGY: TopologyError,
+    lib.ES_ETOPOLOGY: TopologyError, lib.ES_ECANCELED: CancelledError,
 }
 _NAMES = dict(ffi.typeof("es_status").elements)   # value -> name
 

@@ -79,7 +79,8 @@ class Mesh:
         if nverts is None:
             nverts = V.shape[0] if V is not None else (int(F.max()) + 1 if F.size else 0)
         p = ffi.new("es_mesh **")
-        self.ctx.call(lib.es_mesh_new, int(nverts), F.shape[0], A.iptr(F), A.dptr(V), p)
+        self.ctx.call(lib.es_mesh_new, A.index(nverts, "nverts"), F.shape[0], A.iptr(F),
+                      A.dptr(V), p)
         self._ptr = A.owned(self.ctx, p[0], lib.es_mesh_free)
 
     @classmethod
@@ -153,12 +154,14 @@ class Mesh:
         """Write a mesh file (es_mesh_write; coordinates exact)."""
         V = None if vertices is None else self._positions(vertices)
         f = getattr(lib, "ES_FORMAT_" + fmt.upper().replace("-", "_"))
-        self.ctx.call(lib.es_mesh_write, str(path).encode(), f, self._ptr, A.dptr(V), ffi.NULL)
+        self.ctx.call(lib.es_mesh_write, A.cbytes(path, "path"), f, self._ptr, A.dptr(V),
+                      ffi.NULL)
 
     def read_positions(self, path):
         """(V, 3) positions of a mesh file with this face list."""
         out = np.empty((self.nverts, 3))
-        self.ctx.call(lib.es_mesh_read_positions, self._ptr, str(path).encode(), A.dptr(out))
+        self.ctx.call(lib.es_mesh_read_positions, self._ptr, A.cbytes(path, "path"),
+                      A.dptr(out))
         return out
 
     def _positions(self, vertices):
@@ -177,7 +180,7 @@ def read_mesh(path, ctx=None):
     """A mesh file (OBJ, PLY, OFF) as a Mesh with its positions (es_mesh_read)."""
     ctx = ctx_of(ctx)
     p = ffi.new("es_mesh **")
-    ctx.call(lib.es_mesh_read, str(path).encode(), p)
+    ctx.call(lib.es_mesh_read, A.cbytes(path, "path"), p)
     return Mesh._adopt(ctx, p[0])
 
 
@@ -192,7 +195,9 @@ def normalize_lengths(lengths, ctx=None):
 
 class Embedder:
     """An embedder for one topology (es_embedder_new): holds the symbolic
-    factorizations and work buffers that every solve reuses."""
+    factorizations and work buffers that every solve reuses. Threads that
+    share one take turns (its context's lock); for solves in parallel give
+    each thread its own Embedder and Context."""
 
     def __init__(self, mesh, ctx=None):
         self.mesh = mesh if isinstance(mesh, Mesh) else Mesh(mesh, ctx=ctx)
@@ -251,10 +256,11 @@ class Embedder:
         return self._per_vertex(lib.es_embedder_vertex_deviation)
 
     def _per_vertex(self, fn):
-        p = fn(self._ptr)
-        if p == ffi.NULL:
-            return None
-        return np.array(A.view(p, (self.mesh.nverts,), self))   # copy: valid until next solve
+        with self.ctx.hold():   # not while another thread's solve rewrites it
+            p = fn(self._ptr)
+            if p == ffi.NULL:
+                return None
+            return np.array(A.view(p, (self.mesh.nverts,), self))   # copy: valid until next solve
 
 
 def embed(lengths, mesh, scale=0.0, init_vertices=None, init_dihedrals=None, prior=None,

@@ -40,7 +40,7 @@ def _draw(ctx, fn, spec, info=ffi.NULL):
     """Run a drawing call into a temporary PNG and return its bytes."""
     with tempfile.TemporaryDirectory(prefix="edgespace-") as d:
         path = os.path.join(d, "figure.png")
-        ctx.call(fn, spec, path.encode(), info)
+        ctx.call(fn, spec, A.cbytes(path, "path"), info)
         with open(path, "rb") as f:
             return Image(f.read())
 

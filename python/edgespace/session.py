@@ -17,16 +17,18 @@ from .mesh import Embedding, report_dict, set_embed_opts
 class StudyEmbedder:
     """Embeds points of a store's space near their priors, fast; see the
     module's text. Made by Store.embedder(); closed with the store (or by
-    close()). One thread at a time."""
+    close()). Threads that share one take turns (the store's context's lock),
+and a close() from another thread waits for the running embedding."""
 
     def __init__(self, store, cache=True):
         self.store = store           # kept alive while the session is
         self.ctx = store.ctx
         p = ffi.new("es_study_embedder **")
-        self.ctx.call(lib.es_study_embedder_open, store.ptr, 1 if cache else 0, p)
-        self._ptr = A.owned(self.ctx, p[0], lib.es_study_embedder_free)
-        self.faces = store.mesh.faces
-        self.nrows = store.nrows   # the rows it was made for
+        with self.ctx.hold():   # the store not closed meanwhile
+            store._call(lib.es_study_embedder_open, 1 if cache else 0, p)
+            self._ptr = A.owned(self.ctx, p[0], lib.es_study_embedder_free)
+            self.faces = store.mesh.faces
+            self.nrows = store.nrows   # the rows it was made for
 
     @property
     def ptr(self):
@@ -61,8 +63,9 @@ class StudyEmbedder:
         eo = self._opts(fast, opts)
         xyz = np.empty((self.store.nverts, 3))
         res = ffi.new("es_study_embed_result *")
-        self.ctx.call(lib.es_study_embedder_solve, self.ptr, A.dptr(L), float(scale), A.dptr(w), eo,
-                      1 if warm else 0, 1 if exact else 0, A.dptr(xyz), res)
+        with self.ctx.hold():   # a close() from another thread waits
+            self.ctx.call(lib.es_study_embedder_solve, self.ptr, A.dptr(L), float(scale),
+                          A.dptr(w), eo, 1 if warm else 0, 1 if exact else 0, A.dptr(xyz), res)
         return self._result(xyz, res)
 
     def vertex_deviation(self):
@@ -92,20 +95,24 @@ class StudyEmbedder:
         eo = self._opts(fast, opts)
         xyz = np.empty((self.store.nverts, 3))
         res = ffi.new("es_study_embed_result *")
-        keep = [ffi.new("char[]", str(point).encode()),
-                ffi.new("char[]", str(pca).encode()) if pca is not None else ffi.NULL]
-        self.ctx.call(lib.es_study_embedder_point, self.ptr, keep[0], keep[1], float(scale), eo,
-                      1 if warm else 0, A.dptr(xyz), res)
+        keep = [A.cstr(str(point)), A.cstr(None if pca is None else str(pca))]
+        with self.ctx.hold():   # a close() from another thread waits
+            self.ctx.call(lib.es_study_embedder_point, self.ptr, keep[0], keep[1], float(scale),
+                          eo, 1 if warm else 0, A.dptr(xyz), res)
         return self._result(xyz, res)
 
     def forget(self):
         """The next warm embedding starts from its own prior."""
-        lib.es_study_embedder_forget(self.ptr)
+        with self.ctx.hold():
+            lib.es_study_embedder_forget(self.ptr)
 
     def close(self):
-        if self._ptr is not None:
-            ffi.release(self._ptr)
-            self._ptr = None
+        """Free the session: waits for an embedding running in another
+        thread; refused from a callback of a call running on the context."""
+        with self.ctx.closing():
+            if self._ptr is not None:
+                ffi.release(self._ptr)
+                self._ptr = None
 
     def __enter__(self):
         return self

@@ -32,8 +32,9 @@ def _pca_method(method):
     return getattr(lib, _PCA_METHODS[method])
 
 
-def _s(x):
-    return None if x is None else str(x).encode("utf-8")
+def _s(x, name="string"):
+    """A str argument as bytes for C (None stays None); NUL refused."""
+    return A.cbytes(x, name)
 
 
 def _c(x):
@@ -181,7 +182,7 @@ def ingest(store_path, manifest=None, files=None, create=True, threads=0, ctx=No
         raise ValueError("ingest: give manifest= or files=")
     o = ffi.new("es_ingest_opts *")
     lib.es_ingest_opts_init(o)
-    o.create, o.threads = int(create), int(threads)
+    o.create, o.threads = int(create), A.index(threads, "threads")
     rep = ffi.new("es_ingest_report *")
     if manifest is not None:
         ctx.call(lib.es_ingest_manifest, _s(store_path), _s(manifest), o, rep)
@@ -226,36 +227,74 @@ class Store:
             if nverts is None:
                 raise ValueError("Store.create: nverts is needed without faces")
             ed = A.i64(edges if edges is not None else np.zeros((0, 2)), (None, 2), "edges")
-            ctx.call(lib.es_store_create_edges, _s(path), int(nverts), ed.shape[0],
+            ctx.call(lib.es_store_create_edges, _s(path), A.index(nverts, "nverts"),
+                     ed.shape[0],
                      A.iptr(ed), p)
         return cls(path, True, ctx, _ptr=p[0])
 
     # -- handle -----------------------------------------------------------
+    # Every use of the handle holds the context's lock (Context.hold): a
+    # close() from another thread waits for a running call instead of
+    # freeing the store under it, and a close() from a callback of a call
+    # on it is refused. A call that fails (or whose callback raised) after
+    # writing discards what it wrote, unless writes were pending before it.
+    def _get(self, fn, *args):
+        with self.ctx.hold():
+            if self._ptr is None:
+                raise ValueError("the store is closed")
+            return fn(self._ptr, *args)
+
+    def _get_str(self, fn, *args):
+        """A string the store owns, copied while the lock is held (a close
+        from another thread frees it)."""
+        with self.ctx.hold():
+            return A.string(self._get(fn, *args))
+
+    def _call(self, fn, *args):
+        with self.ctx.hold():
+            if self._ptr is None:
+                raise ValueError("the store is closed")
+            p = self._ptr
+            pending = self.writable and bool(lib.es_store_pending(p))
+            try:
+                return self.ctx.call(fn, p, *args)
+            except BaseException:
+                if self.writable and not pending and lib.es_store_pending(p):
+                    lib.es_store_rollback(self.ctx.ptr, p)
+                raise
+
     def commit(self):
         """Publish what was written so far (es_store_commit)."""
-        self.ctx.call(lib.es_store_commit, self._ptr)
+        self._call(lib.es_store_commit)
+
+    def rollback(self):
+        """Discard what was written since the last commit (es_store_rollback)."""
+        self._call(lib.es_store_rollback)
 
     def close(self):
-        """Commit (raising its error) and close. Idempotent."""
-        if self._ptr is None:
-            return
-        self._close_sessions()
-        self._mesh = None     # freed now, while its context lives
-        try:
-            if self.writable:
-                self.commit()
-        finally:
-            ffi.release(self._ptr)
-            self._ptr = None
+        """Commit (raising its error) and close. Idempotent. Waits for a call
+        running in another thread; refused from a callback of a call on it."""
+        with self.ctx.closing():
+            if self._ptr is None:
+                return
+            self._close_sessions()
+            self._mesh = None     # freed now, while its context lives
+            try:
+                if self.writable:
+                    self.commit()
+            finally:
+                ffi.release(self._ptr)
+                self._ptr = None
 
     def abort(self):
         """Close, discarding uncommitted writes."""
-        if self._ptr is not None:
-            self._close_sessions()
-            self._mesh = None
-            ffi.gc(self._ptr, None)   # no es_store_close at collection
-            lib.es_store_abort(self._ptr)
-            self._ptr = None
+        with self.ctx.closing():
+            if self._ptr is not None:
+                self._close_sessions()
+                self._mesh = None
+                ffi.gc(self._ptr, None)   # no es_store_close at collection
+                lib.es_store_abort(self._ptr)
+                self._ptr = None
 
     def __enter__(self):
         return self
@@ -273,29 +312,29 @@ class Store:
         return self._ptr
 
     # -- shape of the data ------------------------------------------------
-    nrows = property(lambda self: int(lib.es_store_nrows(self.ptr)))
-    nedges = property(lambda self: int(lib.es_store_nedges(self.ptr)))
-    nverts = property(lambda self: int(lib.es_store_nverts(self.ptr)))
-    nfaces = property(lambda self: int(lib.es_store_nfaces(self.ptr)))
-    path = property(lambda self: A.string(lib.es_store_path(self.ptr)))
-    fingerprint = property(lambda self: A.string(lib.es_store_fingerprint(self.ptr)))
+    nrows = property(lambda self: int(self._get(lib.es_store_nrows)))
+    nedges = property(lambda self: int(self._get(lib.es_store_nedges)))
+    nverts = property(lambda self: int(self._get(lib.es_store_nverts)))
+    nfaces = property(lambda self: int(self._get(lib.es_store_nfaces)))
+    path = property(lambda self: self._get_str(lib.es_store_path))
+    fingerprint = property(lambda self: self._get_str(lib.es_store_fingerprint))
 
     @property
     def topology_kind(self):
-        return A.string(lib.es_topology_kind_name(lib.es_store_topology_kind(self.ptr)))
+        return A.string(lib.es_topology_kind_name(self._get(lib.es_store_topology_kind)))
 
     @property
     def faces(self):
         """(F, 3) int64 face list."""
         out = np.empty((self.nfaces, 3), dtype=np.int64)
-        self.ctx.call(lib.es_store_read_faces, self.ptr, A.iptr(out))
+        self._call(lib.es_store_read_faces, A.iptr(out))
         return out
 
     @property
     def edges(self):
         """(E, 2) int64 edge list (min, max), sorted: column e of the lengths."""
         out = np.empty((self.nedges, 2), dtype=np.int64)
-        self.ctx.call(lib.es_store_read_edges, self.ptr, A.iptr(out))
+        self._call(lib.es_store_read_edges, A.iptr(out))
         return out
 
     @property
@@ -303,7 +342,7 @@ class Store:
         """The topology with row 0's positions (a Mesh; cached)."""
         if self._mesh is None:
             p = ffi.new("es_mesh **")
-            self.ctx.call(lib.es_store_mesh, self.ptr, p)
+            self._call(lib.es_store_mesh, p)
             self._mesh = Mesh._adopt(self.ctx, p[0])
         return self._mesh
 
@@ -311,23 +350,23 @@ class Store:
     @property
     def ids(self):
         """Row ids, an array of str (N,)."""
-        return np.array([A.string(lib.es_store_row_id(self.ptr, i)) for i in range(self.nrows)],
+        return np.array([self._get_str(lib.es_store_row_id, i) for i in range(self.nrows)],
                         dtype=object)
 
     @property
     def columns(self):
         """Label column names."""
-        return [A.string(lib.es_store_column_name(self.ptr, c))
-                for c in range(lib.es_store_ncolumns(self.ptr))]
+        return [self._get_str(lib.es_store_column_name, c)
+                for c in range(self._get(lib.es_store_ncolumns))]
 
     def label(self, column):
         """The labels of one column, an array of str (N,)."""
-        c = lib.es_store_find_column(self.ptr, _s(column))
+        c = self._get(lib.es_store_find_column, _s(column))
         if c < 0:
             from ._errors import NotFoundError
             raise NotFoundError(f"no label column '{column}' in '{self.path}'",
                                 lib.ES_ENOTFOUND)
-        return np.array([A.string(lib.es_store_label(self.ptr, i, c)) for i in range(self.nrows)],
+        return np.array([self._get_str(lib.es_store_label, i, c) for i in range(self.nrows)],
                         dtype=object)
 
     def labels(self):
@@ -348,23 +387,24 @@ class Store:
 
     def find_row(self, id):
         """Row of an id, or -1."""
-        return int(lib.es_store_find_row(self.ptr, _s(id)))
+        return int(self._get(lib.es_store_find_row, _s(id)))
 
     def select(self, filter=None):
         """Rows matching "col=value[,col=value...]" (None: all), int64 array."""
         rows, n = ffi.new("int64_t **"), ffi.new("int64_t *")
-        self.ctx.call(lib.es_store_select, self.ptr, _s(filter) or ffi.NULL, rows, n)
+        self._call(lib.es_store_select, _s(filter) or ffi.NULL, rows, n)
         return np.array(A.view(rows[0], (n[0],), A.Freed(self.ctx, rows[0]), "i8"))
 
     def source_path(self, row):
-        return A.string(lib.es_store_source_path(self.ptr, int(row)))
+        return self._get_str(lib.es_store_source_path, A.index(row, "row"))
 
     def content_hash(self, row):
-        return A.string(lib.es_store_content_hash(self.ptr, int(row)))
+        return self._get_str(lib.es_store_content_hash, A.index(row, "row"))
 
     # -- data -------------------------------------------------------------
     def _rows(self, rows):
-        """rows as (row0, n) for a contiguous range, else an int64 array."""
+        """rows as (row0, n) for a contiguous range, else an int64 array;
+        integers only (a float is refused, not truncated)."""
         N = self.nrows
         if rows is None:
             return (0, N)
@@ -373,46 +413,45 @@ class Store:
             if step == 1:
                 return (start, max(stop - start, 0))
             rows = np.arange(start, stop, step)
-        if isinstance(rows, (int, np.integer)):
-            return (int(rows), 1)
-        return A.i64(rows, (None,), "rows")
+        if np.ndim(rows) == 0:
+            return (A.index(rows, "row"), 1)
+        return A.indices(rows, (None,), "rows")
 
     def lengths(self, rows=None, out=None):
         """Normalized lengths (n, E) of rows (None: all; a slice, a list of
-        rows or one row). out: an (n, E) float64 C-order array to fill."""
+        rows or one row). out: an (n, E) float64 C-order writable array to
+        fill (a read-only array or memory map, bytes, are refused)."""
         r = self._rows(rows)
         n = r[1] if isinstance(r, tuple) else len(r)
         if out is None:
             out = np.empty((n, self.nedges))
-        elif out.shape != (n, self.nedges) or out.dtype != np.float64 or \
-                not out.flags.c_contiguous:
-            raise ValueError(f"out must be a C-contiguous float64 array of shape "
-                             f"{(n, self.nedges)}")
-        m, keep = A.mat(out)
-        if isinstance(r, tuple):
-            self.ctx.call(lib.es_store_read_lengths, self.ptr, r[0], r[1], m[0])
         else:
-            self.ctx.call(lib.es_store_read_lengths_rows, self.ptr, A.iptr(r), len(r), m[0])
+            A.out_array(out, (n, self.nedges))
+        m, keep = A.mat(out, writable=True)
+        if isinstance(r, tuple):
+            self._call(lib.es_store_read_lengths, r[0], r[1], m[0])
+        else:
+            self._call(lib.es_store_read_lengths_rows, A.iptr(r), len(r), m[0])
         return out
 
     def scales(self):
         """(N,) scales (sum of raw edge lengths) of all rows."""
         out = np.empty(self.nrows)
-        self.ctx.call(lib.es_store_read_scales, self.ptr, A.dptr(out))
+        self._call(lib.es_store_read_scales, A.dptr(out))
         return out
 
     def positions(self, rows=None):
         """Vertex positions as ingested: (V, 3) for one row, (n, V, 3) for
         several (None: all)."""
-        if isinstance(rows, (int, np.integer)):
+        if rows is not None and not isinstance(rows, slice) and np.ndim(rows) == 0:
             out = np.empty((self.nverts, 3))
-            self.ctx.call(lib.es_store_read_positions, self.ptr, int(rows), A.dptr(out))
+            self._call(lib.es_store_read_positions, A.index(rows, "row"), A.dptr(out))
             return out
         r = self._rows(rows)
         rows = np.arange(r[0], r[0] + r[1]) if isinstance(r, tuple) else r
         out = np.empty((len(rows), self.nverts, 3))
         for j, i in enumerate(rows):
-            self.ctx.call(lib.es_store_read_positions, self.ptr, int(i), A.dptr(out[j]))
+            self._call(lib.es_store_read_positions, int(i), A.dptr(out[j]))
         return out
 
     def append(self, ids, vertices, labels=None, source_paths=None):
@@ -449,14 +488,14 @@ class Store:
         rows.ncols, rows.colnames, rows.labels = len(cols), ccol.ptr, ccell.ptr
         if csrc is not None:
             rows.source_paths = csrc.ptr
-        self.ctx.call(lib.es_store_append, self.ptr, rows)
+        self._call(lib.es_store_append, rows)
         self._mesh = None
 
     # -- stored results ---------------------------------------------------
     def results(self, kind=None):
         """Names of stored results of a kind (None: the kinds present)."""
         names, n = ffi.new("char ***"), ffi.new("int64_t *")
-        self.ctx.call(lib.es_store_list_results, self.ptr, _s(kind) or ffi.NULL, names, n)
+        self._call(lib.es_store_list_results, _s(kind) or ffi.NULL, names, n)
         out = []
         for i in range(n[0]):
             out.append(A.string(names[0][i]))
@@ -466,29 +505,29 @@ class Store:
 
     def has(self, path):
         """True if /analysis/<path> exists (a result or one of its datasets)."""
-        return bool(lib.es_store_has(self.ptr, _s(path)))
+        return bool(self._get(lib.es_store_has, _s(path)))
 
     def get_matrix(self, path):
         """A stored matrix "<kind>/<name>/<dataset>" as an array of the
         dataset's shape (read-only view of the library's buffer)."""
         m = ffi.new("es_mat *")
-        self.ctx.call(lib.es_store_get_matrix, self.ptr, _s(path), m)
+        self._call(lib.es_store_get_matrix, _s(path), m)
         return A.view(m.data, (m.cols, m.rows), A.Freed(self.ctx, m.data))
 
     def get_vector(self, path):
         v, n = ffi.new("double **"), ffi.new("int64_t *")
-        self.ctx.call(lib.es_store_get_vector, self.ptr, _s(path), v, n)
+        self._call(lib.es_store_get_vector, _s(path), v, n)
         return A.view(v[0], (n[0],), A.Freed(self.ctx, v[0]))
 
     def get_ints(self, path):
         v, n = ffi.new("int64_t **"), ffi.new("int64_t *")
-        self.ctx.call(lib.es_store_get_ints, self.ptr, _s(path), v, n)
+        self._call(lib.es_store_get_ints, _s(path), v, n)
         return A.view(v[0], (n[0],), A.Freed(self.ctx, v[0]), "i8")
 
     def get_strings(self, path):
         """A stored 1-D string dataset "<kind>/<name>/<dataset>" as a list of str."""
         v, n = ffi.new("char ***"), ffi.new("int64_t *")
-        self.ctx.call(lib.es_store_get_strings, self.ptr, _s(path), v, n)
+        self._call(lib.es_store_get_strings, _s(path), v, n)
         out = []
         for i in range(n[0]):
             out.append(A.string(v[0][i]))
@@ -498,7 +537,7 @@ class Store:
 
     def get_attr(self, path, key):
         buf = ffi.new("char[]", 4096)
-        self.ctx.call(lib.es_store_get_attr, self.ptr, _s(path), _s(key), buf, 4096)
+        self._call(lib.es_store_get_attr, _s(path), _s(key), buf, 4096)
         return ffi.string(buf).decode("utf-8", "replace")
 
     # -- analyses (es_study.h) ---------------------------------------------
@@ -509,7 +548,7 @@ class Store:
         """Means of the rows matching filter, one per value of label column
         `by` (es_study_mean); stored as mean/<name> when name is given."""
         out = ffi.new("es_group_result **")
-        self.ctx.call(lib.es_study_mean, self.ptr, _s(name) or ffi.NULL,
+        self._call(lib.es_study_mean, _s(name) or ffi.NULL,
                       _s(filter) or ffi.NULL, _s(by) or ffi.NULL, self._command("mean"), out)
         r = A.owned(self.ctx, out[0], lib.es_group_result_free)
         G, E = int(r.ngroups), int(r.nedges)
@@ -526,10 +565,11 @@ class Store:
         pca/<name> when name is given. Returns a PCA with .rows."""
         o = ffi.new("es_pca_opts *")
         lib.es_pca_opts_init(o)
-        o.ncomp, o.method = int(ncomp), _pca_method(method)
-        o.oversample, o.power_iters = int(oversample), int(power_iters)
+        o.ncomp, o.method = A.index(ncomp, "ncomp"), _pca_method(method)
+        o.oversample = A.index(oversample, "oversample")
+        o.power_iters = A.index(power_iters, "power_iters")
         out, rows, n = ffi.new("es_pca **"), ffi.new("int64_t **"), ffi.new("int64_t *")
-        self.ctx.call(lib.es_study_pca, self.ptr, _s(name) or ffi.NULL, _s(filter) or ffi.NULL,
+        self._call(lib.es_study_pca, _s(name) or ffi.NULL, _s(filter) or ffi.NULL,
                       o, self._command("pca"), out, rows, n)
         r = np.array(A.view(rows[0], (n[0],), A.Freed(self.ctx, rows[0]), "i8"))
         self._committed(name)
@@ -538,7 +578,7 @@ class Store:
     def load_pca(self, name=None):
         """A stored PCA (es_study_pca_load; None: the only one, else 'default')."""
         out, rows, n = ffi.new("es_pca **"), ffi.new("int64_t **"), ffi.new("int64_t *")
-        self.ctx.call(lib.es_study_pca_load, self.ptr, _s(name) or ffi.NULL, out, rows, n)
+        self._call(lib.es_study_pca_load, _s(name) or ffi.NULL, out, rows, n)
         r = np.array(A.view(rows[0], (n[0],), A.Freed(self.ctx, rows[0]), "i8"))
         return PCA(self.ctx, out[0], r)
 
@@ -546,7 +586,7 @@ class Store:
         """Paired difference to - from, rows paired by label `key`
         (es_study_diff); stored as diff/<name> when name is given."""
         out = ffi.new("es_diff **")
-        self.ctx.call(lib.es_study_diff, self.ptr, _s(name) or ffi.NULL, _s(filter) or ffi.NULL,
+        self._call(lib.es_study_diff, _s(name) or ffi.NULL, _s(filter) or ffi.NULL,
                       _s(key), _s(column), _s(from_), _s(to), self._command("diff"), out)
         d = A.owned(self.ctx, out[0], lib.es_diff_free)
         E, P, U = int(d.nedges), int(d.npairs), int(d.nunpaired)
@@ -565,7 +605,7 @@ class Store:
         vec = ffi.new("double **")
         w = np.empty(self.nrows)
         info = ffi.new("es_point_info *")
-        self.ctx.call(lib.es_study_point, self.ptr, _s(name) or ffi.NULL, _s(expr),
+        self._call(lib.es_study_point, _s(name) or ffi.NULL, _s(expr),
                       _s(pca) or ffi.NULL, float(scale), self._command("point"), vec, A.dptr(w),
                       info)
         lengths = np.array(A.view(vec[0], (self.nedges,), A.Freed(self.ctx, vec[0])))
@@ -578,7 +618,7 @@ class Store:
         """A point as a command names it ("row:ID", a stored point's name, or
         an expression): lengths, scale and row weights (es_study_point_weights)."""
         L, w, sc = np.empty(self.nedges), np.empty(self.nrows), ffi.new("double *")
-        self.ctx.call(lib.es_study_point_weights, self.ptr, _s(spec), _s(pca) or ffi.NULL,
+        self._call(lib.es_study_point_weights, _s(spec), _s(pca) or ffi.NULL,
                       A.dptr(L), sc, A.dptr(w))
         return Point(lengths=L, weights=w, scale=sc[0], info=None, expr=spec)
 
@@ -588,7 +628,7 @@ class Store:
         Embedder.solve(prior=...) takes it."""
         w = A.f64(weights, (self.nrows,), "weights")
         rows = ffi.new("es_study_rows **")
-        self.ctx.call(lib.es_study_rows_load, self.ptr, self.mesh.ptr, rows)
+        self._call(lib.es_study_rows_load, self.mesh.ptr, rows)
         r = A.owned(self.ctx, rows[0], lib.es_study_rows_free)
         xyz, alpha, sd = np.empty((self.nverts, 3)), np.empty(self.nedges), np.empty(self.nedges)
         self.ctx.call(lib.es_study_prior, r, A.dptr(w), A.dptr(xyz), A.dptr(alpha), A.dptr(sd))
@@ -597,9 +637,9 @@ class Store:
     def nearest_row(self, lengths, rows=None):
         """(row, distance) of the stored row nearest in edge-length distance."""
         L = A.f64(lengths, (self.nedges,), "lengths")
-        r = None if rows is None else A.i64(rows, (None,), "rows")
+        r = None if rows is None else A.indices(rows, (None,), "rows")
         row, dist = ffi.new("int64_t *"), ffi.new("double *")
-        self.ctx.call(lib.es_study_nearest_row, self.ptr, A.dptr(L), A.iptr(r),
+        self._call(lib.es_study_nearest_row, A.dptr(L), A.iptr(r),
                       0 if r is None else len(r), row, dist)
         return int(row[0]), float(dist[0])
 
@@ -650,7 +690,7 @@ class Store:
         set_embed_opts(o.embed, opts)
         xyz = np.empty((self.nverts, 3))
         res = ffi.new("es_study_embed_result *")
-        self.ctx.call(lib.es_study_embed, self.ptr, o, A.dptr(xyz), res)
+        self._call(lib.es_study_embed, o, A.dptr(xyz), res)
         rep = report_dict(res.report)
         rep["scale"] = float(res.scale)
         rep["init"] = ffi.string(res.init).decode("utf-8", "replace")
@@ -679,11 +719,11 @@ class Store:
                     self._command("interp") if name else ffi.NULL]
             setattr(o, "from", keep[0])   # a Python keyword
             o.to, o.weights, o.pca_name, o.output, o.name, o.command = keep[1:]
-            o.t0, o.t1, o.steps = float(t0), float(t1), int(steps)
+            o.t0, o.t1, o.steps = float(t0), float(t1), A.index(steps, "steps")
             o.cold = 1 if cold else 0
             o.frame = cb
             set_embed_opts(o.embed, opts)
-            self.ctx.call(lib.es_study_interp, self.ptr, o)
+            self._call(lib.es_study_interp, o)
             out = []
             F = self.mesh.faces
             for i, path, heading, rep in sorted(frames):
@@ -696,7 +736,7 @@ class Store:
         stored PCA (es_study_project): dict names, scores (n, K), residuals."""
         ins = A.CStrings([str(x) for x in inputs])
         out = ffi.new("es_study_projection **")
-        self.ctx.call(lib.es_study_project, self.ptr, _s(pca) or ffi.NULL, len(ins), ins.ptr,
+        self._call(lib.es_study_project, _s(pca) or ffi.NULL, len(ins), ins.ptr,
                       _s(where) or ffi.NULL, out)
         p = A.owned(self.ctx, out[0], lib.es_study_projection_free)
         n, K = int(p.n), int(p.ncomp)
@@ -712,11 +752,12 @@ class Store:
         o = ffi.new("es_gpa_opts *")
         lib.es_gpa_opts_init(o)
         o.scale, o.allow_reflection, o.tol, o.max_iter = int(scale), int(allow_reflection), \
-            float(tol), int(max_iter)
-        r = None if rows is None else A.i64(rows, (None,), "rows")
+            float(tol), A.index(max_iter, "max_iter")
+        r = None if rows is None else A.indices(rows, (None,), "rows")
         rep = ffi.new("es_gpa_report *")
-        self.ctx.call(lib.es_study_gpa, self.ptr, _s(name), A.iptr(r),
-                      -1 if r is None else len(r), o, int(npc), self._command("gpa"), rep)
+        self._call(lib.es_study_gpa, _s(name), A.iptr(r),
+                   -1 if r is None else len(r), o, A.index(npc, "npc"), self._command("gpa"),
+                   rep)
         self.commit()
         return self.load_gpa(name, A.struct_dict(rep, "es_gpa_report"))
 
@@ -746,10 +787,11 @@ class Store:
         committed; out_dir gets the CSV tables."""
         o = ffi.new("es_compare_opts *")
         lib.es_compare_opts_init(o)
-        o.permutations, o.top_pairs = int(permutations), int(top_pairs)
+        o.permutations = A.index(permutations, "permutations")
+        o.top_pairs = A.index(top_pairs, "top_pairs")
         o.normalize_lengths = int(normalize_lengths)
         out = ffi.new("es_compare_result **")
-        self.ctx.call(lib.es_study_compare, self.ptr, _s(gpa), _s(by) or ffi.NULL, o,
+        self._call(lib.es_study_compare, _s(gpa), _s(by) or ffi.NULL, o,
                       _s(name) if name else b"", _s(out_dir) or ffi.NULL,
                       self._command("compare"), out)
         r = A.owned(self.ctx, out[0], lib.es_compare_result_free)
@@ -802,9 +844,10 @@ class Store:
         errs = A.CStrings([f"{t}={e}" for t, e in (errors or {}).items()])
         o.errors, o.nerrors = errs.ptr, len(errs)
         o.ss_type, o.scheme, o.contrasts = ss_type, schemes[permute], codings[contrasts]
-        o.permutations, o.edge_permutations = int(permutations), int(edge_permutations)
+        o.permutations = A.index(permutations, "permutations")
+        o.edge_permutations = A.index(edge_permutations, "edge_permutations")
         out = ffi.new("es_study_model_result **")
-        self.ctx.call(lib.es_study_model, self.ptr, o, out)
+        self._call(lib.es_study_model, o, out)
         r = A.owned(self.ctx, out[0], lib.es_study_model_free)
         if name:
             self.commit()
@@ -844,15 +887,15 @@ class Store:
     # -- files --------------------------------------------------------------
     def export_lengths_csv(self, path, rows=None, raw=False):
         """Rows' lengths as CSV (es_export_lengths_csv; %.17g)."""
-        r = None if rows is None else A.i64(rows, (None,), "rows")
-        self.ctx.call(lib.es_export_lengths_csv, self.ptr, A.iptr(r), -1 if r is None else len(r),
+        r = None if rows is None else A.indices(rows, (None,), "rows")
+        self._call(lib.es_export_lengths_csv, A.iptr(r), -1 if r is None else len(r),
                       int(raw), _s(path))
 
     def export_meshes(self, directory, rows=None, fmt="obj"):
         """Rows' positions as mesh files DIR/<id>.<ext> (es_export_meshes)."""
-        r = None if rows is None else A.i64(rows, (None,), "rows")
+        r = None if rows is None else A.indices(rows, (None,), "rows")
         f = getattr(lib, "ES_FORMAT_" + fmt.upper().replace("-", "_"))
-        self.ctx.call(lib.es_export_meshes, self.ptr, A.iptr(r), -1 if r is None else len(r),
+        self._call(lib.es_export_meshes, A.iptr(r), -1 if r is None else len(r),
                       _s(directory), f)
 
     def export_statismo(self, path, pca=None, gpa=None, ncomp=0, sd=1.0, noise_variance=None,
@@ -864,12 +907,12 @@ class Store:
         lib.es_study_statismo_opts_init(o)
         keep = [_c(pca), _c(gpa), self._command("export_statismo")]
         o.pca_name, o.gpa_name, o.command = keep
-        o.ncomp, o.sd = int(ncomp), float(sd)
+        o.ncomp, o.sd = A.index(ncomp, "ncomp"), float(sd)
         if noise_variance is not None:
             o.noise_variance = float(noise_variance)
         set_embed_opts(o.embed, opts)
         rep = ffi.new("es_study_statismo_report *")
-        self.ctx.call(lib.es_study_export_statismo, self.ptr, o, _s(path), rep)
+        self._call(lib.es_study_export_statismo, o, _s(path), rep)
         return A.struct_dict(rep, "es_study_statismo_report")
 
     def _committed(self, name):

@@ -271,6 +271,74 @@ static void test_replace_targets(es_ctx *ctx)
     }
 }
 
+/* A pid no process has: a child that has exited and been reaped. */
+static pid_t dead_pid(void)
+{
+    pid_t pid = fork();
+    if (pid == 0) _exit(0);
+    waitpid(pid, NULL, 0);
+    return pid;
+}
+
+static void touch(const char *path)
+{
+    FILE *f = fopen(path, "w");
+    ES_CHECK(f != NULL);
+    if (f) fclose(f);
+}
+
+/* Part files a killed writer left ("<name>.<pid>[.<n>].part") are removed by
+ * the next write of that name when their process is gone, and kept when it
+ * lives (issue 25: they piled up); a name too long for a part file beside
+ * it (NAME_MAX) is written through a shortened one. */
+static void test_stale_and_long_names(es_ctx *ctx)
+{
+    char path[4400], p[4600], live[4600], other[4600], name[300];
+    es__file_replace w;
+    pid_t gone = dead_pid();
+    in_dir("model.h5", path, sizeof path);
+    snprintf(p, sizeof p, "%s.%ld.part", path, (long)gone);
+    touch(p);
+    snprintf(p, sizeof p, "%s.%ld.3.part", path, (long)gone);
+    touch(p);
+    snprintf(live, sizeof live, "%s.%ld.part", path, (long)getppid());
+    touch(live);
+    snprintf(other, sizeof other, "%s/other.h5.%ld.part", dir, (long)gone);
+    touch(other);
+    ES_CHECK(es_test_count_entries(dir, ".part") == 4);
+    ES_CHECK_OK(ctx, es__replace_begin(ctx, path, &w));
+    if (w.f) fputs("new\n", w.f);
+    ES_CHECK_OK(ctx, es__replace_end(ctx, &w, ES_OK));
+    /* the live writer's and another file's are kept */
+    ES_CHECK(es_test_count_entries(dir, ".part") == 2 && access(live, F_OK) == 0 &&
+             access(other, F_OK) == 0);
+    remove(live);
+    remove(other);
+    remove(path);
+    /* 250 bytes: "<name>.<pid>.part" would pass NAME_MAX */
+    memset(name, 'n', 250);
+    memcpy(name + 246, ".csv", 5);
+    snprintf(path, sizeof path, "%s/%.255s", dir, name);
+    ES_CHECK_OK(ctx, es__replace_begin(ctx, path, &w));
+    ES_CHECK(w.tmp && strlen(es__path_base(w.tmp)) <= 255 && strstr(w.tmp, "~"));
+    if (w.f) fputs("long\n", w.f);
+    ES_CHECK_OK(ctx, es__replace_end(ctx, &w, ES_OK));
+    ES_CHECK(access(path, F_OK) == 0 && es_test_count_entries(dir, ".part") == 0);
+    remove(path);
+    /* two long names that share their first 120 bytes get two part names */
+    {
+        char a[300], b[300];
+        memset(name, 'n', 250);
+        name[250] = '\0';
+        es__short_base(name, 24, a, sizeof a);
+        name[249] = 'm';
+        es__short_base(name, 24, b, sizeof b);
+        ES_CHECK(strlen(a) == 137 && strcmp(a, b) != 0);
+        es__short_base("short.h5", 24, a, sizeof a);
+        ES_CHECK(!strcmp(a, "short.h5"));
+    }
+}
+
 int main(void)
 {
     es_ctx *ctx = NULL;
@@ -283,6 +351,7 @@ int main(void)
     test_mkdir(ctx);
     test_paths(ctx);
     test_replace_targets(ctx);
+    test_stale_and_long_names(ctx);
     static const char *const left[] = {"bom.txt", "nul.txt", "small.txt", "big.txt"};
     for (size_t i = 0; i < sizeof left / sizeof *left; i++) {
         char path[4200];

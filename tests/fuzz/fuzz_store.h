@@ -8,6 +8,7 @@
 #include "fuzz_util.h"
 #include "crafted.h"
 
+#include <hdf5.h>
 #include <sys/stat.h>
 
 static inline const unsigned char *fuzz_base_store(size_t *n)
@@ -30,6 +31,51 @@ static inline const unsigned char *fuzz_base_store(size_t *n)
     }
     *n = len;
     return bytes;
+}
+
+/* The base store's object headers (address and bytes of each, found by
+ * HDF5 itself: every group and dataset reachable from the root), for the
+ * target that aims its changes at them. */
+typedef struct fuzz_header { size_t addr, len; } fuzz_header;
+static fuzz_header fuzz_headers[256];
+
+static herr_t fuzz_header_cb(hid_t obj, const char *name, const H5O_info_t *info, void *ud)
+{
+    size_t *n = ud;
+    (void)obj;
+    (void)name;
+    if (*n < 256 && info->hdr.space.total > 0) {
+        fuzz_headers[*n].addr = (size_t)info->addr;
+        fuzz_headers[*n].len = (size_t)info->hdr.space.total;
+        ++*n;
+    }
+    return 0;
+}
+
+static inline const fuzz_header *fuzz_base_headers(size_t *n)
+{
+    static size_t count;
+    static int done;
+    if (!done) {
+        size_t nbase;
+        const unsigned char *base = fuzz_base_store(&nbase);
+        char dir[] = "/tmp/edgespace-fuzz-XXXXXX", path[64];
+        FILE *f;
+        hid_t file;
+        done = 1;
+        if (!mkdtemp(dir)) abort();
+        snprintf(path, sizeof path, "%s/base.h5", dir);
+        if (!(f = fopen(path, "wb")) || fwrite(base, 1, nbase, f) != nbase || fclose(f)) abort();
+        if ((file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT)) < 0 ||
+            H5Ovisit2(file, H5_INDEX_NAME, H5_ITER_NATIVE, fuzz_header_cb, &count,
+                      H5O_INFO_BASIC | H5O_INFO_HDR) < 0)
+            abort();
+        H5Fclose(file);
+        remove(path);
+        rmdir(dir);
+    }
+    *n = count;
+    return fuzz_headers;
 }
 
 /* The input as a store file at a real path: HDF5 1.10 resolves the path it

@@ -672,12 +672,17 @@ static void test_shared(es_ctx *ctx)
 }
 
 /* CSV fields: plain text as is, quoted (quotes doubled) when it holds a
- * comma, quote or line break, NULL as empty. */
+ * comma, quote or line break, NULL as empty; what a spreadsheet would run as
+ * a formula (issue 25: "=cmd|' /C calc'!A0") quoted behind an apostrophe,
+ * numbers with a sign as they are. */
 static void test_csv_field(void)
 {
-    static const char *in[] = {"s01", "a,b", "say \"hi\"", "two\nlines", "", NULL};
-    static const char *want = "s01|\"a,b\"|\"say \"\"hi\"\"\"|\"two\nlines\"||";
-    char buf[128] = {0};
+    static const char *in[] = {"s01", "a,b", "say \"hi\"", "two\nlines", "",
+                               "=cmd|' /C calc'!A0", "@SUM(A1)", "+x", "-1.5", "+2e3", "a=b",
+                               NULL};
+    static const char *want = "s01|\"a,b\"|\"say \"\"hi\"\"\"|\"two\nlines\"||"
+                              "\"'=cmd|' /C calc'!A0\"|\"'@SUM(A1)\"|\"'+x\"|-1.5|+2e3|a=b|";
+    char buf[256] = {0};
     FILE *f = tmpfile();
     ES_CHECK(f != NULL);
     if (!f) return;

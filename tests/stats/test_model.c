@@ -5,7 +5,8 @@
  * Cholesky, the model matrices coded by hand the way R's model.matrix codes
  * them. What is checked:
  *  - formulas: terms, their order (by degree, as R's terms()), errors with
- *    their column;
+ *    their column, products bounded before they expand and columns checked
+ *    as they are read;
  *  - designs: treatment and sum contrasts, indicator coding where a margin
  *    is missing, interaction columns, names, errors;
  *  - sums of squares of type I, II and III on an unbalanced two-factor
@@ -25,6 +26,7 @@
  *  - an allocation-failure sweep.
  */
 #include "es_test.h"
+#include <time.h>
 #include "es_test_alloc.h"
 #include "core/core_private.h"
 #include "edgespace/es_model.h"
@@ -133,6 +135,100 @@ static void test_formula(es_ctx *ctx)
     ES_CHECK_FAILS(ctx, es_formula_parse(ctx, "~ a b", &f), ES_EFORMAT, "column 5");
     ES_CHECK_FAILS(ctx, es_formula_parse(ctx, "~", &f), ES_EFORMAT, "no terms");
     ES_CHECK(f == NULL);
+}
+
+/* Columns v1..v9 exist (es_formula_parse_checked's callback). */
+static int known_v(void *ud, const char *name, char *why, size_t n)
+{
+    (*(int *)ud)++;
+    if (name[0] == 'v' && name[1] >= '1' && name[1] <= '9' && !name[2]) return 1;
+    snprintf(why, n, "no label column '%s'", name);
+    return 0;
+}
+
+/* Products expand exponentially: bounded before they are expanded (issue
+ * 25: "~ v1*v2*...*v18", 262,143 terms, ran for minutes), and the columns
+ * checked as they are read. The whole of it must take well under a second
+ * (the wall clock is the finding here, not a benchmark). */
+static void test_formula_bounds(es_ctx *ctx)
+{
+    es_formula *f = NULL;
+    char big[400];
+    int calls = 0;
+    size_t k = 0;
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    k += (size_t)snprintf(big + k, sizeof big - k, "~ v1");
+    for (int v = 2; v <= 18; v++) k += (size_t)snprintf(big + k, sizeof big - k, "*v%d", v);
+    ES_CHECK_FAILS(ctx, es_formula_parse(ctx, big, &f), ES_EFORMAT,
+                   "expands to more than 1024 terms");
+    /* the first bad column is named before anything is expanded */
+    ES_CHECK_FAILS(ctx, es_formula_parse_checked(ctx, big, known_v, &calls, &f), ES_ENOTFOUND,
+                   "column 30: no label column 'v10'");
+    ES_CHECK(calls == 10);
+    /* ten names: 1023 terms, the 2^10 - 1 non-empty subsets */
+    ES_CHECK_OK(ctx, es_formula_parse(ctx, "~ a*b*c*d*e*f*g*h*i*j", &f));
+    ES_CHECK(f && es_formula_nterms(f) == 1023);
+    es_formula_free(f);
+    f = NULL;
+    ES_CHECK_FAILS(ctx, es_formula_parse(ctx, "~ a*b*c*d*e*f*g*h*i*j*k", &f), ES_EFORMAT,
+                   "column 22: the formula expands to more than 1024 terms");
+    ES_CHECK_FAILS(ctx, es_formula_parse(ctx, "~ (a+b+c+d+e+f+g+h):(i+j+k+l+m+n+o+p):"
+                   "(q+r+s+t+u+v+w+x):(y+z+A+B)", &f), ES_EFORMAT, "more than 1024 terms");
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    double sec = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    ES_CHECK_MSG(sec < 1.0, "the bounded formulas took %.2f s", sec);
+    ES_CHECK(f == NULL);
+}
+
+/* Terms that add no rank, found in one pass (fuzz_formula: "~ v1*...*v7*d*f"
+ * on 8 rows, 511 terms, took over a minute under ASan when every term left
+ * out meant a pivoted QR per term and a rebuilt design, and then failed at
+ * 20,000 columns of terms it would have left out). v1..v7 are one factor of
+ * 3 levels under seven names, d and f one number column under two. Worked
+ * out by hand: v2..v7 and f duplicate v1 and d; every vi:vj is a function
+ * of v1 alone; v1:d (v1 by contrasts, its margin d kept) adds 2 directions,
+ * v1:f (f dropped: v1 by indicators) sums to d; d:f = d^2 adds one (rank 7);
+ * v1:d:f adds the 8th (ind(y) d^2; its second column stays, aliased within
+ * the term), after which nothing can add rank in R^8. Kept: v1, d, v1:d,
+ * d:f, v1:d:f, 9 columns; the other 506 left out, each saying why. */
+static void test_alias_pass(es_ctx *ctx)
+{
+    const char *lv[8] = {"x", "y", "z", "x", "y", "z", "x", "y"};
+    const double num[8] = {1, 2, 3, 5, 8, 13, 21, 34};
+    const char *names[9] = {"v1", "v2", "v3", "v4", "v5", "v6", "v7", "d", "f"};
+    const char *const keep[5] = {"v1", "d", "v1:d", "d:f", "v1:d:f"};
+    es_model_column cols[9];
+    es_formula *f = NULL;
+    es_design *d = NULL;
+    struct timespec t0, t1;
+    for (int v = 0; v < 9; v++) {
+        cols[v].name = names[v];
+        cols[v].labels = v < 7 ? lv : NULL;
+        cols[v].values = v < 7 ? NULL : num;
+        cols[v].reference = NULL;
+    }
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    ES_CHECK_OK(ctx, es_formula_parse(ctx, "~ v1*v2*v3*v4*v5*v6*v7*d*f", &f));
+    if (f) ES_CHECK_OK(ctx, es_design_build(ctx, f, 8, cols, 9, ES_CONTRASTS_TREATMENT, &d));
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    double sec = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    ES_CHECK_MSG(sec < 1.0, "511 terms with 506 left out took %.2f s", sec);
+    ES_CHECK(f && es_formula_nterms(f) == 511);
+    if (d) {
+        ES_CHECK_MSG(d->nterms == 5 && d->ndropped == 506 && d->ncols == 9,
+                     "kept %lld terms (%lld columns), left out %lld", (long long)d->nterms,
+                     (long long)d->ncols, (long long)d->ndropped);
+        for (int64_t j = 0; j < d->nterms && j < 5; j++)
+            ES_CHECK_MSG(!strcmp(d->terms[j], keep[j]), "term %lld is '%s'", (long long)j,
+                         d->terms[j]);
+        ES_CHECK(!strcmp(es_design_dropped(d, "v2"), "duplicates 'v1'") &&
+                 !strcmp(es_design_dropped(d, "f"), "duplicates 'd'"));
+        for (int64_t k = 0; k < d->ndropped; k++)
+            ES_CHECK(d->dropped_why[k] && d->dropped_why[k][0]);
+    }
+    es_design_free(d);
+    es_formula_free(f);
 }
 
 static es_design *design(es_ctx *ctx, const char *formula, int64_t n,
@@ -730,6 +826,8 @@ int main(void)
     es_ctx *ctx = NULL;
     if (es_ctx_new(&ctx) != ES_OK) return 1;
     test_formula(ctx);
+    test_formula_bounds(ctx);
+    test_alias_pass(ctx);
     test_design(ctx);
     test_ss_types(ctx);
     test_permutations(ctx);

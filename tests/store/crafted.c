@@ -341,7 +341,7 @@ const crafted_mutation crafted_mutations[] = {
     {"group local heap free block too big", REFUSE, "local heap", 1},
     {"group B-tree child points up", REFUSE, "B-tree", 1},
     {"group link name outside its heap", REFUSE, "outside its local heap", 1},
-    {"attribute value larger than its message", REFUSE, "an attribute of /topology", 2},
+    {"attribute value larger than its message", REFUSE, "/topology has an attribute", 2},
     {"positions chunks larger than the dataset", REFUSE, "the chunks of /shapes/positions", 1},
 };
 const int crafted_nmutations = (int)(sizeof crafted_mutations / sizeof crafted_mutations[0]);

@@ -11,6 +11,8 @@
  * from the rows (the embedding's prior gets the right combination). In
  * Procrustes space (a GPA result) the response is the aligned coordinates,
  * and a coefficient there is refused as a point. log(size) brings the CAC.
+ * A model cancelled from its progress callback stops and stores nothing
+ * (the store's bytes unchanged), and a rolled-back result is gone.
  */
 #include "core/core_private.h"
 #include "es_test.h"
@@ -18,6 +20,18 @@
 #include "edgespace/edgespace.h"
 
 #include <unistd.h>
+
+/* A progress callback that cancels at its second report (es_ctx_cancel from
+ * inside the work, as the Python binding does for an exception or Ctrl-C). */
+static es_ctx *cancel_ctx;
+static void cancel_after_two(void *ud, const char *what, int64_t done, int64_t total)
+{
+    int *reports = ud;
+    (void)what;
+    (void)done;
+    (void)total;
+    if (++*reports == 2) es_ctx_cancel(cancel_ctx);
+}
 
 static es_status make_store(es_ctx *ctx, const char *path, int64_t *nrows)
 {
@@ -78,6 +92,7 @@ int main(void)
     char path[1024];
     int64_t n = 0;
     if (es_ctx_new(&ctx) != ES_OK) return 1;
+    cancel_ctx = ctx;
     snprintf(path, sizeof path, "%s/faces.h5", es_test_tmpdir("model_store"));
     ES_CHECK_OK(ctx, make_store(ctx, path, &n));
     ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_WRITE, &s));
@@ -248,6 +263,47 @@ int main(void)
     o.formula = "~ mood";
     ES_CHECK_FAILS(ctx, es_study_model(ctx, s, &o, &r), ES_ENOTFOUND, "no label column 'mood'");
     ES_CHECK(r == NULL);
+
+    /* ---- cancelled from the progress callback: stops, stores nothing ---- */
+    {
+        int reports = 0;
+        size_t nbefore = 0, nafter = 0;
+        char *before, *after;
+        ES_CHECK_OK(ctx, es_store_commit(ctx, s));
+        before = es_test_slurp(path, &nbefore);
+        es_ctx_set_progress(ctx, cancel_after_two, &reports);
+        o.formula = "~ subject + expression";
+        o.name = "cancelled";
+        o.permutations = 99999;
+        o.edge_term = NULL;
+        o.pairwise = NULL;
+        ES_CHECK_FAILS(ctx, es_study_model(ctx, s, &o, &r), ES_ECANCELED, "; nothing stored");
+        ES_CHECK(r == NULL && reports == 2 && es_ctx_cancelled(ctx));
+        /* while the request stands, writes and commits refuse */
+        ES_CHECK_OK(ctx, es_store_commit(ctx, s));   /* nothing pending: nothing to refuse */
+        ES_CHECK_FAILS(ctx, es_store_result_begin(ctx, s, "mean", "x",
+                                                  &(es_provenance){"t", NULL, -1, NULL}),
+                       ES_ECANCELED, "nothing stored");
+        es_ctx_set_progress(ctx, NULL, NULL);
+        es_ctx_cancel_clear(ctx);
+        ES_CHECK(!es_ctx_cancelled(ctx) && !es_store_has(s, "model/cancelled") &&
+                 !es_store_pending(s));
+        after = es_test_slurp(path, &nafter);
+        ES_CHECK(before && after && nbefore == nafter && !memcmp(before, after, nbefore));
+        free(before);
+        free(after);
+        /* a result written and rolled back is gone; the handle writes again */
+        ES_CHECK_OK(ctx, es_store_result_begin(ctx, s, "mean", "x",
+                                               &(es_provenance){"t", NULL, -1, NULL}));
+        ES_CHECK(es_store_pending(s) && es_store_has(s, "mean/x"));
+        ES_CHECK_OK(ctx, es_store_rollback(ctx, s));
+        ES_CHECK(!es_store_pending(s) && !es_store_has(s, "mean/x") && es_store_nrows(s) == n &&
+                 es_store_find_column(s, "age") == 2);
+        ES_CHECK_OK(ctx, es_store_result_begin(ctx, s, "mean", "y",
+                                               &(es_provenance){"t", NULL, -1, NULL}));
+        ES_CHECK_OK(ctx, es_store_commit(ctx, s));
+        ES_CHECK(es_store_has(s, "mean/y") && !es_store_has(s, "mean/x"));
+    }
     free(y);
     es_store_close(s);
     es_ctx_free(ctx);

@@ -573,6 +573,23 @@ static void test_files(es_ctx *ctx)
         ES_CHECK(system(cmd) == 0);
         snprintf(path, sizeof path, "%s/cli/tube_002.obj", dir);
         ES_CHECK(access(path, R_OK) == 0);
+        /* a folder with a manifest is left alone without --replace (issue 25:
+         * it was overwritten silently) */
+        snprintf(path, sizeof path, "%s/cli/manifest.csv", dir);
+        FILE *mf = fopen(path, "w");
+        if (mf) fputs("file,mine\n", mf);
+        if (mf) fclose(mf);
+        snprintf(cmd, sizeof cmd, "'%s' synth tube -o '%s/cli' --n 3 -r 2 2>/dev/null", exe,
+                 dir);
+        int st0 = system(cmd);
+        char head[32] = "";
+        mf = fopen(path, "r");
+        if (mf && !fgets(head, sizeof head, mf)) head[0] = '\0';
+        if (mf) fclose(mf);
+        ES_CHECK(WIFEXITED(st0) && WEXITSTATUS(st0) == 1 && !strcmp(head, "file,mine\n"));
+        snprintf(cmd, sizeof cmd, "'%s' synth tube -o '%s/cli' --n 3 -r 2 --replace >/dev/null",
+                 exe, dir);
+        ES_CHECK(system(cmd) == 0);
         snprintf(cmd, sizeof cmd, "'%s' synth bagel -o '%s/cli' 2>/dev/null", exe, dir);
         int st = system(cmd);
         ES_CHECK(WIFEXITED(st) && WEXITSTATUS(st) == 2);

@@ -17,6 +17,7 @@
 
 #include <math.h>
 #include <sys/stat.h>
+#include <time.h>
 
 enum { S = 6, X = 3, N = S * X };
 
@@ -118,7 +119,7 @@ int main(void)
     ES_CHECK(r.status == 2 && strstr(r.err, "go with --result"));
 
     /* the faces, their lengths, and failures on the store */
-    ES_RUN(&r, dir, "synth", "face", "-n", "6", "--noise", "0.002", "-o", faces);
+    ES_RUN(&r, dir, "synth", "face", "-n", "6", "--noise", "0.002", "-o", faces, "--replace");
     ES_CHECK(r.status == 0);
     ES_RUN(&r, dir, "ingest", store, "--manifest", manifest, "-q");
     ES_CHECK(r.status == 0);
@@ -140,6 +141,37 @@ int main(void)
     /* a misspelt column names the closest */
     ES_CHECK_MSG(r.status == 1 && strstr(r.err, "no label column 'expresion'") &&
                  strstr(r.err, "did you mean") && strstr(r.err, "expression"), "%s", r.err);
+    /* an 18-way product (262,143 terms) is refused at its first unknown
+     * column, and a product of known columns is bounded before it expands
+     * (a*b*a*b... is the 3 terms of a*b): at once, not after minutes (issue
+     * 25) */
+    {
+        char big[200], known[400];
+        size_t k = (size_t)snprintf(big, sizeof big, "~ v1"), k2;
+        struct timespec t0, t1;
+        for (int v = 2; v <= 18; v++) k += (size_t)snprintf(big + k, sizeof big - k, "*v%d", v);
+        k2 = (size_t)snprintf(known, sizeof known, "~ expression");
+        for (int v = 2; v <= 18; v++)
+            k2 += (size_t)snprintf(known + k2, sizeof known - k2, "*%s",
+                                   v % 2 ? "expression" : "subject");
+        clock_gettime(CLOCK_MONOTONIC, &t0);
+        ES_RUN(&r, dir, "model", store, big);
+        ES_CHECK_MSG(r.status == 1 && strstr(r.err, "formula: column 3: no label column 'v1'"),
+                     "%s", r.err);
+        /* (expression x subject with one face each leaves no residual) */
+        ES_RUN(&r, dir, "model", store, known, "-p", "9", "--no-store");
+        ES_CHECK_MSG(r.status == 1 && strstr(r.err, "no residual degrees of freedom"), "%s",
+                     r.err);
+        clock_gettime(CLOCK_MONOTONIC, &t1);
+        double sec = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+        ES_CHECK_MSG(sec < 5, "two bounded formulas took %.1f s", sec);
+    }
+    /* one cap for every permutation count (issue 25: --edge-permutations and
+     * compare -p took 2^40) */
+    ES_RUN(&r, dir, "model", store, "~ expression", "--edge-permutations", "1099511627776");
+    ES_CHECK_MSG(r.status == 2 && strstr(r.err, "from 0 to 100000000"), "%s", r.err);
+    ES_RUN(&r, dir, "model", store, "~ expression", "-p", "100000001");
+    ES_CHECK_MSG(r.status == 2 && strstr(r.err, "from 0 to 100000000"), "%s", r.err);
     ES_RUN(&r, dir, "model", store, "~ expression", "--block", "subjct");
     ES_CHECK_MSG(r.status == 1 && strstr(r.err, "'subjct'") && strstr(r.err, "did you mean") &&
                  strstr(r.err, "subject"), "%s", r.err);

@@ -47,7 +47,7 @@ int main(void)
     ES_CHECK(r.status == 1 && strstr(r.err, "edgespace gpa: "));
 
     /* barbells: synth, ingest, gpa, compare */
-    ES_RUN(&r, dir, "synth", "barbell", "-o", bb);
+    ES_RUN(&r, dir, "synth", "barbell", "-o", bb, "--replace");   /* (a re-run finds it) */
     ES_CHECK(r.status == 0);
     char manifest[700];
     snprintf(manifest, sizeof manifest, "%s/manifest.csv", bb);
@@ -66,6 +66,8 @@ int main(void)
            "--replace");
     ES_CHECK_MSG(r.status == 0 && strstr(r.out, "4 rows, 3D, partial GPA with reflection") &&
                  strstr(r.out, "PC variance"), "%s%s", r.out, r.err);
+    ES_RUN(&r, dir, "compare", store, "--gpa", "g", "-p", "1099511627776");
+    ES_CHECK_MSG(r.status == 2 && strstr(r.err, "(0 to 100000000)"), "%s", r.err);
     ES_RUN(&r, dir, "compare", store, "--gpa", "nope");
     ES_CHECK(r.status == 1 && strstr(r.err, "no GPA result 'nope'"));
     ES_RUN(&r, dir, "compare", store, "--gpa", "g", "--by", "end", "--permutations", "23", "-o",

@@ -308,6 +308,17 @@ int main(void)
     ES_RUN(&r, dir, "embed", store, "--point", "mean + 0.5*pc:1", "--pca", "one", "-o", out,
            "--no-store");
     ES_CHECK_MSG(r.status == 0, "embed --pca one: %s", r.err);
+    /* a memory limit below the estimated need: refused in one line naming it,
+     * before anything is embedded; a size that is not one: a usage error */
+    remove(out);
+    ES_RUN(&r, dir, "embed", store, "--point", "mean", "-o", out, "--no-store", "--max-memory",
+           "100K");
+    ES_CHECK_MSG(r.status == 1 && strstr(r.err, "needs about") &&
+                 strstr(r.err, "more than the memory limit of 0.102 MB") &&
+                 access(out, F_OK) != 0, "--max-memory 100K: %d %s", r.status, r.err);
+    ES_RUN(&r, dir, "embed", store, "--point", "mean", "-o", out, "--no-store", "--max-memory",
+           "lots");
+    ES_CHECK_MSG(r.status == 2, "--max-memory lots: %d %s", r.status, r.err);
     snprintf(pat, sizeof pat, "%s/pcwalk_%%d.obj", dir);
     ES_RUN(&r, dir, "interp", store, "--from", "mean", "--to", "mean + pc:1", "--pca", "two",
            "--steps", "2", "-o", pat, "--no-store");

@@ -58,8 +58,10 @@ int cmd_compare(int argc, char **argv)
         case 'o': out = optarg; break;
         case O_NAME: name = optarg; break;
         case 'p':
-            if (cli_parse_i64(optarg, &o.permutations) || o.permutations < 0)
-                return cli_usage_error("compare", "bad --permutations '%s'", optarg);
+            if (cli_parse_i64(optarg, &o.permutations) || o.permutations < 0 ||
+                o.permutations > ES_MAX_PERMUTATIONS)
+                return cli_usage_error("compare", "bad --permutations '%s' (0 to %d)", optarg,
+                                       ES_MAX_PERMUTATIONS);
             break;
         case O_TOP:
             if (cli_parse_i64(optarg, &o.top_pairs) || o.top_pairs < 0)

@@ -102,13 +102,14 @@ int cmd_diff(int argc, char **argv)
         cli_fail("diff", ctx, rc);
         goto done;
     }
-    printf("diff '%s': %s=%s minus %s=%s, paired by %s: %lld pairs\n", name, column, to, column,
-           from, key, (long long)d->npairs);
+    FILE *out = cli_report_stream(csv);   /* "-o -": stdout is the CSV alone */
+    fprintf(out, "diff '%s': %s=%s minus %s=%s, paired by %s: %lld pairs\n", name, column, to,
+            column, from, key, (long long)d->npairs);
     if (d->nunpaired) {
-        printf("%lld unpaired rows:", (long long)d->nunpaired);
+        fprintf(out, "%lld unpaired rows:", (long long)d->nunpaired);
         for (int64_t i = 0; i < d->nunpaired; i++)
-            printf(" %s", es_store_row_id(st, d->unpaired[i]));
-        printf("\n");
+            fprintf(out, " %s", es_store_row_id(st, d->unpaired[i]));
+        fprintf(out, "\n");
     }
     double norm = 0, tmax = 0;
     int64_t emax = -1;
@@ -117,18 +118,18 @@ int cmd_diff(int argc, char **argv)
         if (fabs(d->t[e]) > tmax) tmax = fabs(d->t[e]), emax = e;
     }
     if (emax >= 0)
-        printf("|mean difference| = %.6g; largest |t| = %.3g at edge %lld (%lld degrees of "
-               "freedom)\n", sqrt(norm), tmax, (long long)emax, (long long)(d->npairs - 1));
+        fprintf(out, "|mean difference| = %.6g; largest |t| = %.3g at edge %lld (%lld degrees of "
+                "freedom)\n", sqrt(norm), tmax, (long long)emax, (long long)(d->npairs - 1));
     else   /* one pair: no spread, so no t */
-        printf("|mean difference| = %.6g; no t statistics (%lld pair)\n", sqrt(norm),
-               (long long)d->npairs);
+        fprintf(out, "|mean difference| = %.6g; no t statistics (%lld pair)\n", sqrt(norm),
+                (long long)d->npairs);
     /* the table first: a failure leaves the store as it was */
     if ((csv && (rc = es_study_write_diff_table(ctx, st, d, csv)) != ES_OK) ||
         (rc = es_store_commit(ctx, st)) != ES_OK) {
         cli_fail("diff", ctx, rc);
         goto done;
     }
-    printf("stored as /analysis/diff/%s\n", name);
+    fprintf(out, "stored as /analysis/diff/%s\n", name);
     ret = CLI_OK;
 done:
     es_diff_free(d);

@@ -51,6 +51,8 @@ CLI_EMBED_HELP
     "                       vertex order and the rows made ready for priors, kept\n"
     "                       beside the store so the next command skips them)\n"
     "      --replace        replace a stored result of that name (else refused)\n"
+    "      --max-memory SIZE  refuse a mesh whose embedding needs more (default: the\n"
+    "                       machine's memory, or $EDGESPACE_MAX_MEMORY; e.g. 8G)\n"
     "  -h, --help           show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -65,10 +67,11 @@ int cmd_embed(int argc, char **argv)
         {"help", no_argument, NULL, 'h'},        CLI_EMBED_LONGOPTS,
         {"residuals", required_argument, NULL, 'r'}, {"pca", required_argument, NULL, 'c'},
         {"no-cache", no_argument, NULL, 'C'},    {"method", required_argument, NULL, 'm'},
-        {NULL, 0, NULL, 0}};
+        {"max-memory", required_argument, NULL, 'M'}, {NULL, 0, NULL, 0}};
     char namebuf[256], text[1024], *cmd = NULL;
     es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
     int c, e, store_it = 1;
+    uint64_t max_memory = 0;
     es_ctx *ctx;
     es_store *s = NULL;
     es_study_embed_opts o;
@@ -97,6 +100,10 @@ int cmd_embed(int argc, char **argv)
             break;
         case 'C': o.cache = 0; break;
         case 'X': wmode = ES_STORE_REPLACE; break;
+        case 'M':
+            if (cli_parse_size(optarg, &max_memory))
+                return cli_usage_error("embed", "--max-memory wants a size such as 8G");
+            break;
         case 'h': fputs(usage, stdout); return CLI_OK;
         default:
             if ((e = cli_embed_option("embed", c, optarg, &o.embed)) >= 0) {
@@ -118,6 +125,7 @@ int cmd_embed(int argc, char **argv)
         o.name = namebuf;
     }
     if (!(ctx = cli_ctx_new("embed"))) return CLI_FAIL;
+    if (max_memory) es_ctx_set_memory_limit(ctx, max_memory);
     if (store_it) o.command = cmd = cli_command_line(argc, argv);
     const char *name = o.name;
     if (!store_it) o.name = NULL;

@@ -45,6 +45,8 @@ CLI_EMBED_HELP
     "                        point (default: from the last frame's correction of its\n"
     "                        prior, a warm start)\n"
     "      --replace         replace a stored result of that name (else refused)\n"
+    "      --max-memory SIZE refuse a mesh whose embedding needs more (default: the\n"
+    "                        machine's memory, or $EDGESPACE_MAX_MEMORY; e.g. 8G)\n"
     "  -m, --method M        edge-length (default: the above), or another paper's\n"
     "                        way between two rows (--from/--to row:ID):\n"
     "                        multiscale (Winkler et al. 2010), shape-space (Wuhrer\n"
@@ -111,11 +113,13 @@ int cmd_interp(int argc, char **argv)
         {"pca", required_argument, NULL, 'c'},  {"cold", no_argument, NULL, 'C'},
         {"method", required_argument, NULL, 'm'}, {"seed", required_argument, NULL, 'S'},
         {"tries", required_argument, NULL, 'T'}, {"knn", required_argument, NULL, 'K'},
-        {"sigma", required_argument, NULL, 'G'}, {NULL, 0, NULL, 0}};
+        {"sigma", required_argument, NULL, 'G'}, {"max-memory", required_argument, NULL, 'M'},
+        {NULL, 0, NULL, 0}};
     es_study_interp_opts o;
     es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
     int c, e, store_it = 1;
     int64_t seed = -1, tries;
+    uint64_t max_memory = 0;
     es_ctx *ctx;
     es_store *s = NULL;
     es_status rc;
@@ -162,6 +166,10 @@ int cmd_interp(int argc, char **argv)
                 return cli_usage_error("interp", "--sigma wants a positive number");
             break;
         case 'X': wmode = ES_STORE_REPLACE; break;
+        case 'M':
+            if (cli_parse_size(optarg, &max_memory))
+                return cli_usage_error("interp", "--max-memory wants a size such as 8G");
+            break;
         case 'h': fputs(usage, stdout), fputs(usage2, stdout); return CLI_OK;
         default:
             if ((e = cli_embed_option("interp", c, optarg, &o.embed)) >= 0) {
@@ -183,6 +191,7 @@ int cmd_interp(int argc, char **argv)
         return cli_usage_error("interp", "with several frames, --output must be a pattern "
                                "with one integer conversion, like 'out_%%02d.obj'");
     if (!(ctx = cli_ctx_new("interp"))) return CLI_FAIL;
+    if (max_memory) es_ctx_set_memory_limit(ctx, max_memory);
     if (seed >= 0) es_ctx_set_seed(ctx, (uint64_t)seed);
     if (o.weights && !weights_are_rows(ctx, o.weights)) {
         es_ctx_free(ctx);

@@ -75,16 +75,17 @@ int cmd_mean(int argc, char **argv)
         cli_fail("mean", ctx, rc);
         goto done;
     }
-    printf("%-20s %8s %14s\n", by ? by : "group", "rows", "mean scale");
+    FILE *out = cli_report_stream(csv);   /* "-o -": stdout is the CSV alone */
+    fprintf(out, "%-20s %8s %14s\n", by ? by : "group", "rows", "mean scale");
     for (int64_t g = 0; g < r->ngroups; g++)
-        printf("%-20s %8lld %14.6g\n", r->names[g], (long long)r->counts[g], r->scales[g]);
+        fprintf(out, "%-20s %8lld %14.6g\n", r->names[g], (long long)r->counts[g], r->scales[g]);
     /* the table first: a failure leaves the store as it was */
     if ((csv && (rc = es_study_write_mean_table(ctx, st, r, csv)) != ES_OK) ||
         (rc = es_store_commit(ctx, st)) != ES_OK) {
         cli_fail("mean", ctx, rc);
         goto done;
     }
-    if (name) printf("stored as /analysis/mean/%s\n", name);
+    if (name) fprintf(out, "stored as /analysis/mean/%s\n", name);
     ret = CLI_OK;
 done:
     es_group_result_free(r);

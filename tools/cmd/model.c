@@ -105,8 +105,10 @@ int cmd_model(int argc, char **argv)
             else return cli_usage_error("model", "--permute is rrpp or raw, not '%s'", optarg);
             break;
         case 'p':
-            if (cli_parse_i64(optarg, &o.permutations) || o.permutations < 0)
-                return cli_usage_error("model", "--permutations needs a count >= 0");
+            if (cli_parse_i64(optarg, &o.permutations) || o.permutations < 0 ||
+                o.permutations > ES_MAX_PERMUTATIONS)
+                return cli_usage_error("model", "--permutations needs a count from 0 to %d",
+                                       ES_MAX_PERMUTATIONS);
             break;
         case O_CONTRASTS:
             if (!strcmp(optarg, "treatment")) o.contrasts = ES_CONTRASTS_TREATMENT;
@@ -124,8 +126,10 @@ int cmd_model(int argc, char **argv)
             break;
         case O_EDGES: o.edge_term = optarg; break;
         case O_EDGE_PERM:
-            if (cli_parse_i64(optarg, &o.edge_permutations) || o.edge_permutations < 0)
-                return cli_usage_error("model", "--edge-permutations needs a count >= 0");
+            if (cli_parse_i64(optarg, &o.edge_permutations) || o.edge_permutations < 0 ||
+                o.edge_permutations > ES_MAX_PERMUTATIONS)
+                return cli_usage_error("model", "--edge-permutations needs a count from 0 to "
+                                       "%d", ES_MAX_PERMUTATIONS);
             break;
         case O_SEED:
             if (cli_parse_i64(optarg, &seed) || seed < 1)
@@ -170,9 +174,10 @@ int cmd_model(int argc, char **argv)
         cli_fail("model", ctx, rc);
         goto done;
     }
-    fputs(text, stdout);
+    FILE *out = cli_report_stream(csv);   /* "-o -": stdout is the CSV alone */
+    fputs(text, out);
     es_free(ctx, text);
-    if (o.name) printf("stored as /analysis/model/%s\n", o.name);
+    if (o.name) fprintf(out, "stored as /analysis/model/%s\n", o.name);
     ret = CLI_OK;
     if (csv && (rc = es_study_write_model_table(ctx, r, csv)) != ES_OK)
         ret = cli_fail("model", ctx, rc);
@@ -190,7 +195,7 @@ int cmd_model(int argc, char **argv)
 #if ES_HAVE_FIGURES
     if (ret == CLI_OK && figure) {
         if ((rc = es_figure_edge_tests(ctx, st, r, figure)) != ES_OK) ret = cli_fail("model", ctx, rc);
-        else printf("figure: %s\n", figure);
+        else fprintf(out, "figure: %s\n", figure);
     }
 #endif
 done:

@@ -72,25 +72,28 @@ int cmd_point(int argc, char **argv)
         cli_fail("point", ctx, rc);
         goto done;
     }
-    printf("point %s: %lld shape and %lld direction terms, weights sum to %.6g\n",
-           argv[optind + 1], (long long)info.nshapes, (long long)info.ndirections, info.weight);
-    if (isnan(info.scale)) printf("scale: none (no shapes with non-zero total weight; use --scale)\n");
-    else printf("scale: %.9g%s\n", info.scale, scale > 0 ? " (given)" : "");
-    printf("lengths sum to %.12g\n", info.length_sum);
+    FILE *out = cli_report_stream(csv);   /* "-o -": stdout is the CSV alone */
+    fprintf(out, "point %s: %lld shape and %lld direction terms, weights sum to %.6g\n",
+            argv[optind + 1], (long long)info.nshapes, (long long)info.ndirections, info.weight);
+    if (isnan(info.scale))
+        fprintf(out, "scale: none (no shapes with non-zero total weight; use --scale)\n");
+    else fprintf(out, "scale: %.9g%s\n", info.scale, scale > 0 ? " (given)" : "");
+    fprintf(out, "lengths sum to %.12g\n", info.length_sum);
     const es_validity *v = &info.validity;
     if (!info.checked) {
-        printf("validity: not checked (a truss store has no faces for the triangle "
-               "inequality)\n");
+        fprintf(out, "validity: not checked (a truss store has no faces for the triangle "
+                "inequality)\n");
     } else if (v->valid) {
-        printf("valid: every length positive, every face satisfies the triangle inequality\n");
+        fprintf(out, "valid: every length positive, every face satisfies the triangle "
+                "inequality\n");
     } else {
-        printf("INVALID: %lld non-finite, %lld non-positive lengths; %lld faces violate the "
-               "triangle inequality", (long long)v->n_nonfinite, (long long)v->n_nonpositive,
-               (long long)v->n_bad_faces);
+        fprintf(out, "INVALID: %lld non-finite, %lld non-positive lengths; %lld faces violate the "
+                "triangle inequality", (long long)v->n_nonfinite, (long long)v->n_nonpositive,
+                (long long)v->n_bad_faces);
         if (v->worst_face >= 0)
-            printf(" (worst: face %lld by %.3g of its perimeter)", (long long)v->worst_face,
-                   v->worst_violation);
-        printf("\n");
+            fprintf(out, " (worst: face %lld by %.3g of its perimeter)", (long long)v->worst_face,
+                    v->worst_violation);
+        fprintf(out, "\n");
     }
     /* the table first: a failure leaves the store as it was */
     static const char *const names[1] = {"length"};
@@ -99,7 +102,7 @@ int cmd_point(int argc, char **argv)
         cli_fail("point", ctx, rc);
         goto done;
     }
-    if (name) printf("stored as /analysis/point/%s\n", name);
+    if (name) fprintf(out, "stored as /analysis/point/%s\n", name);
     ret = CLI_OK;
 done:
     es_free(ctx, vec);

@@ -7,6 +7,7 @@
 #include <getopt.h>
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 static const char usage[] =
     "usage: edgespace synth <family> -o DIR [options]\n"
@@ -30,9 +31,29 @@ static const char usage[] =
     "  -r, --resolution R     mesh density 1..64 (default 8)\n"
     "      --noise X          per-vertex noise sd relative to size\n"
     "      --subdivide K      apply 1-to-4 subdivision K times\n"
+    "      --replace          overwrite DIR/manifest.csv and meshes of the same names\n"
+    "                         (else refused: a folder holding data is left alone)\n"
     "  -h, --help             show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
+
+/* A folder's manifest.csv (a study's, most likely) and meshes are not
+ * overwritten without --replace (they were, silently): 1 (said) if one is
+ * there. */
+static int refuse_existing(const es_synth_set *set, const char *dir)
+{
+    char path[4400];
+    for (int64_t i = -1; i < set->nmembers; i++) {
+        if (i < 0) snprintf(path, sizeof path, "%s/manifest.csv", dir);
+        else snprintf(path, sizeof path, "%s/%s.obj", dir, set->names[i]);
+        if (access(path, F_OK) == 0) {
+            fprintf(stderr, "edgespace synth: '%s' exists; give a new folder, or --replace to "
+                    "overwrite it\n", path);
+            return 1;
+        }
+    }
+    return 0;
+}
 
 int cmd_synth(int argc, char **argv)
 {
@@ -43,12 +64,13 @@ int cmd_synth(int argc, char **argv)
         {"resolution", required_argument, NULL, 'r'},
         {"noise", required_argument, NULL, 'N'},
         {"subdivide", required_argument, NULL, 'S'},
+        {"replace", no_argument, NULL, 'X'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
     const char *verb = "synth", *dir = NULL;
     es_synth_opts o;
     int64_t seed = -1, subdiv = 0;
-    int c;
+    int c, replace = 0;
     es_synth_opts_init(&o);
     optind = 1;
     while ((c = getopt_long(argc, argv, "o:n:s:r:h", longopts, NULL)) != -1) {
@@ -74,6 +96,7 @@ int cmd_synth(int argc, char **argv)
             if (cli_parse_i64(optarg, &subdiv) || subdiv < 0 || subdiv > 8)
                 return cli_usage_error(verb, "--subdivide wants 0..8, not '%s'", optarg);
             break;
+        case 'X': replace = 1; break;
         case 'h': fputs(usage, stdout); return CLI_OK;
         default: return cli_usage_error(verb, "unknown option");
         }
@@ -93,15 +116,17 @@ int cmd_synth(int argc, char **argv)
         return CLI_USAGE;
     }
     if (seed >= 0) es_ctx_set_seed(ctx, (uint64_t)seed);
+    int refused = 0;
     if ((rc = es_synth_generate(ctx, fam, &o, &set)) == ES_OK) {
         if ((rc = es_synth_subdivide(ctx, &set, (int)subdiv)) == ES_OK &&
+            !(refused = !replace && refuse_existing(&set, dir)) &&
             (rc = es_synth_write(ctx, &set, dir)) == ES_OK)
             printf("%s: %lld meshes, %lld vertices, %lld faces -> %s%smanifest.csv\n",
                    es_synth_family_name(fam), (long long)set.nmembers, (long long)set.nverts,
                    (long long)set.nfaces, dir, dir[strlen(dir) - 1] == '/' ? "" : "/");
         es_synth_set_clear(ctx, &set);
     }
-    int ret = rc == ES_OK ? CLI_OK : cli_fail(verb, ctx, rc);
+    int ret = refused ? CLI_FAIL : rc == ES_OK ? CLI_OK : cli_fail(verb, ctx, rc);
     es_ctx_free(ctx);
     return ret;
 }

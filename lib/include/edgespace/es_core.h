@@ -45,7 +45,8 @@ typedef enum es_status {
     ES_ENOTFOUND,    /* a named row, group, point or column does not exist */
     ES_EEXIST,       /* the thing to create exists already */
     ES_EMISMATCH,    /* inputs disagree (topology, vertex count, dimension) */
-    ES_ETOPOLOGY     /* a face list is not an oriented 2-manifold */
+    ES_ETOPOLOGY,    /* a face list is not an oriented 2-manifold */
+    ES_ECANCELED     /* the work was cancelled (es_ctx_cancel); nothing was stored */
 } es_status;
 
 typedef enum es_log_level {
@@ -62,6 +63,10 @@ typedef struct es_mat {
     int64_t rows, cols, ld;
 } es_mat;
 #define ES_AT(m, i, j) ((m).data[(i) + (int64_t)(j) * (m).ld])
+
+/* The most permutations any permutation test takes (models, per-edge tests,
+ * Mantel and group tests): 10^8, one cap for all of them. */
+#define ES_MAX_PERMUTATIONS 100000000
 
 /* Version string of the library, e.g. "0.1.0". Static. */
 ES_API const char *es_version(void);
@@ -88,6 +93,24 @@ ES_API void es_ctx_set_log(es_ctx *ctx, es_log_fn fn, void *userdata);
 typedef void (*es_progress_fn)(void *userdata, const char *what, int64_t done,
                                int64_t total);
 ES_API void es_ctx_set_progress(es_ctx *ctx, es_progress_fn fn, void *userdata);
+
+/* Ask the work running on ctx to stop: safe from the progress or log
+ * callback, another thread or a signal handler (an atomic flag). Long work
+ * checks it at each progress report and returns ES_ECANCELED; a store write
+ * or commit refuses while it is set, so cancelled work stores nothing. The
+ * request stays until es_ctx_cancel_clear (every call made meanwhile stops
+ * at its first check). */
+ES_API void es_ctx_cancel(es_ctx *ctx);
+ES_API void es_ctx_cancel_clear(es_ctx *ctx);
+ES_API int es_ctx_cancelled(const es_ctx *ctx);
+
+/* The memory work on ctx may plan to use, in bytes: what refuses a job
+ * whose estimated need is larger before it allocates it (an embedding of
+ * 5 million vertices grew past 14 GB and was killed by the kernel). 0 (the
+ * default) means the machine's physical memory, or less under a process
+ * limit (RLIMIT_AS); es_ctx_memory_limit returns the limit in force. */
+ES_API void es_ctx_set_memory_limit(es_ctx *ctx, uint64_t bytes);
+ES_API uint64_t es_ctx_memory_limit(const es_ctx *ctx);
 
 /* Seed for everything random the library does (randomized PCA, permutation
  * tests, synthetic data). Same seed, same results. */
@@ -125,8 +148,11 @@ ES_API uint64_t es_rng_below(es_rng *rng, uint64_t n);
 ES_API es_status es_make_dirs(es_ctx *ctx, const char *dir);
 
 /* One CSV field of free text (ids, labels, names) to f, quoted the RFC 4180
- * way when it holds a comma, quote or line break; "" for NULL. Every CSV
- * the library and the command write goes through it. */
+ * way when it holds a comma, quote or line break; "" for NULL. A field a
+ * spreadsheet would run as a formula (starting with = + - @, a tab or a
+ * carriage return, and not a number) is quoted with a leading apostrophe
+ * ("'=cmd|..."), as OWASP advises against CSV injection. Every CSV the
+ * library and the command write goes through it. */
 ES_API void es_csv_write_field(FILE *f, const char *s);
 
 #ifdef __cplusplus

@@ -370,6 +370,15 @@ ES_API es_status es_embed_prior_from_rows_sc(es_ctx *ctx, int64_t nverts, int64_
                                              const double *const *sin_rows, const double *w,
                                              double *xyz, double *alpha, double *sd);
 
+/* Bytes an embedder of mesh and its solves need (an estimate from the
+ * mesh's edges, measured against peak memory: embed_memory.c), and the
+ * check es_embedder_new makes first: ES_ERANGE naming the need when it,
+ * plus extra bytes the caller will hold meanwhile (extra_what names them,
+ * " for 600 rows of the prior"), passes es_ctx_memory_limit. */
+ES_API uint64_t es_embed_memory_estimate(const es_mesh *mesh);
+ES_API es_status es_embed_check_memory(es_ctx *ctx, const es_mesh *mesh, uint64_t extra,
+                                       const char *extra_what);
+
 /* One-line and multi-line text of a report (for commands and notebooks):
  * writes at most n bytes with NUL, returns buf. */
 ES_API const char *es_embed_report_format(const es_embed_report *rep, char *buf, size_t n);

@@ -54,8 +54,21 @@ typedef enum es_var_kind {
 } es_var_kind;
 
 /* Parse text. Errors are ES_EFORMAT naming the 1-based column:
- * "formula: column 9: expected a column name, found '+'". */
+ * "formula: column 9: expected a column name, found '+'". A formula that
+ * expands to more than ES_FORMULA_MAX_TERMS terms is refused before it is
+ * expanded (a*b*...*r, 18 names, would be 262,143 terms). */
+#define ES_FORMULA_MAX_TERMS 1024
 ES_API es_status es_formula_parse(es_ctx *ctx, const char *text, es_formula **out);
+/* Whether a variable's column exists: 1 if it does; 0 if not, with the
+ * reason in why[n] ("no label column 'mood' in 's.h5' (did you mean
+ * 'mode'?)"). */
+typedef int (*es_formula_column_fn)(void *userdata, const char *name, char *why, size_t n);
+/* es_formula_parse with each variable's column checked by known as it is
+ * read, before any product is expanded: ES_ENOTFOUND "formula: column 4:
+ * " and known's reason. */
+ES_API es_status es_formula_parse_checked(es_ctx *ctx, const char *text,
+                                          es_formula_column_fn known, void *userdata,
+                                          es_formula **out);
 ES_API void es_formula_free(es_formula *f);
 /* Variables (distinct NAME / factor(NAME) / log(NAME), in order of first
  * appearance): the label column each reads and how. Borrowed strings. */

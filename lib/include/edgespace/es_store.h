@@ -94,9 +94,16 @@ ES_API es_status es_store_commit(es_ctx *ctx, es_store *store);
 ES_API void es_store_close(es_store *store);
 /* Close, discarding every uncommitted write. NULL: no-op. */
 ES_API void es_store_abort(es_store *store);
+/* Discard every uncommitted write and go on with the store as it is
+ * published (reloaded, as es_store_open loads it); also clears a failed
+ * write's refusal of further writes. ES_EINVAL for a new store never
+ * committed (abort it). */
+ES_API es_status es_store_rollback(es_ctx *ctx, es_store *store);
+/* 1 if the handle holds uncommitted writes, else 0. */
+ES_API int es_store_pending(const es_store *store);
 
 /* A number that changes whenever this handle starts a write (rows,
- * results, attributes, deletions): a cache of values read through the
+ * results, attributes, deletions) or rolls writes back: a cache of values read through the
  * handle is current while the number it was made at is. Other handles' and
  * other processes' writes are not counted (a handle reads the file it
  * opened). */
@@ -139,7 +146,10 @@ typedef struct es_store_rows {
  * new to the store are added with "" in the existing rows; store columns
  * not given get "" in the new rows. Fails with ES_EEXIST on an id that is
  * in the store or given twice, ES_EINVAL on a non-finite length or a bad
- * scale; nothing is written then. */
+ * scale, ES_ERANGE on coordinates outside 1e-30..1e30 (extent, magnitude)
+ * or more than ES_STORE_MAX_COLUMNS label columns (names of at most 500
+ * bytes); nothing is written then. */
+#define ES_STORE_MAX_COLUMNS 2000
 ES_API es_status es_store_append(es_ctx *ctx, es_store *store, const es_store_rows *rows);
 
 /* The stored topology (reference positions: those of row 0, or none for an
