@@ -94,7 +94,7 @@ static es_status check_free(es_ctx *ctx, es_store *s, const char *kind, const ch
     if ((rc = find_link(ctx, s, full, exists))) return rc;
     if (*exists && s->mode != ES_STORE_REPLACE)
         ES_FAIL(ctx, ES_EEXIST, "store: result %s/%s exists already in '%s' (give another name, "
-                "or --replace to replace it)", kind, name, s->path);
+                "or replace it: --replace, replace=True in Python)", kind, name, s->path);
     return ES_OK;
 }
 

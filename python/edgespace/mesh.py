@@ -52,6 +52,12 @@ class Embedding(NamedTuple):
     F: np.ndarray
     report: dict
 
+    def __repr__(self):   # a notebook's text/plain: not every coordinate
+        r = self.report
+        rms = r.get("rms_ratio")
+        return (f"<edgespace.Embedding V={self.V.shape[0]} F={self.F.shape[0]}"
+                + (f" rms_ratio={rms:.3g}" if isinstance(rms, float) else "") + ">")
+
     def render(self, **kw):
         """PNG bytes of this mesh (edgespace.render)."""
         from .render import render
@@ -65,6 +71,14 @@ class Embedding(NamedTuple):
         """Write the mesh file (OBJ/PLY/OFF by extension; es_mesh_write)."""
         m = mesh if mesh is not None else Mesh(self.F, ctx=ctx)
         m.write(path, self.V)
+
+
+def study_embedding(xyz, faces, res):
+    """Embedding of an es_study_embed_result: its report with scale and init."""
+    rep = report_dict(res.report)
+    rep["scale"] = float(res.scale)
+    rep["init"] = ffi.string(res.init).decode("utf-8", "replace")
+    return Embedding(xyz, faces, rep)
 
 
 class Mesh:

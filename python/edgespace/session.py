@@ -11,7 +11,7 @@ import numpy as np
 
 from . import _arrays as A
 from ._native import ffi, lib
-from .mesh import Embedding, report_dict, set_embed_opts
+from .mesh import set_embed_opts, study_embedding
 
 
 class StudyEmbedder:
@@ -51,10 +51,7 @@ class StudyEmbedder:
                 ffi.new("char[]", str(pca).encode()) if pca is not None else ffi.NULL]
         self.ctx.call(lib.es_study_embedder_point, self.ptr, keep[0], keep[1], float(scale), eo,
                       1 if warm else 0, A.dptr(xyz), res)
-        rep = report_dict(res.report)
-        rep["scale"] = float(res.scale)
-        rep["init"] = ffi.string(res.init).decode("utf-8", "replace")
-        return Embedding(xyz, self.faces, rep)
+        return study_embedding(xyz, self.faces, res)
 
     def forget(self):
         """The next warm embedding starts from its own prior."""

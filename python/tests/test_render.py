@@ -25,6 +25,9 @@ def test_render_is_the_commands_picture(tmp_path, cli, ctx):
     assert isinstance(img, bytes) and img == (tmp_path / "cli.png").read_bytes()
     assert png_size(img) == (480, 480)
     assert img._repr_png_() == bytes(img)
+    # a notebook's text/plain of an image: a line, not the PNG's bytes again
+    assert repr(img) == f"<edgespace.Image PNG 480x480, {len(img)} bytes>"
+    assert img.size == png_size(img)
     # with scalars, a title and a colour map: the command's options
     t = np.linspace(-1, 1, m.nedges)
     np.savetxt(tmp_path / "t.csv", t, fmt="%.17g")
@@ -53,6 +56,8 @@ def test_embedding_displays_inline(store_path, ctx):
         e = s.embed("row:face_s01_neutral")
     png = e._repr_png_()
     assert png_size(png) == (360, 360)
+    assert repr(e).startswith(f"<edgespace.Embedding V={e.V.shape[0]} F={e.F.shape[0]} ")
+    assert len(repr(e)) < 100
 
 
 def test_plots(ctx):

@@ -70,6 +70,10 @@ typedef enum es_store_mode {
  * of another format version, or corrupt). */
 ES_API es_status es_store_open(es_ctx *ctx, const char *path, es_store_mode mode,
                                es_store **out);
+/* Switch a write handle between ES_STORE_WRITE (replace 0) and
+ * ES_STORE_REPLACE (1) for the results written from now on (Python's
+ * replace= on one call). ES_EINVAL on a read handle. */
+ES_API es_status es_store_set_replace(es_ctx *ctx, es_store *store, int replace);
 /* Create a new, empty store (N = 0) for `mesh`'s topology, open for
  * writing. Nothing appears at `path` until es_store_commit/es_store_close.
  * Fails with ES_EEXIST if `path` exists. */
