@@ -180,6 +180,13 @@ ES_API const char *es_store_label(const es_store *store, int64_t row, int64_t co
 ES_API void es_store_column_hint(const es_store *store, const char *name, char *buf, size_t n);
 ES_API void es_store_value_hint(const es_store *store, int64_t col, const char *value, char *buf,
                                 size_t n);
+/* The same for a result /analysis/<kind>/<name> the store does not have:
+ * the closest names of that kind (" (did you mean 'faces'?)"), else those
+ * there are (" (pca results: a, b)"), else the kinds present (" (no pca
+ * results; the store has: gpa, model)") or " (the store holds no results)".
+ * Leaves ctx's error message as it was. */
+ES_API void es_store_result_hint(es_ctx *ctx, es_store *store, const char *kind, const char *name,
+                                 char *buf, size_t n);
 
 /* Rows matching a filter "col=value[,col=value...]" (all must hold; NULL or
  * "" selects every row; the column "id" means the row id unless a label
