@@ -70,3 +70,35 @@ def test_plots(ctx):
     assert png_size(img)[0] > 100
     with pytest.raises(ValueError):
         es.plot_scatter(x, y[:5], ctx=ctx)
+
+
+def test_render_scalars_column_and_percentile_range(tmp_path, cli, ctx):
+    """render --column picks a CSV column by name (its header labels the colour
+    bar), --percentiles sets the range: against numpy.percentile (linear)."""
+    import re
+    syn = es.synth("face", n=1, ctx=ctx)
+    m = es.Mesh(syn["faces"], syn["vertices"][0], ctx=ctx)
+    m.write(tmp_path / "f.ply")
+    rng = np.random.default_rng(3)
+    a = rng.normal(size=m.nverts)
+    b = rng.lognormal(sigma=2.0, size=m.nverts)     # a heavy tail, as residuals have
+    with open(tmp_path / "s.csv", "w") as f:
+        f.write("a,b\n" + "".join(f"{x!r},{y!r}\n" for x, y in zip(a, b)))
+
+    def colour_range(*args):
+        r = cli("render", tmp_path / "f.ply", "--scalars", tmp_path / "s.csv", "-o",
+                tmp_path / "r.png", *args)
+        lo, hi = re.search(r"colour range (\S+)\.\.(\S+)", r.stdout).groups()
+        return float(lo), float(hi)
+    assert np.allclose(colour_range("--column", "b"), [b.min(), b.max()], rtol=1e-3)
+    assert np.allclose(colour_range("--column", "b", "--percentiles", "5,95"),
+                       np.percentile(b, [5, 95]), rtol=1e-3)
+    assert np.allclose(colour_range("--column", "1", "--percentiles", "0,50"),
+                       [a.min(), np.median(a)], rtol=1e-3)
+    assert png_size((tmp_path / "r.png").read_bytes())[1] == 480
+    r = cli("render", tmp_path / "f.ply", "--scalars", tmp_path / "s.csv", "--column", "c",
+            "-o", tmp_path / "x.png", check=False)
+    assert r.returncode == 1 and "no column 'c' (columns: a, b)" in r.stderr
+    r = cli("render", tmp_path / "f.ply", "--percentiles", "90,10", "-o", tmp_path / "x.png",
+            check=False)
+    assert r.returncode == 2
