@@ -163,11 +163,22 @@ class Mesh:
                       int(normalize), out, out + 1, out + 2)
         return tuple(out)
 
-    def write(self, path, vertices=None, fmt="auto"):
-        """Write a mesh file (es_mesh_write; coordinates exact)."""
+    def write(self, path, vertices=None, fmt="auto", colors=None):
+        """Write a mesh file (es_mesh_write; coordinates exact). colors: (V, 3)
+        per-vertex colours, uint8 or floats in [0, 1] (PLY only; see
+        edgespace.scalar_colors for values under a colour map)."""
         V = None if vertices is None else self._positions(vertices)
         f = getattr(lib, "ES_FORMAT_" + fmt.upper().replace("-", "_"))
-        self.ctx.call(lib.es_mesh_write, str(path).encode(), f, self._ptr, A.dptr(V), ffi.NULL)
+        rgb = ffi.NULL
+        if colors is not None:
+            c = np.asarray(colors)
+            if c.shape != (self.nverts, 3):
+                raise ValueError(f"colors: shape {c.shape}, want ({self.nverts}, 3)")
+            if not np.issubdtype(c.dtype, np.integer):
+                c = np.round(np.clip(c, 0, 1) * 255)
+            c = np.ascontiguousarray(c, dtype=np.uint8)
+            rgb = ffi.from_buffer("uint8_t[]", c)
+        self.ctx.call(lib.es_mesh_write, str(path).encode(), f, self._ptr, A.dptr(V), rgb)
 
     def read_positions(self, path):
         """(V, 3) positions of a mesh file with this face list."""
