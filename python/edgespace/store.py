@@ -934,8 +934,10 @@ class Store:
     def export_statismo(self, path, pca=None, gpa=None, ncomp=0, sd=1.0, noise_variance=None,
                         **opts):
         """A statismo shape model of a stored PCA or GPA
-        (es_study_export_statismo; datasets-spec/statismo.md). Returns the
-        report as a dict."""
+        (es_study_export_statismo; datasets-spec/statismo.md; a landmark GPA
+        as a POINT_SET model). Returns the report as a dict: kind, and for
+        a GPA None where the edge-length linearization's figures (worst
+        RMS and bending ratio, nonlinearity) do not apply."""
         o = ffi.new("es_study_statismo_opts *")
         lib.es_study_statismo_opts_init(o)
         keep = [_c(pca), _c(gpa), self._command("export_statismo")]
@@ -946,7 +948,12 @@ class Store:
         set_embed_opts(o.embed, opts)
         rep = ffi.new("es_study_statismo_report *")
         self.ctx.call(lib.es_study_export_statismo, self.ptr, o, _s(path), rep)
-        return A.struct_dict(rep, "es_study_statismo_report")
+        out = A.struct_dict(rep, "es_study_statismo_report")
+        out["kind"] = "POLYGON_MESH" if out["nfaces"] else "POINT_SET"
+        if gpa is not None:   # the linearization's figures do not apply to a GPA model
+            for k in ("worst_rms_ratio", "worst_bend_ratio", "nonlinearity"):
+                out[k] = None
+        return out
 
     def _committed(self, name):
         if name:

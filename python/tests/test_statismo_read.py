@@ -73,6 +73,7 @@ def test_a_landmark_gpa_is_a_point_set_model(landmark_store, tmp_path, ctx):
             s.export_statismo(tmp_path / "x.h5", pca="none")
     K = len(g.pc_sdev)
     assert rep["nfaces"] == 0 and rep["nverts"] == 9 and rep["ncomp"] == K
+    assert rep["kind"] == "POINT_SET" and rep["nonlinearity"] is None   # not 0.0
     ref, cells, mean_def, var, basis = scalismo_read_pdm(tmp_path / "lm_model.h5")
     assert cells is None
     with h5py.File(tmp_path / "lm_model.h5", "r") as f:
