@@ -114,3 +114,25 @@ def test_same_embeddings_as_the_c_notebook(runs):
 
 if __name__ == "__main__":
     sys.exit(pytest.main([__file__, "-q"]))
+
+
+def test_without_face_study_the_notebook_names_the_path_it_tried(tmp_path, monkeypatch, capsys):
+    """Its first two cells (settings, data) with EDGESPACE_SHARED pointing
+    nowhere: it falls back to synthetic faces and says where it looked."""
+    display = pytest.importorskip("IPython.display")
+    with open(os.path.join(HERE, "01_faces.ipynb"), encoding="utf-8") as f:
+        cells = [c for c in json.load(f)["cells"] if c["cell_type"] == "code"][:2]
+    nowhere = tmp_path / "nowhere"
+    monkeypatch.setenv("EDGESPACE_SHARED", str(nowhere))
+    monkeypatch.setenv("EDGESPACE_NOTEBOOK_SMALL", "1")
+    monkeypatch.setenv("EDGESPACE_NOTEBOOK_OUT", str(tmp_path / "out"))
+    monkeypatch.delenv("EDGESPACE_NOTEBOOK_SYNTHETIC", raising=False)
+    shown = []
+    monkeypatch.setattr(display, "display", lambda *a, **k: shown.extend(a))
+    scope = {}
+    for c in cells:
+        exec("".join(c["source"]), scope)
+    tried = str(nowhere / "data" / "face-study")
+    assert any(tried in getattr(m, "data", "") for m in shown)
+    assert f"face-study was not found at {tried}" in capsys.readouterr().out
+    assert scope["report"]["rows_added"] == 30   # 10 synthetic subjects x 3 expressions

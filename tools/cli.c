@@ -126,10 +126,20 @@ FILE *cli_report_stream(const char *csv)
     return csv && !strcmp(csv, "-") ? stderr : stdout;
 }
 
+/* msg without a leading "VERB: " (the library names the analysis, which is
+ * often the command: "edgespace mean: mean: ..." says it twice). */
+static const char *without_verb(const char *verb, const char *msg)
+{
+    size_t n = strlen(verb);
+    if (strncmp(msg, verb, n) == 0 && msg[n] == ':' && msg[n + 1] == ' ') return msg + n + 2;
+    return msg;
+}
+
 int cli_fail(const char *verb, es_ctx *ctx, es_status rc)
 {
     const char *msg = ctx ? es_ctx_errmsg(ctx) : "";
-    fprintf(stderr, "edgespace %s: %s\n", verb, msg && *msg ? msg : es_strerror(rc));
+    fprintf(stderr, "edgespace %s: %s\n", verb,
+            msg && *msg ? without_verb(verb, msg) : es_strerror(rc));
     return CLI_FAIL;
 }
 

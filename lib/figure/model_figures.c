@@ -196,10 +196,10 @@ es_status es_figure_variation(es_ctx *ctx, es_store *store, const es_figure_vari
             (rc = displacement(ctx, nv, xm, xp, disp + a * nv, &r.max_displacement[a])) != ES_OK)
             break;
         const char *unit = o.coef ? "" : " sd";
-        snprintf(labels[4 * a], 160, "%s -%g%s", what, o.k, unit);
+        snprintf(labels[4 * a], 160, "%s \u2212%g%s", what, o.k, unit);   /* minus sign */
         snprintf(labels[4 * a + 1], 160, "mean");
         snprintf(labels[4 * a + 2], 160, "%s +%g%s", what, o.k, unit);
-        snprintf(labels[4 * a + 3], 160, "%s: displacement - to +", what);
+        snprintf(labels[4 * a + 3], 160, "%s: displacement \u2212 to +", what);
         const double *pos[4] = {xm, xyz, xp, xyz};
         for (int k = 0; k < 4; k++) {
             es_render_mesh_from(&items[4 * a + k], mesh, pos[k]);
@@ -224,8 +224,8 @@ es_status es_figure_variation(es_ctx *ctx, es_store *store, const es_figure_vari
     char title[256];
     if (o.title) spec.title = o.title;
     else {
-        snprintf(title, sizeof title, "shape variation: mean +- %g %s, embedded near the data",
-                 o.k, o.coef ? "x coefficient" : "sd");
+        snprintf(title, sizeof title, "shape variation: mean \u00b1 %g %s, embedded near the data",
+                 o.k, o.coef ? "\u00d7 coefficient" : "sd");
         spec.title = title;
     }
     rc = es_render(ctx, &spec, out_path, &r.render);

@@ -516,11 +516,45 @@ static es_status check_spec(es_ctx *ctx, const es_render_spec *spec)
         ES_FAIL(ctx, ES_EINVAL, "render: supersample %d is outside 1..4", spec->supersample);
     if (!(spec->fill > 0 && spec->fill <= 1))
         ES_FAIL(ctx, ES_EINVAL, "render: fill %g is outside (0, 1]", spec->fill);
+    {
+        const double *p = spec->range_percentiles;
+        if (!(p[0] >= 0 && p[1] <= 100 && (p[1] == 0 ? p[0] == 0 : p[0] < p[1])))
+            ES_FAIL(ctx, ES_EINVAL, "render: percentiles %g, %g: want 0 <= LO < HI <= 100", p[0],
+                    p[1]);
+    }
     if (spec->projection == ES_PROJ_PERSPECTIVE && !(spec->fov_deg >= 1 && spec->fov_deg <= 150))
         ES_FAIL(ctx, ES_EINVAL, "render: field of view %g is outside 1..150 degrees",
                 spec->fov_deg);
     if (!(spec->font_size > 0 && spec->font_size < 200))
         ES_FAIL(ctx, ES_EINVAL, "render: font size %g is outside (0, 200)", spec->font_size);
+    return ES_OK;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The range_percentiles of every finite scalar of every mesh into *lo, *hi. */
+static es_status percentile_range(es_ctx *ctx, const es_render_spec *spec, double *lo,
+                                  double *hi)
+{
+    int64_t n = 0, k = 0;
+    for (int64_t i = 0; i < spec->nmeshes; i++) n += nscalars(&spec->meshes[i]);
+    double *v = es__alloc_array(ctx, n, sizeof *v);
+    if (!v) return ES_ENOMEM;
+    for (int64_t i = 0; i < spec->nmeshes; i++)
+        for (int64_t j = 0; j < nscalars(&spec->meshes[i]); j++)
+            if (isfinite(spec->meshes[i].scalars[j])) v[k++] = spec->meshes[i].scalars[j];
+    qsort(v, (size_t)k, sizeof *v, cmp_double);
+    for (int e = 0; e < 2 && k > 0; e++) {
+        double p = e == 1 && spec->range_percentiles[1] <= 0 ? 100 : spec->range_percentiles[e];
+        double at = p / 100 * (double)(k - 1), f = floor(at);
+        int64_t i0 = (int64_t)f, i1 = i0 + 1 < k ? i0 + 1 : i0;
+        *(e ? hi : lo) = v[i0] + (at - f) * (v[i1] - v[i0]);
+    }
+    es__free(ctx, v);
     return ES_OK;
 }
 
@@ -555,6 +589,11 @@ es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
     }
     rep.vmin = spec->vmin;
     rep.vmax = spec->vmax;
+    if ((rep.vmin == rep.vmax || !isfinite(rep.vmin) || !isfinite(rep.vmax)) && lo < hi &&
+        (spec->range_percentiles[0] > 0 || (spec->range_percentiles[1] > 0 &&
+                                           spec->range_percentiles[1] < 100)) &&
+        (rc = percentile_range(ctx, spec, &lo, &hi)) != ES_OK)
+        return rc;
     if (rep.vmin == rep.vmax || !isfinite(rep.vmin) || !isfinite(rep.vmax)) {
         double pair[2] = {lo, hi};
         rep.vmin = rep.vmax = 0;

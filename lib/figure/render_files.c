@@ -17,6 +17,7 @@
 #include "edgespace/es_io.h"
 
 #include <math.h>
+#include <stdlib.h>
 
 /* Line ends in s[0..n) as the CSV reader counts them: LF, CRLF or a lone CR. */
 static int64_t line_ends(const char *s, size_t n)
@@ -41,16 +42,48 @@ static int64_t record_breaks(const es__csv_table *t, int64_t r)
     return k;
 }
 
-/* The values of a scalar file into *out (es__free), *n of them: one per
- * line after an optional header line, NaN for blank lines and missing
- * cells. */
-static es_status read_scalars(es_ctx *ctx, const char *path, double **out, int64_t *n)
+/* The 0-based index of column `want` (a header name or a 1-based number;
+ * NULL: 0) of a table whose first record is `head` (NULL: no header). */
+static es_status pick_column(es_ctx *ctx, const char *path, const es__csv_table *t, int has_head,
+                             const char *want, int64_t *col)
+{
+    char *end;
+    long k;
+    *col = 0;
+    if (!want) return ES_OK;
+    k = strtol(want, &end, 10);
+    if (*want && !*end) {
+        if (k < 1 || (t->nrecords > 0 && k > es__csv_nfields(t, 0)))
+            ES_FAIL(ctx, ES_ERANGE, "%s: no column %ld (it has %lld)", path, k,
+                    (long long)(t->nrecords > 0 ? es__csv_nfields(t, 0) : 0));
+        *col = k - 1;
+        return ES_OK;
+    }
+    if (has_head)
+        for (int64_t c = 0; c < es__csv_nfields(t, 0); c++)
+            if (!strcmp(es__csv_field(t, 0, c), want)) {
+                *col = c;
+                return ES_OK;
+            }
+    char cols[300] = "";
+    for (int64_t c = 0; has_head && c < es__csv_nfields(t, 0); c++)
+        snprintf(cols + strlen(cols), sizeof cols - strlen(cols), "%s%s", c ? ", " : "",
+                 es__csv_field(t, 0, c));
+    ES_FAIL(ctx, ES_ENOTFOUND, "%s: no column '%s' (%s%s)", path, want,
+            has_head ? "columns: " : "no header line; name a column by its number", cols);
+}
+
+/* The values of column `want` (pick_column) of a scalar file into *out
+ * (es__free), *n of them: one per line after an optional header line, NaN
+ * for blank lines and missing cells; the column's header into head[hn]. */
+static es_status read_scalars(es_ctx *ctx, const char *path, const char *want, double **out,
+                              int64_t *n, char *head, size_t hn)
 {
     char *buf = NULL;
     size_t len, bom;
     es__csv_table t;
     double v, *vals = NULL;
-    int64_t nv = 0, next = 1, r = 0;
+    int64_t nv = 0, next = 1, r = 0, col = 0;
     es_status rc;
     *out = NULL;
     *n = 0;
@@ -70,9 +103,14 @@ static es_status read_scalars(es_ctx *ctx, const char *path, double **out, int64
         next = 2 + record_breaks(&t, 0);
         r = 1;
     }
+    if ((rc = pick_column(ctx, path, &t, r == 1, want, &col)) != ES_OK) {
+        es__csv_table_clear(ctx, &t);
+        return rc;
+    }
+    if (head && hn) snprintf(head, hn, "%s", r == 1 ? es__csv_field(&t, 0, col) : "");
     if (!(vals = es__alloc_array(ctx, nlines > 0 ? nlines : 1, sizeof *vals))) rc = ES_ENOMEM;
     for (; rc == ES_OK && r < t.nrecords; r++) {
-        const char *f = es__csv_field(&t, r, 0);
+        const char *f = col < es__csv_nfields(&t, r) ? es__csv_field(&t, r, col) : "";
         for (; next < t.line[r]; next++) vals[nv++] = NAN;   /* blank lines */
         if (es__figure_cell_number(f, &vals[nv++]) != 0)
             rc = es__fail(ctx, ES_EFORMAT, "%s:%lld: '%s' is not a number", path,
@@ -143,6 +181,7 @@ es_status es_figure_render_files(es_ctx *ctx, const es_render_spec *spec, int64_
                                  const char *out_path, es_render_report *rep)
 {
     es_status rc = check_args(ctx, spec, n, mesh_paths, nscalars, scalar_paths, out_path);
+    char head[200] = "";   /* the first scalar file's column header */
     if (rc != ES_OK) return rc;
     es_meshdata *md = es__calloc(ctx, (size_t)n, sizeof *md);
     es_mesh **mesh = es__calloc(ctx, (size_t)n, sizeof *mesh);
@@ -162,13 +201,15 @@ es_status es_figure_render_files(es_ctx *ctx, const es_render_spec *spec, int64_
         it->label = labels && labels[i] ? labels[i] : n > 1 ? es__path_base(path) : NULL;
         if (nscalars == 0) continue;
         int64_t s = nscalars == 1 ? 0 : i;
-        if (!scal[s] && (rc = read_scalars(ctx, scalar_paths[s], &scal[s], &nscal[s])) != ES_OK)
+        if (!scal[s] && (rc = read_scalars(ctx, scalar_paths[s], spec->scalar_column, &scal[s],
+                                           &nscal[s], *head ? NULL : head, sizeof head)) != ES_OK)
             break;
         it->scalars = scal[s];
         rc = match_scalars(ctx, path, &md[i], scalar_paths[s], nscal[s], &mesh[i], it);
     }
     if (rc == ES_OK) {
         es_render_spec sp = *spec;
+        if (!sp.colorbar_label && *head) sp.colorbar_label = head;
         sp.meshes = items;
         sp.nmeshes = n;
         rc = es_render(ctx, &sp, out_path, rep);

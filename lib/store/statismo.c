@@ -96,10 +96,9 @@ static es_status put_matrix(es_ctx *ctx, hid_t loc, const char *name, int64_t ro
 static es_status check_model(es_ctx *ctx, const es_statismo_model *m)
 {
     int64_t v3, n;
-    if (!m || m->nverts < 1 || m->nfaces < 1 || m->ncomp < 1 || !m->faces || !m->mean ||
-        !m->basis || !m->variance)
-        ES_FAIL(ctx, ES_EINVAL, "statismo: a model needs vertices, faces, a mean and at least "
-                "one mode");
+    if (!m || m->nverts < 1 || m->nfaces < 0 || m->ncomp < 1 || (m->nfaces && !m->faces) ||
+        !m->mean || !m->basis || !m->variance)
+        ES_FAIL(ctx, ES_EINVAL, "statismo: a model needs points, a mean and at least one mode");
     if (m->nverts > INT32_MAX)
         ES_FAIL(ctx, ES_ERANGE, "statismo: %lld vertices do not fit the format's 32-bit cells",
                 (long long)m->nverts);
@@ -128,7 +127,10 @@ static es_status check_model(es_ctx *ctx, const es_statismo_model *m)
     return ES_OK;
 }
 
-/* /representer: the mean as the reference mesh (points 3 x V, cells 3 x F). */
+/* /representer: the mean as the reference mesh (points 3 x V, cells 3 x F),
+ * or without faces as a point set (statismo's itkPointSetRepresenter:
+ * datasetType POINT_SET and no cells, what scalismo's readStatismoPDM reads
+ * as an UnstructuredPointsDomain). */
 static es_status put_representer(es_ctx *ctx, hid_t root, const es_statismo_model *m)
 {
     hid_t g = H5Gcreate2(root, "representer", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), sub;
@@ -136,10 +138,12 @@ static es_status put_representer(es_ctx *ctx, hid_t root, const es_statismo_mode
     int32_t *cells = NULL;
     es_status rc;
     if (g < 0) return es__h5_fail(ctx, ES_EIO, "statismo: cannot create /representer");
-    if ((rc = put_str_attr(ctx, g, "name", "itkStandardMeshRepresenter")) ||
+    const int mesh = m->nfaces > 0;
+    if ((rc = put_str_attr(ctx, g, "name",
+                           mesh ? "itkStandardMeshRepresenter" : "itkPointSetRepresenter")) ||
         (rc = put_str_attr(ctx, g, "version", "1.0")) ||
-        (rc = put_str_attr(ctx, g, "datasetType", "POLYGON_MESH")) ||
-        (rc = put_matrix(ctx, g, "points", 3, m->nverts, m->mean, 1, 3)))
+        (rc = put_str_attr(ctx, g, "datasetType", mesh ? "POLYGON_MESH" : "POINT_SET")) ||
+        (rc = put_matrix(ctx, g, "points", 3, m->nverts, m->mean, 1, 3)) || !mesh)
         goto done;
     if (!(cells = es__alloc_array(ctx, 3 * m->nfaces, sizeof *cells))) {
         rc = ES_ENOMEM;
@@ -219,6 +223,22 @@ static es_status put_model(es_ctx *ctx, hid_t root, const es_statismo_model *m)
     return rc;
 }
 
+/* scalismo opens a model only by a name ending in .h5 (or .h5.json, its
+ * JSON form): a model it cannot open is refused here, with the name to use. */
+es_status es_statismo_check_name(es_ctx *ctx, const char *path)
+{
+    size_t n = path ? strlen(path) : 0;
+    const char *base, *dot;
+    if (!n) ES_FAIL(ctx, ES_EINVAL, "statismo: no output file");
+    base = strrchr(path, '/');
+    if (n > 3 && !strcmp(path + n - 3, ".h5")) return ES_OK;
+    base = base ? base + 1 : path;
+    dot = strrchr(base, '.');
+    ES_FAIL(ctx, ES_EINVAL, "statismo: '%s': scalismo reads statismo models only from files "
+            "named *.h5; name it '%.*s.h5'", path, (int)(dot && dot > base ? dot - path : (long)n),
+            path);
+}
+
 /* An existing file may be replaced only if it is a statismo model: a typo
  * must not overwrite a store or another HDF5 file. */
 static es_status check_target(es_ctx *ctx, const char *path)
@@ -243,7 +263,8 @@ es_status es_statismo_write(es_ctx *ctx, const char *path, const es_statismo_mod
     const int32_t major = STATISMO_MAJOR, minor = STATISMO_MINOR;
     es_status rc;
     if (!path || !*path) ES_FAIL(ctx, ES_EINVAL, "statismo: no output file");
-    if ((rc = check_model(ctx, m)) != ES_OK) return rc;
+    if ((rc = es_statismo_check_name(ctx, path)) != ES_OK || (rc = check_model(ctx, m)) != ES_OK)
+        return rc;
     H5E_BEGIN_TRY {
         rc = check_target(ctx, path);
     } H5E_END_TRY

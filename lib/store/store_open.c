@@ -330,3 +330,13 @@ es_topology_kind es_store_topology_kind(const es_store *s)
 }
 const char *es_store_path(const es_store *s) { return s ? s->path : NULL; }
 const char *es_store_fingerprint(const es_store *s) { return s ? s->fingerprint : NULL; }
+
+es_status es_store_set_replace(es_ctx *ctx, es_store *s, int replace)
+{
+    if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL handle");
+    if (s->mode == ES_STORE_READ)
+        ES_FAIL(ctx, ES_EINVAL, "store: '%s' is open for reading: results cannot be replaced",
+                s->path);
+    s->mode = replace ? ES_STORE_REPLACE : ES_STORE_WRITE;
+    return ES_OK;
+}

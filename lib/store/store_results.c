@@ -98,7 +98,7 @@ static es_status check_free(es_ctx *ctx, es_store *s, const char *kind, const ch
     if ((rc = find_link(ctx, s, full, exists))) return rc;
     if (*exists && s->mode != ES_STORE_REPLACE)
         ES_FAIL(ctx, ES_EEXIST, "store: result %s/%s exists already in '%s' (give another name, "
-                "or --replace to replace it)", kind, name, s->path);
+                "or replace it: --replace, replace=True in Python)", kind, name, s->path);
     return ES_OK;
 }
 
@@ -730,7 +730,11 @@ static es_status delete_impl(es_ctx *ctx, es_store *s, const char *kind, const c
     snprintf(full, sizeof full, "%s/%s", group, name);
     bool e;
     if ((rc = find_link(ctx, s, full, &e))) return rc;
-    if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result %s/%s in '%s'", kind, name, s->path);
+    if (!e) {
+        char hint[400];
+        es_store_result_hint(ctx, s, kind, name, hint, sizeof hint);
+        ES_FAIL(ctx, ES_ENOTFOUND, "store: no result %s/%s in '%s'%s", kind, name, s->path, hint);
+    }
     if ((rc = es__store_begin_write(s))) return rc;
     if (H5Ldelete(s->file, full, H5P_DEFAULT) < 0) {
         s->broken = true;

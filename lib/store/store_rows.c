@@ -496,6 +496,40 @@ void es_store_value_hint(const es_store *s, int64_t col, const char *value, char
     es__suggest_format(&sg, col < 0 ? "ids" : "values", buf, n);
 }
 
+/* es_free's each name and the array. */
+static void free_names(es_ctx *ctx, char **names, int64_t n)
+{
+    for (int64_t i = 0; i < n; i++) es_free(ctx, names[i]);
+    es_free(ctx, names);
+}
+
+void es_store_result_hint(es_ctx *ctx, es_store *s, const char *kind, const char *name,
+                          char *buf, size_t n)
+{
+    char **names = NULL, what[160], saved[1024];
+    int64_t count = 0;
+    if (!n) return;
+    buf[0] = '\0';
+    if (!s || !kind) return;
+    snprintf(saved, sizeof saved, "%s", es_ctx_errmsg(ctx));   /* listing may fail: keep it */
+    if (es_store_list_results(ctx, s, kind, &names, &count) == ES_OK && count > 0) {
+        es__suggest sg;
+        es__suggest_init(&sg, name ? name : "");
+        for (int64_t i = 0; i < count; i++) es__suggest_add(&sg, names[i]);
+        snprintf(what, sizeof what, "%s results", kind);
+        es__suggest_format(&sg, what, buf, n);
+    } else if (es_store_list_results(ctx, s, NULL, &names, &count) == ES_OK && count > 0) {
+        size_t at = (size_t)snprintf(buf, n, " (no %s results; the store has:", kind);
+        for (int64_t i = 0; i < count && at < n; i++)
+            at += (size_t)snprintf(buf + at, n - at, "%s %s", i ? "," : "", names[i]);
+        if (at < n) snprintf(buf + at, n - at, ")");
+    } else {
+        snprintf(buf, n, " (the store holds no results)");
+    }
+    if (names) free_names(ctx, names, count);
+    es__fail(ctx, ES_OK, "%s", saved);
+}
+
 es_status es_store_select(es_ctx *ctx, const es_store *s, const char *filter, int64_t **rows,
                           int64_t *nrows)
 {

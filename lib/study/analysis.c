@@ -310,7 +310,11 @@ es_status es_study_pca_load(es_ctx *ctx, es_store *store, const char *name, es_p
     es_status rc = pick_pca(ctx, store, name, nm, sizeof nm);
     if (rc != ES_OK) return rc;
     snprintf(path, sizeof path, "pca/%s", nm);
-    if (!es_store_has(store, path)) ES_FAIL(ctx, ES_ENOTFOUND, "pca: no PCA named '%s'", nm);
+    if (!es_store_has(store, path)) {
+        char hint[400];
+        es_store_result_hint(ctx, store, "pca", nm, hint, sizeof hint);
+        ES_FAIL(ctx, ES_ENOTFOUND, "pca: no PCA named '%s'%s", nm, hint);
+    }
     if ((rc = dpath(ctx, path, "pca", nm, "mean")) != ES_OK ||
         (rc = es_store_get_vector(ctx, store, path, &mean, &E)) != ES_OK ||
         (rc = dpath(ctx, path, "pca", nm, "eigenvalues")) != ES_OK ||
@@ -537,7 +541,11 @@ static es_status resolve_diff(es_ctx *ctx, es_study_resolver *r, const char *arg
     es_status rc;
     if (bad_name(arg)) ES_FAIL(ctx, ES_EINVAL, "bad difference name");
     if ((rc = dpath(ctx, p, "diff", arg, "mean")) != ES_OK) return rc;
-    if (!es_store_has(r->store, p)) ES_FAIL(ctx, ES_ENOTFOUND, "no difference named '%s'", arg);
+    if (!es_store_has(r->store, p)) {
+        char hint[400];
+        es_store_result_hint(ctx, r->store, "diff", arg, hint, sizeof hint);
+        ES_FAIL(ctx, ES_ENOTFOUND, "no difference named '%s'%s", arg, hint);
+    }
     if ((rc = es_store_get_vector(ctx, r->store, p, &v, &n)) != ES_OK) return rc;
     if (n != E) {
         es_free(ctx, v);

@@ -72,9 +72,12 @@ es_status es_study_compare(es_ctx *ctx, es_store *store, const char *gpa_name,
         (rc = es_store_result_check(ctx, store, "compare", name ? name : gpa_name)) != ES_OK)
         return rc;
     snprintf(path, sizeof path, "gpa/%s", gpa_name);
-    if (!es_store_has(store, path))
-        ES_FAIL(ctx, ES_ENOTFOUND, "compare: no GPA result '%s' in the store (run 'edgespace gpa "
-                "--name %s' first)", gpa_name, gpa_name);
+    if (!es_store_has(store, path)) {
+        char hint[400];
+        es_store_result_hint(ctx, store, "gpa", gpa_name, hint, sizeof hint);
+        ES_FAIL(ctx, ES_ENOTFOUND, "compare: no GPA result '%s' in the store%s (run 'edgespace "
+                "gpa --name %s' first)", gpa_name, hint, gpa_name);
+    }
     snprintf(path, sizeof path, "gpa/%s/input_rows", gpa_name);
     if ((rc = es_store_get_ints(ctx, store, path, &rows, &n)) != ES_OK) return rc;
     snprintf(path, sizeof path, "gpa/%s/aligned", gpa_name);

@@ -473,9 +473,11 @@ es_status es_study_export_result(es_ctx *ctx, es_store *store, const char *resul
     memcpy(kind, result, (size_t)(slash - result));
     kind[slash - result] = '\0';
     snprintf(name, sizeof name, "%s", slash + 1);
-    if (!es_store_has(store, result))
-        ES_FAIL(ctx, ES_ENOTFOUND, "export: the store has no result %s (edgespace results "
-                "STORE lists them)", result);
+    if (!es_store_has(store, result)) {
+        char hint[400];
+        es_store_result_hint(ctx, store, kind, name, hint, sizeof hint);
+        ES_FAIL(ctx, ES_ENOTFOUND, "export: the store has no result %s%s", result, hint);
+    }
     if (table && !strcmp(table, "attributes")) return t_attributes(ctx, store, kind, name, path);
     for (size_t i = 0; i < sizeof tables / sizeof *tables; i++)
         if (!strcmp(tables[i].kind, kind) && (!table || !strcmp(tables[i].table, table)))

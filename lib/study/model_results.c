@@ -179,7 +179,11 @@ es_status es_study_model_coef(es_ctx *ctx, es_store *s, const char *model, const
     if (!model || !*model || strchr(model, '/'))
         ES_FAIL(ctx, ES_EINVAL, "bad model name '%s'", model ? model : "");
     snprintf(path, sizeof path, "model/%s", model);
-    if (!es_store_has(s, path)) ES_FAIL(ctx, ES_ENOTFOUND, "no model named '%s'", model);
+    if (!es_store_has(s, path)) {
+        char hint[400];
+        es_store_result_hint(ctx, s, "model", model, hint, sizeof hint);
+        ES_FAIL(ctx, ES_ENOTFOUND, "no model named '%s'%s", model, hint);
+    }
     if ((rc = es_store_get_attr(ctx, s, path, "space", space, sizeof space)) != ES_OK) return rc;
     if (strcmp(space, "lengths"))
         ES_FAIL(ctx, ES_EINVAL, "model '%s' is in %s space; points are edge lengths", model,

@@ -96,9 +96,12 @@ static es_status gpa_response(es_ctx *ctx, es_store *s, const char *gpa, const i
     es_status rc;
     if (strchr(gpa, '/')) ES_FAIL(ctx, ES_EINVAL, "model: bad GPA name '%s'", gpa);
     snprintf(path, sizeof path, "gpa/%s", gpa);
-    if (!es_store_has(s, path))
-        ES_FAIL(ctx, ES_ENOTFOUND, "model: no GPA result '%s' (run edgespace gpa --name %s)",
-                gpa, gpa);
+    if (!es_store_has(s, path)) {
+        char hint[400];
+        es_store_result_hint(ctx, s, "gpa", gpa, hint, sizeof hint);
+        ES_FAIL(ctx, ES_ENOTFOUND, "model: no GPA result '%s'%s (run edgespace gpa --name %s)",
+                gpa, hint, gpa);
+    }
     double dim = 0;
     snprintf(path, sizeof path, "gpa/%s", gpa);
     if ((rc = es_store_get_attr_double(ctx, s, path, "dim", &dim)) != ES_OK) return rc;

@@ -282,9 +282,11 @@ es_status es_study_export_statismo(es_ctx *ctx, es_store *s, const es_study_stat
     memset(&m, 0, sizeof m);
     if (!o || (o->pca_name && o->gpa_name))
         ES_FAIL(ctx, ES_EINVAL, "statismo: give a PCA or a GPA result, not both");
-    if (es_store_topology_kind(s) != ES_TOPOLOGY_MESH || es_store_nfaces(s) < 1)
-        ES_FAIL(ctx, ES_EINVAL, "statismo: store '%s' has no triangles; a statismo mesh model "
-                "needs them", es_store_path(s));
+    if ((rc = es_statismo_check_name(ctx, path)) != ES_OK) return rc;   /* before any work */
+    if (!o->gpa_name && (es_store_topology_kind(s) != ES_TOPOLOGY_MESH || es_store_nfaces(s) < 1))
+        ES_FAIL(ctx, ES_EINVAL, "statismo: store '%s' has no triangles: an edge-length PCA is "
+                "exported through embedded meshes; a landmark GPA (--gpa) is exported as a point "
+                "set", es_store_path(s));
     {
         /* the store itself as the output: refused before the embeddings
          * (es_statismo_write refuses any HDF5 file that is not a model) */
@@ -298,10 +300,13 @@ es_status es_study_export_statismo(es_ctx *ctx, es_store *s, const es_study_stat
         ES_FAIL(ctx, ES_EINVAL, "statismo: the step along each PC must be > 0 sd (got %g)",
                 o->sd);
     m.nverts = es_store_nverts(s);
-    m.nfaces = es_store_nfaces(s);
-    if (!(faces = es__alloc_array(ctx, 3 * m.nfaces, sizeof *faces))) return ES_ENOMEM;
-    if ((rc = es_store_read_faces(ctx, s, faces)) != ES_OK) goto done;
-    m.faces = faces;
+    /* a mesh model over the store's triangles; without them a point set */
+    m.nfaces = es_store_topology_kind(s) == ES_TOPOLOGY_MESH ? es_store_nfaces(s) : 0;
+    if (m.nfaces > 0) {
+        if (!(faces = es__alloc_array(ctx, 3 * m.nfaces, sizeof *faces))) return ES_ENOMEM;
+        if ((rc = es_store_read_faces(ctx, s, faces)) != ES_OK) goto done;
+        m.faces = faces;
+    }
     if (o->gpa_name) snprintf(r->source, sizeof r->source, "gpa/%s", o->gpa_name);
     rc = o->gpa_name ? procrustes_model(ctx, s, o, &m, bufs)
                      : edge_length_model(ctx, s, o, &m, bufs, r);

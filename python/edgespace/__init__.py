@@ -32,6 +32,8 @@ from .mesh import (Embedder, Embedding, Mesh, embed, embed_opts, normalize_lengt
                    read_mesh)
 from .render import FiguresUnavailable, Image, auto_view, plot_scatter, plot_scree, render
 from .session import StudyEmbedder
+from .colour_files import scalar_colors, write_vtp
+from .statismo import StatismoModel, read_statismo
 from .store import PCA, Store, ingest
 
 __all__ = [
@@ -42,7 +44,7 @@ __all__ = [
     "LoadError", "Mesh", "Embedder", "Embedding", "embed", "embed_opts",
     "normalize_lengths", "read_mesh", "render", "plot_scatter", "plot_scree", "auto_view",
     "Image", "FiguresUnavailable", "Store", "StudyEmbedder", "PCA", "ingest", "synth", "pca",
-    "version",
+    "version", "StatismoModel", "read_statismo", "scalar_colors", "write_vtp",
     "has_figures", "LIBRARY_PATH", "INCLUDE_DIR", "ffi", "lib",
 ]
 

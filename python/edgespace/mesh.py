@@ -52,6 +52,12 @@ class Embedding(NamedTuple):
     F: np.ndarray
     report: dict
 
+    def __repr__(self):   # a notebook's text/plain: not every coordinate
+        r = self.report
+        rms = r.get("rms_ratio")
+        return (f"<edgespace.Embedding V={self.V.shape[0]} F={self.F.shape[0]}"
+                + (f" rms_ratio={rms:.3g}" if isinstance(rms, float) else "") + ">")
+
     def render(self, **kw):
         """PNG bytes of this mesh (edgespace.render)."""
         from .render import render
@@ -65,6 +71,14 @@ class Embedding(NamedTuple):
         """Write the mesh file (OBJ/PLY/OFF by extension; es_mesh_write)."""
         m = mesh if mesh is not None else Mesh(self.F, ctx=ctx)
         m.write(path, self.V)
+
+
+def study_embedding(xyz, faces, res):
+    """Embedding of an es_study_embed_result: its report with scale and init."""
+    rep = report_dict(res.report)
+    rep["scale"] = float(res.scale)
+    rep["init"] = ffi.string(res.init).decode("utf-8", "replace")
+    return Embedding(xyz, faces, rep)
 
 
 class Mesh:
@@ -150,12 +164,22 @@ class Mesh:
                       int(normalize), out, out + 1, out + 2)
         return tuple(out)
 
-    def write(self, path, vertices=None, fmt="auto"):
-        """Write a mesh file (es_mesh_write; coordinates exact)."""
+    def write(self, path, vertices=None, fmt="auto", colors=None):
+        """Write a mesh file (es_mesh_write; coordinates exact). colors: (V, 3)
+        per-vertex colours, uint8 or floats in [0, 1] (PLY only; see
+        edgespace.scalar_colors for values under a colour map)."""
         V = None if vertices is None else self._positions(vertices)
         f = getattr(lib, "ES_FORMAT_" + fmt.upper().replace("-", "_"))
-        self.ctx.call(lib.es_mesh_write, A.cbytes(path, "path"), f, self._ptr, A.dptr(V),
-                      ffi.NULL)
+        rgb = ffi.NULL
+        if colors is not None:
+            c = np.asarray(colors)
+            if c.shape != (self.nverts, 3):
+                raise ValueError(f"colors: shape {c.shape}, want ({self.nverts}, 3)")
+            if not np.issubdtype(c.dtype, np.integer):
+                c = np.round(np.clip(c, 0, 1) * 255)
+            c = np.ascontiguousarray(c, dtype=np.uint8)
+            rgb = ffi.from_buffer("uint8_t[]", c)
+        self.ctx.call(lib.es_mesh_write, A.cbytes(path, "path"), f, self._ptr, A.dptr(V), rgb)
 
     def read_positions(self, path):
         """(V, 3) positions of a mesh file with this face list."""

@@ -21,7 +21,20 @@ class FiguresUnavailable(RuntimeError):
 
 
 class Image(bytes):
-    """PNG bytes; displayed inline by Jupyter (_repr_png_)."""
+    """PNG bytes; displayed inline by Jupyter (_repr_png_). Its repr (a
+    notebook's text/plain) is a short description, not the bytes, so an
+    executed notebook does not carry every image twice."""
+
+    def __repr__(self):
+        w, h = self.size
+        return f"<edgespace.Image PNG {w}x{h}, {len(self)} bytes>"
+
+    @property
+    def size(self):
+        """(width, height) from the PNG's IHDR chunk (0, 0 if not a PNG)."""
+        if len(self) >= 24 and self[:8] == b"\x89PNG\r\n\x1a\n":
+            return int.from_bytes(self[16:20], "big"), int.from_bytes(self[20:24], "big")
+        return 0, 0
 
     def _repr_png_(self):
         return bytes(self)

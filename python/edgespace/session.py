@@ -11,7 +11,7 @@ import numpy as np
 
 from . import _arrays as A
 from ._native import ffi, lib
-from .mesh import Embedding, report_dict, set_embed_opts
+from .mesh import set_embed_opts, study_embedding
 
 
 class StudyEmbedder:
@@ -47,10 +47,7 @@ and a close() from another thread waits for the running embedding."""
         return eo
 
     def _result(self, xyz, res):
-        rep = report_dict(res.report)
-        rep["scale"] = float(res.scale)
-        rep["init"] = ffi.string(res.init).decode("utf-8", "replace")
-        return Embedding(xyz, self.faces, rep)
+        return study_embedding(xyz, self.faces, res)
 
     def solve(self, lengths, scale, weights, warm=True, exact=False, fast=False, **opts):
         """Embedding(V, F, report) of lengths (E,) at sum `scale` near the

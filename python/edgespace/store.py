@@ -11,6 +11,7 @@ owner alive.
 Linear models (Store.model) come back as a ModelResult whose tables view the
 library's arrays, with the summary text the command prints.
 """
+import contextlib
 import os
 import tempfile
 
@@ -19,7 +20,7 @@ import numpy as np
 from . import _arrays as A
 from ._context import ctx_of
 from ._native import ffi, lib
-from .mesh import Embedding, Mesh, report_dict, set_embed_opts
+from .mesh import Embedding, Mesh, report_dict, set_embed_opts, study_embedding
 
 _PCA_METHODS = {"auto": "ES_PCA_AUTO", "gram": "ES_PCA_GRAM",
                 "covariance": "ES_PCA_COVARIANCE", "randomized": "ES_PCA_RANDOMIZED"}
@@ -540,15 +541,41 @@ class Store:
         self._call(lib.es_store_get_attr, _s(path), _s(key), buf, 4096)
         return ffi.string(buf).decode("utf-8", "replace")
 
+    def delete_result(self, kind, name=None):
+        """Delete a stored result: delete_result("pca", "faces") or
+        delete_result("pca/faces") (es_store_delete_result), committed.
+        NotFoundError naming the results of that kind when there is none."""
+        if name is None:
+            kind, _, name = str(kind).partition("/")
+        self._call(lib.es_store_delete_result, _s(kind), _s(name))
+        self.commit()
+
+    @contextlib.contextmanager
+    def _replacing(self, replace):
+        """With replace, the results written inside may replace those of the
+        same name (es_store_set_replace), as the commands' --replace; the
+        handle's own mode is restored after."""
+        if not replace:
+            yield
+            return
+        with self.ctx.hold():   # another thread's call does not see the mode
+            self._call(lib.es_store_set_replace, 1)
+            try:
+                yield
+            finally:
+                lib.es_store_set_replace(self.ctx.ptr, self.ptr, 0)
+
     # -- analyses (es_study.h) ---------------------------------------------
     def _command(self, what):
         return _c(f"python: edgespace.Store.{what}")
 
-    def mean(self, by=None, filter=None, name=None):
+    def mean(self, by=None, filter=None, name=None, replace=False):
         """Means of the rows matching filter, one per value of label column
-        `by` (es_study_mean); stored as mean/<name> when name is given."""
+        `by` (es_study_mean); stored as mean/<name> when name is given
+        (replace=True: over one of that name, as every storing call)."""
         out = ffi.new("es_group_result **")
-        self._call(lib.es_study_mean, _s(name) or ffi.NULL,
+        with self._replacing(replace):
+            self._call(lib.es_study_mean, _s(name) or ffi.NULL,
                       _s(filter) or ffi.NULL, _s(by) or ffi.NULL, self._command("mean"), out)
         r = A.owned(self.ctx, out[0], lib.es_group_result_free)
         G, E = int(r.ngroups), int(r.nedges)
@@ -560,7 +587,7 @@ class Store:
         return res
 
     def pca(self, name=None, filter=None, ncomp=0, method="auto", oversample=10,
-            power_iters=4):
+            power_iters=4, replace=False):
         """Fit a PCA of the rows matching filter (es_study_pca); stored as
         pca/<name> when name is given. Returns a PCA with .rows."""
         o = ffi.new("es_pca_opts *")
@@ -569,8 +596,9 @@ class Store:
         o.oversample = A.index(oversample, "oversample")
         o.power_iters = A.index(power_iters, "power_iters")
         out, rows, n = ffi.new("es_pca **"), ffi.new("int64_t **"), ffi.new("int64_t *")
-        self._call(lib.es_study_pca, _s(name) or ffi.NULL, _s(filter) or ffi.NULL,
-                      o, self._command("pca"), out, rows, n)
+        with self._replacing(replace):
+            self._call(lib.es_study_pca, _s(name) or ffi.NULL, _s(filter) or ffi.NULL,
+                          o, self._command("pca"), out, rows, n)
         r = np.array(A.view(rows[0], (n[0],), A.Freed(self.ctx, rows[0]), "i8"))
         self._committed(name)
         return PCA(self.ctx, out[0], r)
@@ -582,12 +610,13 @@ class Store:
         r = np.array(A.view(rows[0], (n[0],), A.Freed(self.ctx, rows[0]), "i8"))
         return PCA(self.ctx, out[0], r)
 
-    def diff(self, name, key, column, from_, to, filter=None):
+    def diff(self, name, key, column, from_, to, filter=None, replace=False):
         """Paired difference to - from, rows paired by label `key`
         (es_study_diff); stored as diff/<name> when name is given."""
         out = ffi.new("es_diff **")
-        self._call(lib.es_study_diff, _s(name) or ffi.NULL, _s(filter) or ffi.NULL,
-                      _s(key), _s(column), _s(from_), _s(to), self._command("diff"), out)
+        with self._replacing(replace):
+            self._call(lib.es_study_diff, _s(name) or ffi.NULL, _s(filter) or ffi.NULL,
+                          _s(key), _s(column), _s(from_), _s(to), self._command("diff"), out)
         d = A.owned(self.ctx, out[0], lib.es_diff_free)
         E, P, U = int(d.nedges), int(d.npairs), int(d.nunpaired)
         res = Diff(mean=A.view(d.mean, (E,), d), sd=A.view(d.sd, (E,), d),
@@ -598,16 +627,17 @@ class Store:
         self._committed(name)
         return res
 
-    def point(self, expr, name=None, pca=None, scale=0.0):
+    def point(self, expr, name=None, pca=None, scale=0.0, replace=False):
         """Evaluate a point expression (datasets-spec/point-syntax.md) with its
         row weights (es_study_point); stored as point/<name> when name is given.
         Returns a Point: lengths (E,), weights (N,), scale, info (validity)."""
         vec = ffi.new("double **")
         w = np.empty(self.nrows)
         info = ffi.new("es_point_info *")
-        self._call(lib.es_study_point, _s(name) or ffi.NULL, _s(expr),
-                      _s(pca) or ffi.NULL, float(scale), self._command("point"), vec, A.dptr(w),
-                      info)
+        with self._replacing(replace):
+            self._call(lib.es_study_point, _s(name) or ffi.NULL, _s(expr),
+                          _s(pca) or ffi.NULL, float(scale), self._command("point"), vec, A.dptr(w),
+                          info)
         lengths = np.array(A.view(vec[0], (self.nedges,), A.Freed(self.ctx, vec[0])))
         inf = A.struct_dict(info, "es_point_info")
         inf["validity"] = A.struct_dict(info.validity, "es_validity")
@@ -659,7 +689,7 @@ class Store:
         return s
 
     def embed(self, point, pca=None, init=None, scale=0.0, name=None, output=None,
-              residuals=None, warm=False, **opts):
+              residuals=None, warm=False, replace=False, **opts):
         """Embed a point of the store's space (es_study_embed: near the prior
         of its row weights, in the store's frame, unless init names an explicit
         start). Returns Embedding(V, F, report) with report["scale"] and
@@ -669,7 +699,21 @@ class Store:
         first, from STORE.es-cache when current), so the next one costs only
         its solve; warm=True starts from the last call's correction of its
         prior (default: from the point's own prior, the same mesh whatever
-        came before)."""
+        came before).
+
+        point may also be an array of E edge lengths (a model's prediction,
+        a PCA reconstruction): embedded near the prior of its row weights
+        (ridge regression on every row, as a file: point's), at scale (0:
+        the lengths' own sum, or for lengths that sum to 1 the rows' mean
+        scale); init, name and residuals need a point expression."""
+        if not isinstance(point, str):
+            if init is not None or name is not None or residuals is not None:
+                raise ValueError("embed: init=, name= and residuals= need a point expression; "
+                                 "an array of lengths is embedded near its prior only")
+            emb = self._embed_lengths(point, scale, warm, opts)
+            if output is not None:
+                emb.write(output, self.mesh)
+            return emb
         o = ffi.new("es_study_embed_opts *")
         lib.es_study_embed_opts_init(o)
         keep = [_c(point), _c(pca), _c(init), _c(name), _c(output), _c(residuals),
@@ -680,24 +724,55 @@ class Store:
         o.name, o.output, o.residuals, o.command = keep[3], keep[4], keep[5], keep[6]
         o.scale = float(scale)
         if init is None or init == "prior":
-            s = getattr(self, "_embed_session", None)
-            if s is None or s._ptr is None or s.nrows != self.nrows:   # rows added since
-                if s is not None:
-                    s.close()
-                self._embed_session = self.embedder()
-            o.session = self._embed_session.ptr
+            o.session = self._session().ptr   # made again when rows were added
             o.warm = 1 if warm else 0
         set_embed_opts(o.embed, opts)
         xyz = np.empty((self.nverts, 3))
         res = ffi.new("es_study_embed_result *")
-        self._call(lib.es_study_embed, o, A.dptr(xyz), res)
-        rep = report_dict(res.report)
-        rep["scale"] = float(res.scale)
-        rep["init"] = ffi.string(res.init).decode("utf-8", "replace")
-        return Embedding(xyz, self.mesh.faces, rep)
+        with self._replacing(replace):
+            self._call(lib.es_study_embed, o, A.dptr(xyz), res)
+        return study_embedding(xyz, self.mesh.faces, res)
+
+    def _session(self):
+        """The store's embedding session, made again when rows were added."""
+        s = getattr(self, "_embed_session", None)
+        if s is None or s._ptr is None or s.nrows != self.nrows:
+            if s is not None:
+                s.close()
+            self._embed_session = self.embedder()
+        return self._embed_session
+
+    def _embed_lengths(self, lengths, scale, warm, opts):
+        L = A.f64(np.ravel(np.asarray(lengths, dtype=np.float64)), (self.nedges,), "lengths")
+        if not np.all(np.isfinite(L)) or np.any(L <= 0):
+            bad = int(np.flatnonzero(~(np.isfinite(L) & (L > 0)))[0])
+            raise ValueError(f"embed: length {bad} (edge {tuple(self.edges[bad])}) is "
+                             f"{L[bad]!r}: no mesh realizes lengths that are not positive")
+        unit, sc = np.empty_like(L), ffi.new("double *")   # normalized as the library does
+        self.ctx.call(lib.es_lengths_normalize, len(L), A.dptr(L), A.dptr(unit), sc)
+        total = float(sc[0])
+        if scale <= 0:
+            scale = float(np.mean(self.scales())) if abs(total - 1) < 1e-9 else total
+        w = self._all_rows_pca().row_weights(unit)
+        eo = ffi.new("es_embed_opts *")
+        lib.es_embed_opts_init(eo)
+        set_embed_opts(eo, opts)
+        xyz = np.empty((self.nverts, 3))
+        res = ffi.new("es_study_embed_result *")
+        with self.ctx.hold():   # the store and its session not closed meanwhile
+            self.ctx.call(lib.es_study_embedder_solve, self._session().ptr, A.dptr(unit),
+                          float(scale), A.dptr(w), eo, 1 if warm else 0, 0, A.dptr(xyz), res)
+        return study_embedding(xyz, self.mesh.faces, res)
+
+    def _all_rows_pca(self):
+        """A PCA of every row (not stored), for the row weights of lengths."""
+        p = getattr(self, "_weights_pca", None)
+        if p is None or p.nrows != self.nrows:
+            p = self._weights_pca = self.pca()
+        return p
 
     def interp(self, from_=None, to=None, steps=9, t0=0.0, t1=1.0, weights=None, pca=None,
-               name=None, output=None, cold=False, **opts):
+               name=None, output=None, cold=False, replace=False, **opts):
         """A walk from `from_` (t = t0) to `to` (t = t1) in `steps` frames, or one
         weighted combination of rows (weights="0.3*row:a + 0.7*row:b"), each
         frame embedded as es_study_interp embeds it: from the last frame's
@@ -723,7 +798,8 @@ class Store:
             o.cold = 1 if cold else 0
             o.frame = cb
             set_embed_opts(o.embed, opts)
-            self._call(lib.es_study_interp, o)
+            with self._replacing(replace):
+                self._call(lib.es_study_interp, o)
             out = []
             F = self.mesh.faces
             for i, path, heading, rep in sorted(frames):
@@ -745,7 +821,7 @@ class Store:
                 "residuals": np.array(A.view(p.residuals, (n,), p))}
 
     def gpa(self, name, rows=None, scale=True, allow_reflection=False, tol=1e-10,
-            max_iter=1000, npc=0):
+            max_iter=1000, npc=0, replace=False):
         """GPA of the rows' positions with the PCA of the tangent coordinates
         (es_study_gpa), stored as gpa/<name> and committed; the stored arrays
         come back in (specimen, landmark, dimension) order."""
@@ -755,9 +831,10 @@ class Store:
             float(tol), A.index(max_iter, "max_iter")
         r = None if rows is None else A.indices(rows, (None,), "rows")
         rep = ffi.new("es_gpa_report *")
-        self._call(lib.es_study_gpa, _s(name), A.iptr(r),
-                   -1 if r is None else len(r), o, A.index(npc, "npc"), self._command("gpa"),
-                   rep)
+        with self._replacing(replace):
+            self._call(lib.es_study_gpa, _s(name), A.iptr(r),
+                       -1 if r is None else len(r), o, A.index(npc, "npc"), self._command("gpa"),
+                       rep)
         self.commit()
         return self.load_gpa(name, A.struct_dict(rep, "es_gpa_report"))
 
@@ -781,7 +858,7 @@ class Store:
         return res
 
     def compare(self, gpa, by=None, permutations=999, top_pairs=20, normalize_lengths=True,
-                name=None, out_dir=None):
+                name=None, out_dir=None, replace=False):
         """Edge-length space against Procrustes space on a stored GPA's rows
         (es_study_compare); stored as compare/<name> (None: not stored) and
         committed; out_dir gets the CSV tables."""
@@ -791,9 +868,10 @@ class Store:
         o.top_pairs = A.index(top_pairs, "top_pairs")
         o.normalize_lengths = int(normalize_lengths)
         out = ffi.new("es_compare_result **")
-        self._call(lib.es_study_compare, _s(gpa), _s(by) or ffi.NULL, o,
-                      _s(name) if name else b"", _s(out_dir) or ffi.NULL,
-                      self._command("compare"), out)
+        with self._replacing(replace):
+            self._call(lib.es_study_compare, _s(gpa), _s(by) or ffi.NULL, o,
+                          _s(name) if name else b"", _s(out_dir) or ffi.NULL,
+                          self._command("compare"), out)
         r = A.owned(self.ctx, out[0], lib.es_compare_result_free)
         if name:
             self.commit()
@@ -819,7 +897,7 @@ class Store:
     def model(self, formula, gpa=None, where=None, block=None, ss_type=1, permute="rrpp",
               permutations=999, contrasts="treatment", pairwise=None, edges=None,
               edge_permutations=-1, name=None, reference=None, slopes=None, at=None,
-              errors=None, null=None):
+              errors=None, null=None, seed=None, replace=False):
         """A linear model of the shapes on label columns with permutation
         tests (es_study_model): in edge-length space, or on GPA result
         `gpa`'s aligned coordinates; stored as model/<name> (None: not
@@ -829,7 +907,9 @@ class Store:
         covariate values; errors: {"TERM": "ERROR_TERM"} for nested designs;
         null: a nested formula the model is compared with (RRPP's
         anova(null, full)); edges: a term tested per edge (per landmark with
-        gpa). The options are the command's (edgespace model --help)."""
+        gpa); seed: of the permutations (None: the context's; the result's
+        seed says which). The options are the command's (edgespace model
+        --help)."""
         schemes = {"rrpp": lib.ES_PERM_RRPP, "raw": lib.ES_PERM_RAW}
         codings = {"treatment": lib.ES_CONTRASTS_TREATMENT, "sum": lib.ES_CONTRASTS_SUM}
         if permute not in schemes or contrasts not in codings or ss_type not in (1, 2, 3):
@@ -847,7 +927,16 @@ class Store:
         o.permutations = A.index(permutations, "permutations")
         o.edge_permutations = A.index(edge_permutations, "edge_permutations")
         out = ffi.new("es_study_model_result **")
-        self._call(lib.es_study_model, o, out)
+        old_seed = self.ctx.seed
+        if seed is not None:
+            if int(seed) < 1:
+                raise ValueError(f"model: seed {seed!r} must be >= 1")
+            self.ctx.seed = seed
+        try:
+            with self._replacing(replace):
+                self._call(lib.es_study_model, o, out)
+        finally:
+            self.ctx.seed = old_seed
         r = A.owned(self.ctx, out[0], lib.es_study_model_free)
         if name:
             self.commit()
@@ -866,7 +955,8 @@ class Store:
             df=A.view(m.df, (T,), r, "i8"), ss=A.view(m.ss, (T,), r), ms=A.view(m.ms, (T,), r),
             r2=A.view(m.r2, (T,), r), f=A.view(m.f, (T,), r), p=A.view(m.pval, (T,), r),
             z=A.view(m.z, (T,), r),
-            df_resid=int(m.df_resid), rss=m.rss, tss=m.tss,
+            df_resid=int(m.df_resid), rss=m.rss, tss=m.tss, seed=int(m.seed),
+            permutations=int(m.permutations),
             coef_names=[A.string(d.colnames[c]) for c in range(q)],
             coef=A.view(m.coef, (P, q), r).T, coef_weights=A.view(m.coef_weights, (q, N), r),
             mean=A.view(m.mean, (P,), r), rows=A.view(r.rows, (N,), r, "i8"))
@@ -901,8 +991,10 @@ class Store:
     def export_statismo(self, path, pca=None, gpa=None, ncomp=0, sd=1.0, noise_variance=None,
                         **opts):
         """A statismo shape model of a stored PCA or GPA
-        (es_study_export_statismo; datasets-spec/statismo.md). Returns the
-        report as a dict."""
+        (es_study_export_statismo; datasets-spec/statismo.md; a landmark GPA
+        as a POINT_SET model). Returns the report as a dict: kind, and for
+        a GPA None where the edge-length linearization's figures (worst
+        RMS and bending ratio, nonlinearity) do not apply."""
         o = ffi.new("es_study_statismo_opts *")
         lib.es_study_statismo_opts_init(o)
         keep = [_c(pca), _c(gpa), self._command("export_statismo")]
@@ -913,7 +1005,12 @@ class Store:
         set_embed_opts(o.embed, opts)
         rep = ffi.new("es_study_statismo_report *")
         self._call(lib.es_study_export_statismo, o, _s(path), rep)
-        return A.struct_dict(rep, "es_study_statismo_report")
+        out = A.struct_dict(rep, "es_study_statismo_report")
+        out["kind"] = "POLYGON_MESH" if out["nfaces"] else "POINT_SET"
+        if gpa is not None:   # the linearization's figures do not apply to a GPA model
+            for k in ("worst_rms_ratio", "worst_bend_ratio", "nonlinearity"):
+                out[k] = None
+        return out
 
     def _committed(self, name):
         if name:

@@ -25,6 +25,9 @@ def test_render_is_the_commands_picture(tmp_path, cli, ctx):
     assert isinstance(img, bytes) and img == (tmp_path / "cli.png").read_bytes()
     assert png_size(img) == (480, 480)
     assert img._repr_png_() == bytes(img)
+    # a notebook's text/plain of an image: a line, not the PNG's bytes again
+    assert repr(img) == f"<edgespace.Image PNG 480x480, {len(img)} bytes>"
+    assert img.size == png_size(img)
     # with scalars, a title and a colour map: the command's options
     t = np.linspace(-1, 1, m.nedges)
     np.savetxt(tmp_path / "t.csv", t, fmt="%.17g")
@@ -53,6 +56,8 @@ def test_embedding_displays_inline(store_path, ctx):
         e = s.embed("row:face_s01_neutral")
     png = e._repr_png_()
     assert png_size(png) == (360, 360)
+    assert repr(e).startswith(f"<edgespace.Embedding V={e.V.shape[0]} F={e.F.shape[0]} ")
+    assert len(repr(e)) < 100
 
 
 def test_plots(ctx):
@@ -65,3 +70,55 @@ def test_plots(ctx):
     assert png_size(img)[0] > 100
     with pytest.raises(ValueError):
         es.plot_scatter(x, y[:5], ctx=ctx)
+
+
+def test_render_scalars_column_and_percentile_range(tmp_path, cli, ctx):
+    """render --column picks a CSV column by name (its header labels the colour
+    bar), --percentiles sets the range: against numpy.percentile (linear)."""
+    import re
+    syn = es.synth("face", n=1, ctx=ctx)
+    m = es.Mesh(syn["faces"], syn["vertices"][0], ctx=ctx)
+    m.write(tmp_path / "f.ply")
+    rng = np.random.default_rng(3)
+    a = rng.normal(size=m.nverts)
+    b = rng.lognormal(sigma=2.0, size=m.nverts)     # a heavy tail, as residuals have
+    with open(tmp_path / "s.csv", "w") as f:
+        f.write("a,b\n" + "".join(f"{x!r},{y!r}\n" for x, y in zip(a, b)))
+
+    def colour_range(*args):
+        r = cli("render", tmp_path / "f.ply", "--scalars", tmp_path / "s.csv", "-o",
+                tmp_path / "r.png", *args)
+        lo, hi = re.search(r"colour range (\S+)\.\.(\S+)", r.stdout).groups()
+        return float(lo), float(hi)
+    assert np.allclose(colour_range("--column", "b"), [b.min(), b.max()], rtol=1e-3)
+    assert np.allclose(colour_range("--column", "b", "--percentiles", "5,95"),
+                       np.percentile(b, [5, 95]), rtol=1e-3)
+    assert np.allclose(colour_range("--column", "1", "--percentiles", "0,50"),
+                       [a.min(), np.median(a)], rtol=1e-3)
+    assert png_size((tmp_path / "r.png").read_bytes())[1] == 480
+    r = cli("render", tmp_path / "f.ply", "--scalars", tmp_path / "s.csv", "--column", "c",
+            "-o", tmp_path / "x.png", check=False)
+    assert r.returncode == 1 and "no column 'c' (columns: a, b)" in r.stderr
+    r = cli("render", tmp_path / "f.ply", "--percentiles", "90,10", "-o", tmp_path / "x.png",
+            check=False)
+    assert r.returncode == 2
+
+
+def test_variation_figure_writes_plus_minus_and_minus_signs(store_path, tmp_path, cli):
+    """The labels and title say "±" and "−" (U+00B1, U+2212), not "+-" and
+    "-": read from the PDF's ToUnicode maps (zlib, not the library)."""
+    import re
+    import zlib
+    cli("pca", store_path, "--name", "faces")
+    cli("variation", store_path, "--pca", "faces", "--pcs", "1", "-o", tmp_path / "v.pdf")
+    data = (tmp_path / "v.pdf").read_bytes()
+    maps = b""
+    for m in re.finditer(rb"stream\r?\n(.*?)\r?\nendstream", data, re.S):
+        try:
+            text = zlib.decompress(m.group(1))
+        except zlib.error:
+            continue
+        if b"beginbfchar" in text:
+            maps += text
+    codes = set(re.findall(rb"<[0-9a-f]+> <([0-9a-f]{4})>", maps))
+    assert b"00b1" in codes and b"2212" in codes

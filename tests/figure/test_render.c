@@ -694,6 +694,7 @@ static void test_render_files(es_ctx *ctx)
         es_render_spec sp = spec;
         sp.meshes = &it;
         sp.nmeshes = 1;
+        if (k == 0) sp.colorbar_label = "height";   /* the file's header labels its bar */
         ES_CHECK_OK(ctx, es_render(ctx, &sp, b, &rep2));
         ES_CHECK_MSG(same_file(a, b), "%s scalars from a file differ from es_render's", what[k]);
         ES_CHECK(rep2.n_nan_scalars == rep.n_nan_scalars && rep2.vmin == rep.vmin);

@@ -19,6 +19,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 /* A whole dataset as float (or int32 with is_int), its dims in d[0..1]
  * (rank 1: d[1] = 0, scalar: both 0). NULL if absent. */
@@ -238,6 +239,22 @@ int main(void)
         m.ncomp = 1;   /* and a valid one replaces it */
         ES_CHECK_OK(ctx, es_statismo_write(ctx, model, &m));
         check_layout(model, 3, 1, 1, tri);
+        {   /* read back (es_statismo_read) as written; a name scalismo cannot open refused */
+            es_statismo_data *d = NULL;
+            char bad[4400];
+            ES_CHECK_OK(ctx, es_statismo_read(ctx, model, &d));
+            ES_CHECK(d && d->nverts == 3 && d->nfaces == 1 && d->ncomp == 1 &&
+                     !strcmp(d->dataset_type, "POLYGON_MESH") && d->minor == 9);
+            for (int i = 0; d && i < 9; i++)
+                ES_CHECK(d->mean[i] == mean[i] && d->points[i] == mean[i] &&
+                         d->basis[i] == basis[i]);
+            for (int i = 0; d && i < 3; i++) ES_CHECK(d->faces[i] == tri[i]);
+            es_statismo_data_free(d);
+            snprintf(bad, sizeof bad, "%s/m.hdf5", dir);
+            ES_CHECK_FAILS(ctx, es_statismo_write(ctx, bad, &m), ES_EINVAL, "name it '");
+            ES_CHECK(access(bad, F_OK) != 0);
+            ES_CHECK_FAILS(ctx, es_statismo_read(ctx, path, &d), ES_EFORMAT, "representer");
+        }
         free(before);
         free(store_before);
     }

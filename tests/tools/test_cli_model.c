@@ -248,6 +248,10 @@ int main(void)
     ES_CHECK(r.status == 0);
     ES_RUN(&r, dir, "variation", store, "--pcs", "1", "-o", var);
     ES_CHECK_MSG(r.status == 0 && strstr(r.out, "axis 1: ") && is_png(var), "%s%s", r.out, r.err);
+    /* a PCA that is not there: the message lists those that are */
+    ES_RUN(&r, dir, "plot-pca", store, "--pca", "nope", "-o", var);
+    ES_CHECK_MSG(r.status == 1 && strstr(r.err, "no PCA named 'nope' (pca results: default)"),
+                 "%s", r.err);
     unlink(var);
     ES_RUN(&r, dir, "variation", store, "--coef", "m:expression=happy", "-k", "1", "-o", var);
     ES_CHECK_MSG(r.status == 0 && is_png(var), "%s%s", r.out, r.err);
@@ -262,7 +266,17 @@ int main(void)
     ES_CHECK_MSG(r.status == 0 && strstr(r.out, "model/m ") && strstr(r.out, "gpa/g ") &&
                  strstr(r.out, "edgespace model "), "%s%s", r.out, r.err);
     ES_RUN(&r, dir, "results", store, "--delete", "gpa/g", "--delete", "model/none");
-    ES_CHECK_MSG(r.status == 1 && strstr(r.err, "no result model/none"), "%s", r.err);
+    ES_CHECK_MSG(r.status == 1 && strstr(r.err, "no result model/none") &&
+                 strstr(r.err, "(model results: m)"), "%s", r.err);
+    ES_RUN(&r, dir, "results", store, "--delete", "point/nothere");
+    ES_CHECK_MSG(r.status == 1 && strstr(r.err, "(no point results; the store has: ") &&
+                 strstr(r.err, "gpa") && strstr(r.err, "model"), "%s", r.err);
+    ES_RUN(&r, dir, "results", store, "--delete", "model/n");   /* one edit from 'm' */
+    ES_CHECK_MSG(r.status == 1 && strstr(r.err, "(did you mean 'm'?)"), "%s", r.err);
+    /* the message names the command once, not "mean: mean:" */
+    ES_RUN(&r, dir, "mean", store, "--where", "expression=sad");
+    ES_CHECK_MSG(r.status == 1 && strstr(r.err, "\nedgespace mean: no rows match") &&
+                 !strstr(r.err, "mean: mean:"), "%s", r.err);
     ES_RUN(&r, dir, "results", store, "--kind", "gpa");
     ES_CHECK(r.status == 0 && strstr(r.out, "gpa/g ") && !strstr(r.out, "model/m"));
     ES_RUN(&r, dir, "results", store, "--delete", "gpa/g");

@@ -203,7 +203,7 @@ int main(void)
     ES_CHECK(run(out, sizeof out, "point study.h5 'lerp(row:s1_neutral, row:s1_happy, 60)'") == 0);
     ES_CHECK_MSG(strstr(out, "INVALID"), "%s", out);
     ES_CHECK(run(out, sizeof out, "point study.h5 'mean + (row:s1_neutral'") == 1);
-    ES_CHECK_MSG(strstr(out, "edgespace point: point: column 23: expected ')' to close the '(' at column 8"), "%s", out);
+    ES_CHECK_MSG(strstr(out, "edgespace point: column 23: expected ')' to close the '(' at column 8"), "%s", out);
     ES_CHECK(run(out, sizeof out, "point study.h5 'row:nobody'") == 1);
     ES_CHECK_MSG(strstr(out, "row:nobody: no row with id 'nobody'"), "%s", out);
     ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_READ, &st));

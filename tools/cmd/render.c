@@ -28,9 +28,14 @@ static void usage(FILE *f)
           "      --view X,Y,Z       direction the camera looks along\n"
           "      --up X,Y,Z         screen up direction\n"
           "      --scalars CSV      values to colour by: one per vertex, edge or face\n"
-          "                         (the count decides; edges in es_mesh order), first\n"
-          "                         column, a header line allowed, empty or nan = missing;\n"
-          "                         once for all meshes or once per mesh\n"
+          "                         (the count decides; edges in es_mesh order), a header\n"
+          "                         line allowed, empty or nan = missing; once for all\n"
+          "                         meshes or once per mesh\n"
+          "      --column C         the scalars' column: a header name or a number\n"
+          "                         (default: the first); its header labels the colour bar\n"
+          "      --percentiles P,Q  colour range from the P-th to the Q-th percentile of\n"
+          "                         the values (e.g. 2,98: a few large residuals do not\n"
+          "                         leave the rest one colour); beyond: the end colours\n"
           "      --cmap NAME        viridis (default), rdbu (signed values), greys\n"
           "      --range LO,HI      colour range (default: the data's, symmetric for rdbu)\n"
           "      --label TEXT       label under a panel (repeat per mesh; default: file\n"
@@ -71,6 +76,7 @@ int cmd_render(int argc, char **argv)
         {"cmap", required_argument, NULL, 'c'}, {"range", required_argument, NULL, 'r'},
         {"label", required_argument, NULL, 'l'}, {"title", required_argument, NULL, 't'},
         {"colorbar-label", required_argument, NULL, 'b'},
+        {"column", required_argument, NULL, 'k'}, {"percentiles", required_argument, NULL, 'p'},
         {"width", required_argument, NULL, 'W'}, {"height", required_argument, NULL, 'H'},
         {"ortho", no_argument, NULL, 'O'}, {"fov", required_argument, NULL, 'F'},
         {"cull", no_argument, NULL, 'C'}, {"fit-each", no_argument, NULL, 'E'},
@@ -120,6 +126,17 @@ int cmd_render(int argc, char **argv)
             labels[nlabels++] = optarg;
             break;
         case 't': spec.title = optarg; break;
+        case 'k': spec.scalar_column = optarg; break;
+        case 'p': {
+            char buf[256];
+            snprintf(buf, sizeof buf, "%s,1", optarg);
+            if (parse_vec3(buf, range) || !(range[0] >= 0 && range[0] < range[1] &&
+                                            range[1] <= 100))
+                return cli_usage_error(VERB, "--percentiles wants P,Q with 0 <= P < Q <= 100");
+            spec.range_percentiles[0] = range[0];
+            spec.range_percentiles[1] = range[1];
+            break;
+        }
         case 'b': spec.colorbar_label = optarg; break;
         case 'W':
         case 'H':

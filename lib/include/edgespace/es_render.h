@@ -105,6 +105,16 @@ typedef struct es_render_spec {
     double background_rgb[3];  /* (1, 1, 1) */
     double font_size;          /* (12) */
     int supersample;           /* 1..4 samples per pixel per axis (3) */
+    /* Without vmin/vmax: the colour range from the lo-th to the hi-th
+     * percentile of the finite scalars (linear interpolation between order
+     * statistics, numpy's default), so that a few large values (a mesh's
+     * worst residuals) do not leave the rest one colour; values beyond are
+     * drawn in the end colours. {0, 0} (default): {0, 100}, the full range. */
+    double range_percentiles[2];
+    /* es_figure_render_files: the CSV column of the scalar files, a header
+     * name or a 1-based number (NULL: the first); its header labels the
+     * colour bar when colorbar_label is NULL. */
+    const char *scalar_column;
 } es_render_spec;
 
 typedef struct es_render_report {

@@ -70,6 +70,10 @@ typedef enum es_store_mode {
  * of another format version, or corrupt). */
 ES_API es_status es_store_open(es_ctx *ctx, const char *path, es_store_mode mode,
                                es_store **out);
+/* Switch a write handle between ES_STORE_WRITE (replace 0) and
+ * ES_STORE_REPLACE (1) for the results written from now on (Python's
+ * replace= on one call). ES_EINVAL on a read handle. */
+ES_API es_status es_store_set_replace(es_ctx *ctx, es_store *store, int replace);
 /* Create a new, empty store (N = 0) for `mesh`'s topology, open for
  * writing. Nothing appears at `path` until es_store_commit/es_store_close.
  * Fails with ES_EEXIST if `path` exists. */
@@ -192,6 +196,13 @@ ES_API const char *es_store_label(const es_store *store, int64_t row, int64_t co
 ES_API void es_store_column_hint(const es_store *store, const char *name, char *buf, size_t n);
 ES_API void es_store_value_hint(const es_store *store, int64_t col, const char *value, char *buf,
                                 size_t n);
+/* The same for a result /analysis/<kind>/<name> the store does not have:
+ * the closest names of that kind (" (did you mean 'faces'?)"), else those
+ * there are (" (pca results: a, b)"), else the kinds present (" (no pca
+ * results; the store has: gpa, model)") or " (the store holds no results)".
+ * Leaves ctx's error message as it was. */
+ES_API void es_store_result_hint(es_ctx *ctx, es_store *store, const char *kind, const char *name,
+                                 char *buf, size_t n);
 
 /* Rows matching a filter "col=value[,col=value...]" (all must hold; NULL or
  * "" selects every row; the column "id" means the row id unless a label
@@ -317,6 +328,34 @@ typedef struct es_statismo_model {
  * values or negative variances; ES_ERANGE beyond 2^31 vertices; ES_EEXIST
  * if path is an HDF5 file that is not a statismo model (a store, say). */
 ES_API es_status es_statismo_write(es_ctx *ctx, const char *path, const es_statismo_model *m);
+/* ES_OK if path ends in ".h5", the only name scalismo opens a model by
+ * (StatisticalModelIOUtils); else ES_EINVAL naming the file to write
+ * instead ("model.hdf5" -> "model.h5"). es_statismo_write checks it. */
+ES_API es_status es_statismo_check_name(es_ctx *ctx, const char *path);
+
+/* A statismo model read back (es_statismo_read; owned, es_statismo_data_free):
+ * what edgespace, statismo or scalismo wrote, read as scalismo's
+ * StatismoIO.readStatismoPDM reads it. */
+typedef struct es_statismo_data {
+    es_ctx *ctx;
+    char dataset_type[32];     /* "POLYGON_MESH" or "POINT_SET" */
+    int major, minor;          /* the format version (0.8, 0.9 or 1.x) */
+    int64_t nverts, nfaces;    /* nfaces 0 for a point set */
+    int64_t *faces;            /* 3 x F (NULL for a point set) */
+    double *points;            /* 3 x V: the representer's reference points */
+    double *mean;              /* 3 x V: the model's mean, vertex-interleaved */
+    int64_t ncomp;
+    double *basis;             /* 3V x K, column k = mode k (unit; 0.8's scaled basis
+                                  divided by sqrt(variance) as scalismo does) */
+    double *variance;          /* K */
+    double noise_variance;
+} es_statismo_data;
+
+/* Read a statismo 3D shape model. ES_EFORMAT naming what is missing or
+ * inconsistent (no representer, an IMAGE or VOLUME_MESH model, sizes that
+ * disagree, a cell out of range, a non-finite value); ES_EIO if unreadable. */
+ES_API es_status es_statismo_read(es_ctx *ctx, const char *path, es_statismo_data **out);
+ES_API void es_statismo_data_free(es_statismo_data *m);
 
 #ifdef __cplusplus
 }
