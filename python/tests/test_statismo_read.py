@@ -171,3 +171,39 @@ def test_a_name_scalismo_cannot_open_is_refused(store_path, tmp_path, cli, ctx):
     assert not list(tmp_path.glob("m.*"))
     with pytest.raises(IOError):
         scalismo_read_pdm(tmp_path / "m.hdf5")
+
+
+def test_scalars_are_read_only_from_one_number(tmp_path, ctx):
+    """A noiseVariance of many numbers is not read into the one double the
+    model keeps (it was read whole, past it, before the merge of issue 29);
+    a version stored as a vector is no version; a file cut short is refused
+    with its name. Checked against what was written here, and under the
+    address sanitizer in CI."""
+    rng = np.random.default_rng(11)
+    V = 4
+    pts = rng.normal(size=(V, 3))
+
+    def write(p, noise, minor):
+        with h5py.File(p, "w") as f:
+            f["model/mean"] = pts.reshape(-1)
+            f["model/noiseVariance"] = noise
+            f["model/pcaBasis"] = np.eye(3 * V, 1)
+            f["model/pcaVariance"] = np.ones(1)
+            r = f.create_group("representer")
+            r.attrs["datasetType"] = "POINT_SET"
+            r["points"] = pts.T
+            f["version/majorVersion"] = np.int32(0)
+            f["version/minorVersion"] = minor
+
+    write(tmp_path / "many.h5", np.full(4096, 3.0), np.int32(9))
+    m = es.read_statismo(tmp_path / "many.h5", ctx=ctx)
+    assert m.noise_variance == 0.0 and np.allclose(m.instance([0]), pts)
+    write(tmp_path / "one.h5", np.full(1, 0.5), np.int32(9))
+    assert es.read_statismo(tmp_path / "one.h5", ctx=ctx).noise_variance == 0.5
+    write(tmp_path / "vec.h5", np.zeros(1), np.arange(9, dtype=np.int32))
+    with pytest.raises(es.FormatError, match="vec.h5.*minorVersion"):
+        es.read_statismo(tmp_path / "vec.h5", ctx=ctx)
+    data = (tmp_path / "one.h5").read_bytes()
+    (tmp_path / "cut.h5").write_bytes(data[:len(data) // 2])
+    with pytest.raises(es.Error, match="cut.h5"):
+        es.read_statismo(tmp_path / "cut.h5", ctx=ctx)
