@@ -515,32 +515,23 @@ static int points(notebook *nb, study *s)
 
 static int embed(notebook *nb, study *s)
 {
-    es_embedder *emb = NULL;
-    es_study_rows *rows = NULL;
+    es_study_embedder *se = NULL;
     es_embed_opts eo;
     es_status rc;
     const int64_t V3 = 3 * s->V;
-    double *prior = NULL;
     FILE *f;
 
     nb_step(nb, "embed: each point as a mesh near the prior of its row weights");
     s->xyz = malloc(sizeof(double) * (size_t)(V3 * NPTS));
-    prior = malloc(sizeof(double) * (size_t)(V3 + 2 * s->E));
-    if (!s->xyz || !prior) {
-        free(prior);
-        return nb_fail(nb, ES_ENOMEM, "embedding output");
-    }
-    /* every face GPA-aligned (no scaling) into the store's frame, with its
-     * dihedrals: the material of every point's prior */
-    if ((rc = es_study_rows_load(nb->ctx, s->store, s->mesh, &rows)) != ES_OK ||
-        (rc = es_embedder_new(nb->ctx, s->mesh, &emb)) != ES_OK) {
-        free(prior);
-        es_study_rows_free(rows);
-        return nb_fail(nb, rc, "making the embedder");
-    }
-    /* the library's defaults: longer refinement would let the lengths win
-     * over the prior's bending where they are not exactly realizable
-     * (averages of noisy faces), which shows as creases */
+    if (!s->xyz) return nb_fail(nb, ES_ENOMEM, "embedding output");
+    /* an embedding session: every face GPA-aligned (no scaling) into the
+     * store's frame, with its dihedrals (the material of every point's
+     * prior), and the embedder, made once and kept beside the store */
+    if ((rc = es_study_embedder_open(nb->ctx, s->store, 1, &se)) != ES_OK)
+        return nb_fail(nb, rc, "making the embedding session");
+    /* the library's defaults: more exact lengths would let them win over
+     * the prior's bending where they are not exactly realizable (averages
+     * of noisy faces), which shows as creases */
     es_embed_opts_init(&eo);
     s->npts = nb->small ? 3 : NPTS;
     if (nb->small)
@@ -550,14 +541,13 @@ static int embed(notebook *nb, study *s)
         /* the prior of the point's row weights starts the solve, holds the
          * free directions of the open face near the data's bending, and puts
          * the output in the store's frame: every face stands alike */
-        es_embed_prior pr = {prior, prior + V3, prior + V3 + s->E, NULL};
-        if ((rc = es_study_prior(nb->ctx, rows, s->w + p * s->N, prior, prior + V3,
-                                 prior + V3 + s->E)) != ES_OK ||
-            (rc = es_embed_prior_solve(nb->ctx, emb, s->pts + p * s->E, s->pt_scale[p], &pr,
-                                       &eo, s->xyz + p * V3, &s->rep[p])) != ES_OK) {
+        es_study_embed_result res;
+        if ((rc = es_study_embedder_solve(nb->ctx, se, s->pts + p * s->E, s->pt_scale[p], s->w + p * s->N,
+                                          &eo, 0, 0, s->xyz + p * V3, &res)) != ES_OK) {
             nb_fail(nb, rc, s->pt_name[p]);
             break;
         }
+        s->rep[p] = res.report;
         printf("%s:   %-16s rms ratio %.3g, max rel %.3g, bending %.3f x the prior's, %.1f s\n",
                nb->name, s->pt_name[p], s->rep[p].rms_ratio, s->rep[p].max_rel,
                s->rep[p].bend_ratio, s->rep[p].t_total);
@@ -568,9 +558,7 @@ static int embed(notebook *nb, study *s)
         }
         nb_output(nb, nb_path(nb, "%s.obj", s->pt_name[p]) + strlen(nb->outdir) + 1);
     }
-    es_embedder_free(emb);
-    es_study_rows_free(rows);
-    free(prior);
+    es_study_embedder_free(se);
     if (rc != ES_OK) return 1;
 
     if (!(f = nb_csv_open(nb, "embedding_quality.csv",

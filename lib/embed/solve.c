@@ -51,7 +51,7 @@ void es_embed_opts_init(es_embed_opts *o)
     o->lg_rms_tol = 5e-4;
     o->lg_max_tol = 1e-2;
     o->lg_rtol = 1e-4;
-    o->lg_polish = 1;
+    o->lg_polish = 4;
     o->realize_bend = 3;
     o->realize_margin = 0.01;
 }
@@ -295,9 +295,14 @@ static es_status shape_from_start(es_embedder *emb, const es_embed_opts *o, es__
      * rows: bending 1.22 x the prior's with the last weight, 1.07 with 3 x
      * the first, length RMS 0.04 % -> 0.13 %) */
     int inconsistent = rep->n_bad_faces > 0 && o->realize_bend > 0 && bp;
-    if ((!res.met || inconsistent) && o->lg_polish && o->refine_max_iter > 0) {
+    if ((!res.met || inconsistent) && o->lg_polish > 0 && o->refine_max_iter > 0) {
         es__refine_opts ro = es__refine_opts_from(o);
         es__bend_prior hold;
+        /* a few iterations: chasing the last edges' error for longer crumpled
+         * the rest (sfm_surrey subdivided to 54K: mean + 2 sd on PC 2 went
+         * from bending 1.31 x the prior's to 1.69 in 12 iterations to move
+         * its worst edge from 7 % to 1.01 %) */
+        ro.max_iter = o->lg_polish < o->refine_max_iter ? o->lg_polish : o->refine_max_iter;
         ro.rms_tol = lo.rms_tol, ro.max_tol = lo.max_tol;
         if (bp) {
             hold = *bp;

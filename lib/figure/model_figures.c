@@ -103,7 +103,7 @@ static es_status embed_point(es_ctx *ctx, es_study_embedder *se, const es_figure
                              int64_t total)
 {
     es_study_embed_result res;
-    es_status rc = es_study_embedder_point(se, point, o->pca_name, 0, &o->embed, 1, xyz, &res);
+    es_status rc = es_study_embedder_point(ctx, se, point, o->pca_name, 0, &o->embed, 1, xyz, &res);
     if (rc != ES_OK) return es__fail(ctx, rc, "variation: %s: %s", point, es_ctx_errmsg(ctx));
     if (rep) *rep = res.report;
     es__progress(ctx, "variation: embedding", ++*done, total);

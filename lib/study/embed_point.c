@@ -114,6 +114,8 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
     es_status rc;
     memset(res, 0, sizeof *res);
     if (!o || !o->point) ES_FAIL(ctx, ES_EINVAL, "embed: no point given");
+    if (o->session && es_study_embedder_store(o->session) != s)
+        ES_FAIL(ctx, ES_EINVAL, "embed: the session given is of another store");
     if (o->name && (rc = es_store_result_check(ctx, s, "embed", o->name)) != ES_OK) return rc;
     if ((rc = es_store_mesh(ctx, s, &mesh)) != ES_OK) return rc;
     ne = es_mesh_nedges(mesh);
@@ -137,7 +139,8 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
         /* the session: the embedder and the rows for priors, from the cache
          * beside the store when it is current (a fresh process skips their
          * making) */
-        if ((rc = es_study_embedder_open(ctx, s, o->cache, &se)) != ES_OK) goto done;
+        if (o->session) se = o->session;
+        else if ((rc = es_study_embedder_open(ctx, s, o->cache, &se)) != ES_OK) goto done;
         if (o->paper) {
             /* the published pipeline from the prior's dihedrals, in its frame */
             snprintf(res->init, sizeof res->init, "prior's dihedrals and frame");
@@ -146,7 +149,8 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
                 (rc = solve_paper(ctx, es_study_embedder_embedder(se), o, target, res->scale,
                                   alpha, init_xyz, xyz, res)) != ES_OK)
                 goto done;
-        } else if ((rc = es_study_embedder_solve(se, target, res->scale, w, &o->embed, 0,
+        } else if ((rc = es_study_embedder_solve(ctx, se, target, res->scale, w, &o->embed,
+                                                 o->session && o->warm,
                                                  es__study_point_is_one_mesh(ctx, o->point),
                                                  xyz, res)) != ES_OK)
             goto done;
@@ -209,7 +213,7 @@ done:
     }
     if (se) emb = NULL;   /* the session's */
     es_embedder_free(emb);
-    es_study_embedder_free(se);
+    if (se != o->session) es_study_embedder_free(se);
     es_mesh_free(mesh);
     es__free(ctx, sel);
     es__free(ctx, target);

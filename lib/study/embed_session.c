@@ -104,20 +104,26 @@ const es_study_rows *es_study_embedder_rows(const es_study_embedder *se)
     return se ? se->rows : NULL;
 }
 
+es_store *es_study_embedder_store(const es_study_embedder *se) { return se ? se->store : NULL; }
+
 void es_study_embedder_forget(es_study_embedder *se)
 {
     if (se) se->have_last = 0;
 }
 
-es_status es_study_embedder_solve(es_study_embedder *se, const double *lengths, double scale,
-                                  const double *w, const es_embed_opts *eo, int warm, int exact,
+es_status es_study_embedder_solve(es_ctx *ctx, es_study_embedder *se, const double *lengths,
+                                  double scale, const double *w, const es_embed_opts *eo, int warm, int exact,
                                   double *xyz, es_study_embed_result *res)
 {
-    es_ctx *ctx = se->ctx;
     int64_t used = 0, top = 0;
-    double *alpha = se->prior + 3 * se->nv, *sd = alpha + se->ne;
     es_embed_opts o;
     es_status rc;
+    if (!se) ES_FAIL(ctx, ES_EINVAL, "embed: no session");
+    double *alpha = se->prior + 3 * se->nv, *sd = alpha + se->ne;
+    if (es_store_nrows(se->store) != se->n)
+        ES_FAIL(ctx, ES_EMISMATCH, "embed: the store has %lld rows, the session was made for "
+                "%lld: rows were added since; open a new session", (long long)es_store_nrows(se->store),
+                (long long)se->n);
     if (eo) o = *eo;
     else es_embed_opts_init(&o);
     o.prior_exact = exact;
@@ -163,17 +169,18 @@ int es__study_point_is_one_mesh(es_ctx *ctx, const char *spec)
     return one;
 }
 
-es_status es_study_embedder_point(es_study_embedder *se, const char *point, const char *pca_name,
+es_status es_study_embedder_point(es_ctx *ctx, es_study_embedder *se, const char *point,
+                                  const char *pca_name,
                                   double scale, const es_embed_opts *eo, int warm, double *xyz,
                                   es_study_embed_result *res)
 {
     double own;
     es_status rc;
-    if (!se) return ES_EINVAL;
-    if (!point) ES_FAIL(se->ctx, ES_EINVAL, "embed: no point given");
-    if ((rc = es_study_point_weights(se->ctx, se->store, point, pca_name, se->target, &own,
+    if (!se) ES_FAIL(ctx, ES_EINVAL, "embed: no session");
+    if (!point) ES_FAIL(ctx, ES_EINVAL, "embed: no point given");
+    if ((rc = es_study_point_weights(ctx, se->store, point, pca_name, se->target, &own,
                                      se->w)) != ES_OK)
         return rc;
-    return es_study_embedder_solve(se, se->target, scale > 0 ? scale : own, se->w, eo, warm,
-                                   es__study_point_is_one_mesh(se->ctx, point), xyz, res);
+    return es_study_embedder_solve(ctx, se, se->target, scale > 0 ? scale : own, se->w, eo, warm,
+                                   es__study_point_is_one_mesh(ctx, point), xyz, res);
 }

@@ -337,7 +337,7 @@ static es_status data_driven(mwalk *w, int lri)
                                       ve)) != ES_OK)
                 break;
         } else {   /* each frame from the last one's correction (a warm start) */
-            if ((rc = es_study_embedder_solve(se, v, scale, wi, &o->embed, i > 0 && !o->cold, 0,
+            if ((rc = es_study_embedder_solve(ctx, se, v, scale, wi, &o->embed, i > 0 && !o->cold, 0,
                                               xyz, &er)) != ES_OK)
                 break;
             rep = er.report;

@@ -179,7 +179,7 @@ static es_status embed_frame(walk *wk, int64_t i, double t, const double *v, dou
     es_study_embed_result er;
     const es_embed_report *rep = &er.report;
     es_status rc;
-    if ((rc = es_study_embedder_solve(wk->se, v, scale, w, &o->embed, i > 0 && !o->cold, 0, res,
+    if ((rc = es_study_embedder_solve(ctx, wk->se, v, scale, w, &o->embed, i > 0 && !o->cold, 0, res,
                                       &er)) != ES_OK ||
         (rc = used_rows(ctx, n, w, &rows, &nrows)) != ES_OK) {
         es__free(ctx, rows);

@@ -117,7 +117,7 @@ static es_status edge_length_model(es_ctx *ctx, es_store *s, const es_study_stat
         /* each point from its own prior, as es_study_embed starts it: a model
          * file is a function of the store, not of the order its points were
          * embedded in (warm starts left mean -/+ c sd 1e-4 asymmetric) */
-        if ((rc = es_study_embedder_point(se, spec, name, 0, &o->embed, 0, out, &er)) != ES_OK)
+        if ((rc = es_study_embedder_point(ctx, se, spec, name, 0, &o->embed, 0, out, &er)) != ES_OK)
             break;
         r->worst_rms_ratio = fmax(r->worst_rms_ratio, er.report.rms_ratio);
         r->worst_bend_ratio = fmax(r->worst_bend_ratio, er.report.bend_ratio);

@@ -26,6 +26,7 @@ class StudyEmbedder:
         self.ctx.call(lib.es_study_embedder_open, store.ptr, 1 if cache else 0, p)
         self._ptr = A.owned(self.ctx, p[0], lib.es_study_embedder_free)
         self.faces = store.mesh.faces
+        self.nrows = store.nrows   # the rows it was made for
 
     @property
     def ptr(self):

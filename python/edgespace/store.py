@@ -606,12 +606,17 @@ class Store:
         return s
 
     def embed(self, point, pca=None, init=None, scale=0.0, name=None, output=None,
-              residuals=None, **opts):
+              residuals=None, warm=False, **opts):
         """Embed a point of the store's space (es_study_embed: near the prior
         of its row weights, in the store's frame, unless init names an explicit
         start). Returns Embedding(V, F, report) with report["scale"] and
         report["init"]. name stores /analysis/embed/<name> (write handle);
-        output/residuals write the mesh and per-vertex CSV. opts: es_embed_opts."""
+        output/residuals write the mesh and per-vertex CSV. opts: es_embed_opts.
+        The store keeps one embedding session for these calls (made on the
+        first, from STORE.es-cache when current), so the next one costs only
+        its solve; warm=True starts from the last call's correction of its
+        prior (default: from the point's own prior, the same mesh whatever
+        came before)."""
         o = ffi.new("es_study_embed_opts *")
         lib.es_study_embed_opts_init(o)
         keep = [_c(point), _c(pca), _c(init), _c(name), _c(output), _c(residuals),
@@ -621,6 +626,14 @@ class Store:
             o.init = keep[2]
         o.name, o.output, o.residuals, o.command = keep[3], keep[4], keep[5], keep[6]
         o.scale = float(scale)
+        if init is None or init == "prior":
+            s = getattr(self, "_embed_session", None)
+            if s is None or s._ptr is None or s.nrows != self.nrows:   # rows added since
+                if s is not None:
+                    s.close()
+                self._embed_session = self.embedder()
+            o.session = self._embed_session.ptr
+            o.warm = 1 if warm else 0
         set_embed_opts(o.embed, opts)
         xyz = np.empty((self.nverts, 3))
         res = ffi.new("es_study_embed_result *")

@@ -5,6 +5,7 @@ Oracles: the command's output meshes (binary PLY: doubles, bit for bit) and
 stored reports; numpy edge lengths of the output against the target; the
 array route with the store's prior against the store route (the same
 library calls, so the same bits); RSS over 1,000 embeddings for leaks."""
+import os
 import shutil
 
 import h5py
@@ -140,3 +141,35 @@ def test_no_leaks_over_1000_embeddings(ctx):
     grown = _rss_kib() - before
     assert mesh.nverts * 3 * 8 * 1000 > 2 * 1024 * 1024 * 0.9   # the bound would see one
     assert grown < 1024, f"RSS grew by {grown} KiB over 1,000 embeddings"
+
+
+def test_sessions_embed_as_the_command_and_keep_their_work(store_path, faces_dir, ctx):
+    """Store.embedder() and Store.embed's own session (es_study_embedder):
+    cold embeddings equal es_study_embed's whatever came before, warm ones
+    stay within the solver's tolerance, the cache file appears beside the
+    store, a session made before rows were added refuses, and closing the
+    store closes its sessions."""
+    pts = ["mean", "mean[expression=happy]", "lerp(row:face_s01_neutral, row:face_s02_angry, 0.4)"]
+    with es.Store(store_path, write=True, ctx=ctx) as s:
+        cold = [s.embed(p).V for p in pts]
+        assert os.path.exists(str(store_path) + ".es-cache")
+        again = [s.embed(p).V for p in reversed(pts)][::-1]     # the order does not matter
+        for a, b in zip(cold, again):
+            assert np.array_equal(a, b)
+        se = s.embedder()
+        for p, c in zip(pts, cold):
+            assert np.array_equal(se.embed(p, warm=False, fast=False).V, c)
+        w = s.embed(pts[1], warm=True)        # from the last call's correction
+        diag = np.linalg.norm(cold[1].max(0) - cold[1].min(0))
+        assert np.sqrt(((w.V - cold[1]) ** 2).sum(1).mean()) <= 1e-3 * diag
+        assert "correction" in w.report["init"] or "prior of" in w.report["init"]
+        f = se.embed(pts[0], fast=True)
+        assert f.report["refine_iters"] == 0 and f.report["lg_iters"] <= 30
+        # rows added: the old session refuses, Store.embed makes a new one
+        X = s.mesh.read_positions(faces_dir / "face_s01_neutral.obj")[None]
+        s.append(["again"], X, labels={"subject": ["s01"], "expression": ["neutral"]})
+        with pytest.raises(es.MismatchError, match="rows were added"):
+            se.embed("mean")
+        assert s.embed("mean").V.shape == cold[0].shape
+    with pytest.raises(ValueError, match="closed"):
+        se.embed("mean")

@@ -60,7 +60,7 @@ static void embed_all(es_ctx *ctx, es_store *s, int cache, double *out, int64_t 
     es_study_embed_result r;
     ES_CHECK_OK(ctx, es_study_embedder_open(ctx, s, cache, &se));
     for (int k = 0; se && k < 3; k++)
-        ES_CHECK_OK(ctx, es_study_embedder_point(se, points[k], NULL, 0, NULL, 0,
+        ES_CHECK_OK(ctx, es_study_embedder_point(ctx, se, points[k], NULL, 0, NULL, 0,
                                                  out + 3 * nv * k, &r));
     es_study_embedder_free(se);
 }
@@ -179,7 +179,7 @@ int main(void)
         for (int i = 0; se && i < 9; i++) {
             char pt[64];
             snprintf(pt, sizeof pt, "mean + %g*pc:1", -2.0 + 0.5 * i);
-            ES_CHECK_OK(ctx, es_study_embedder_point(se, pt, "p", 0, NULL, 1, walk + n3 * i, &r));
+            ES_CHECK_OK(ctx, es_study_embedder_point(ctx, se, pt, "p", 0, NULL, 1, walk + n3 * i, &r));
             warm_it += r.report.lg_iters;
             wbend[i] = r.report.bend_ratio;
             /* a frame after one that folded (bending > 1.1) starts from its prior */
@@ -188,7 +188,7 @@ int main(void)
         for (int i = 0; se && i < 9; i++) {
             char pt[64];
             snprintf(pt, sizeof pt, "mean + %g*pc:1", -2.0 + 0.5 * i);
-            ES_CHECK_OK(ctx, es_study_embedder_point(se, pt, "p", 0, NULL, 0, ref, &r));
+            ES_CHECK_OK(ctx, es_study_embedder_point(ctx, se, pt, "p", 0, NULL, 0, ref, &r));
             cold_it += r.report.lg_iters;
             double ss = 0;
             for (int64_t j = 0; j < n3; j++) ss += pow(walk[n3 * i + j] - ref[j], 2);

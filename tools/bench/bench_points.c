@@ -104,7 +104,7 @@ static result embed(es_ctx *ctx, es_study_embedder *se, const char *pt, const es
 {
     result x;
     double w0 = bench_wall_s(), c0 = bench_process_cpu_s();
-    if (es_study_embedder_point(se, pt, "bench", 0, o, warm, out, &x.r) != ES_OK) fail(ctx, pt);
+    if (es_study_embedder_point(ctx, se, pt, "bench", 0, o, warm, out, &x.r) != ES_OK) fail(ctx, pt);
     x.cpu = bench_process_cpu_s() - c0;
     x.wall = bench_wall_s() - w0;
     return x;

@@ -157,9 +157,10 @@ typedef struct es_embed_opts {
     double lg_rtol;           /* local-global also stops when its energy falls by less
                                  than this fraction per iteration over five (1e-4) */
     int lg_history;           /* L-BFGS pairs kept (default 6) */
-    int lg_polish;            /* 1: the Levenberg-Marquardt finish where the local-global
-                                 iterations did not meet the tolerances (default); 0:
-                                 local-global alone (interactive use: es_embed_opts_fast) */
+    int lg_polish;            /* where the local-global iterations did not meet the
+                                 tolerances: Levenberg-Marquardt iterations at most
+                                 (and at most refine_max_iter) toward them (default 4;
+                                 0: local-global alone, es_embed_opts_fast) */
     double realize_bend;      /* for such a target (no mesh has its lengths) the
                                  Levenberg-Marquardt finish always runs, with the prior's
                                  bending term held at realize_bend x prior_mu, so that the

@@ -421,6 +421,7 @@ ES_API void es_study_embedder_free(es_study_embedder *se);
 ES_API const es_mesh *es_study_embedder_mesh(const es_study_embedder *se);
 ES_API es_embedder *es_study_embedder_embedder(es_study_embedder *se);
 ES_API const es_study_rows *es_study_embedder_rows(const es_study_embedder *se);
+ES_API es_store *es_study_embedder_store(const es_study_embedder *se);
 /* Forget the last output: the next warm embedding starts from its prior. */
 ES_API void es_study_embedder_forget(es_study_embedder *se);
 /* Embed lengths (E, any scale; embedded at `scale`, > 0) with row weights w
@@ -428,14 +429,14 @@ ES_API void es_study_embedder_forget(es_study_embedder *se);
  * last output when there is one; exact: the lengths are one real mesh's
  * (es_embed_opts.prior_exact). xyz: 3 x V, in the store's frame. res->init
  * says what the solve started from. */
-ES_API es_status es_study_embedder_solve(es_study_embedder *se, const double *lengths,
-                                         double scale, const double *w, const es_embed_opts *eo,
+ES_API es_status es_study_embedder_solve(es_ctx *ctx, es_study_embedder *se,
+                                         const double *lengths, double scale, const double *w, const es_embed_opts *eo,
                                          int warm, int exact, double *xyz,
                                          es_study_embed_result *res);
 /* The same for a point expression (datasets-spec/point-syntax.md) at its own
  * scale (scale 0) or the one given; a point that is one row or one mesh file
  * is solved as exact. */
-ES_API es_status es_study_embedder_point(es_study_embedder *se, const char *point,
+ES_API es_status es_study_embedder_point(es_ctx *ctx, es_study_embedder *se, const char *point,
                                          const char *pca_name, double scale,
                                          const es_embed_opts *eo, int warm, double *xyz,
                                          es_study_embed_result *res);
@@ -459,6 +460,11 @@ typedef struct es_study_embed_opts {
     const char *command;    /* provenance of the stored result */
     int cache;              /* 1 (the default): the session's cache beside the store
                                (es_study_embedder_open) */
+    es_study_embedder *session;   /* an open session of this store to use (and leave
+                               open) instead of making one: repeated calls then cost
+                               only their solves (NULL: one for this call) */
+    int warm;               /* with a session: start from its last output's correction
+                               (es_study_embedder_solve; default 0: from the prior) */
     es_embed_opts embed;    /* solver options (es_embed_opts_init) */
     int paper;              /* 1: the published pipeline (es_embed_paper_solve, default
                                L-BFGS settings; embed's alignment and report settings)
