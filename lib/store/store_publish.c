@@ -17,7 +17,9 @@
  * and the rename hold an advisory lock on the folder. This is the "write a
  * new file, then rename" scheme of editors and package managers (SQLite
  * keeps every fsync and rename in os_unix.c for the same reason); HDF5 1.10
- * has no transactional writes of its own.
+ * has no transactional writes of its own. Results of a format-3 store are
+ * not written here at all but beside it, a file each (store_beside.c):
+ * storing one never copies the store.
  */
 #include "store/store_pkg.h"
 #include "core/files.h"
@@ -66,19 +68,21 @@ void es__store_clean_stale(const char *path)
     closedir(d);
 }
 
-char *es__store_temp_name(es_store *s)
+char *es__store_temp_for(es_store *s, const char *path)
 {
-    const char *base = es__path_base(s->path);
-    size_t dn = (size_t)(base - s->path), n = strlen(s->path) + 64;
+    const char *base = es__path_base(path);
+    size_t dn = (size_t)(base - path), n = strlen(path) + 64;
     char *t = es__malloc(s->ctx, n);
     struct timespec ts;
     clock_gettime(CLOCK_REALTIME, &ts);
     /* pid first (stale copies are recognized by it), then enough to keep
      * two handles of one process apart. */
-    if (t) snprintf(t, n, "%.*s.%s.tmp-%ld-%lx%lx%u", (int)dn, s->path, base, (long)getpid(),
+    if (t) snprintf(t, n, "%.*s.%s.tmp-%ld-%lx%lx%u", (int)dn, path, base, (long)getpid(),
                     (unsigned long)(uintptr_t)s, (unsigned long)ts.tv_nsec, s->tmp_counter++);
     return t;
 }
+
+char *es__store_temp_name(es_store *s) { return es__store_temp_for(s, s->path); }
 
 static es_status copy_file(es_ctx *ctx, const char *src, const char *dst, struct stat *st)
 {
@@ -133,6 +137,11 @@ static es_status fsync_path(es_ctx *ctx, const char *path, bool dir)
     }
     close(fd);
     return ES_OK;
+}
+
+es_status es__store_fsync(es_ctx *ctx, const char *path, bool dir)
+{
+    return fsync_path(ctx, path, dir);
 }
 
 /* Another writer's commit replaces the file (a new inode) and an in-place
@@ -191,7 +200,7 @@ es_status es__store_publish(es_ctx *ctx, es_store *s)
     struct stat now, done;
     char *dir = NULL;
     hid_t fapl;
-    if (!s->work) return ES_OK; /* nothing written */
+    if (!s->work) return es__beside_publish(ctx, s); /* the store itself unchanged */
     if (s->broken)
         ES_FAIL(ctx, ES_EIO, "store: an earlier write to '%s' failed; nothing committed",
                 s->path);
@@ -262,7 +271,8 @@ es_status es__store_publish(es_ctx *ctx, es_store *s)
     es__h5_close(fapl);
     if (s->file < 0)
         return es__h5_fail(ctx, ES_EIO, "store: committed '%s' but cannot reopen it", s->path);
-    return ES_OK;
+    /* results beside it after the store: one of them may name its new rows */
+    return es__beside_publish(ctx, s);
 fail:
     s->broken = true;
     return rc;
