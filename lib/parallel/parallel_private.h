@@ -1,8 +1,8 @@
 /* lib/parallel/parallel_private.h — the collectives the other modules use
  * (library-private; es_parallel.h is the public side). Only lib/parallel
- * includes mpi.h: the store gets the communicator as an opaque pointer for
- * HDF5's MPI-IO driver, the numerical modules only sums, broadcasts and
- * exchanges of doubles.
+ * includes mpi.h: the numerical modules get sums, broadcasts and exchanges
+ * of doubles; the communicator is offered as an opaque pointer for HDF5's
+ * MPI-IO driver (es__par_comm; no caller yet: collective ingest is to come).
  *
  * Every function here is collective over ctx's job (all ranks call it, in
  * the same order) and a no-op, or a plain copy, on a context that is alone;

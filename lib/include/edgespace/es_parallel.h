@@ -2,17 +2,17 @@
  * an MPI job (mpirun -n P), with parallel HDF5.
  *
  * A library built with -Dmpi=enabled (Open MPI and Debian's openmpi build of
- * HDF5) runs the heavy steps of a study on P processes ("ranks"): ingest
- * (inputs spread over the ranks, rows written by collective parallel-HDF5
- * I/O), PCA (Gram, covariance and randomized routes), GPA and the
- * permutations of a linear model. Every rank runs the same program: a
+ * HDF5) runs PCA (Gram, covariance and randomized routes: es_pca_fit, and
+ * `mpirun -n P edgespace pca`) on P processes ("ranks"); ingest, GPA and the
+ * permutations of a linear model are still one process (datasets-spec/
+ * parallel.md says what runs where). Every rank runs the same program: a
  * context joined to the job (es_ctx_join_parallel) makes those calls
  * collective, so every rank must make them, in the same order and with the
  * same arguments; each returns the same status on every rank, with the
  * message of the lowest rank that failed. Results are the same as on one
  * process (to rounding: sums are added in another order; permutation
  * p-values are identical for the same seed), and stores and results are
- * written by rank 0 alone or collectively, never twice.
+ * written by rank 0 alone, never twice.
  * datasets-spec/parallel.md states how the work and the data are divided and
  * what each rank reads, computes and sends.
  *
