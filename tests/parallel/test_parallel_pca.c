@@ -11,7 +11,8 @@
  * rows read in shares and exchanged all-to-all), the covariance route and
  * the randomized route (rows shared, partial products summed): eigenvalues,
  * mean, components and scores agree to 1e-12 of their scale (sums are added
- * in another order). A reader that fails on one rank fails the fit on every
+ * in another order); a linear model's permutations, shared over the ranks,
+ * give the same p-values. A reader that fails on one rank fails the fit on every
  * rank with that rank's message. */
 #include "core/core_private.h"   /* ES_FAIL: a reader sets its message */
 #include "edgespace/edgespace.h"
@@ -141,6 +142,43 @@ int main(int argc, char **argv)
     make(&d, 23, 61);    /* E < N: the covariance route */
     d.rank = me;
     check_route(job, alone, &d, ES_PCA_COVARIANCE, 0, 0, "covariance, all components");
+
+    /* a linear model's permutations, shared over the ranks: F, SS of every
+     * permutation and the p-values bit for bit those of one process */
+    {
+        const char *g[61];
+        double x[61];
+        for (int i = 0; i < 61; i++) {
+            g[i] = i % 3 == 0 ? "a" : i % 3 == 1 ? "b" : "c";
+            x[i] = sin(0.3 * i);
+        }
+        es_model_column cols[2] = {{"g", g, NULL, NULL}, {"x", NULL, x, NULL}};
+        es_formula *fm = NULL;
+        es_design *dsg = NULL;
+        es_model *mj = NULL, *ma = NULL;
+        es_model_opts mo;
+        es_model_opts_init(&mo);
+        mo.permutations = 199;
+        mo.seed = 11;
+        es_source src = {d.E, d.N, read_rows, &d, 7, {0}, NULL};
+        ES_CHECK_OK(alone, es_formula_parse(alone, "~ g + x", &fm));
+        ES_CHECK_OK(alone, es_design_build(alone, fm, 61, cols, 2, ES_CONTRASTS_TREATMENT, &dsg));
+        ES_CHECK_OK(alone, es_model_fit(alone, dsg, &src, &mo, &ma));
+        ES_CHECK_OK(job, es_model_fit(job, dsg, &src, &mo, &mj));
+        if (ma && mj) {
+            const int64_t n = ma->permutations * ma->nterms;
+            ES_CHECK(mj->nterms == ma->nterms && mj->permutations == ma->permutations);
+            for (int64_t t = 0; t < ma->nterms; t++)
+                ES_CHECK_MSG(mj->pval[t] == ma->pval[t], "model term %lld: p %.17g vs %.17g",
+                             (long long)t, mj->pval[t], ma->pval[t]);
+            ES_CHECK_MSG(maxdiff(mj->ssperm, ma->ssperm, n) <= 1e-12 * maxabs(ma->ssperm, n),
+                         "model: permutation SS differ by %g", maxdiff(mj->ssperm, ma->ssperm, n));
+        }
+        es_model_free(mj);
+        es_model_free(ma);
+        es_design_free(dsg);
+        es_formula_free(fm);
+    }
 
     /* a reader that fails on the last rank fails the fit everywhere, with its message */
     d.fail_rank = P - 1;
