@@ -476,8 +476,12 @@ static es_status upgrade_impl(es_ctx *ctx, es_store *s)
     }
     for (int64_t k = 0; k < nk; k++) es__free(ctx, kinds[k]);
     es__free(ctx, kinds);
-    if (rc == ES_OK) s->beside = true;
-    else s->broken = true;
+    if (rc == ES_OK) {
+        s->beside = true;
+        s->version = ES__FORMAT_VERSION_BESIDE;
+    } else {
+        s->broken = true;
+    }
     return rc;
 }
 
@@ -494,6 +498,5 @@ es_status es_store_upgrade(es_ctx *ctx, es_store *s)
 
 int es_store_format_version(const es_store *s)
 {
-    return !s ? 0 : s->beside ? ES__FORMAT_VERSION_BESIDE
-                  : s->kind == ES_TOPOLOGY_MESH ? ES__FORMAT_VERSION : ES__FORMAT_VERSION_KIND;
+    return s ? s->version : 0;
 }

@@ -262,6 +262,7 @@ static es_status load_kind(es_store *s, es__h5_raw *raw)
                 "versions %d to %d", s->path, (long long)version, ES__FORMAT_VERSION,
                 ES__FORMAT_VERSION_BESIDE);
     s->kind = ES_TOPOLOGY_MESH;
+    s->version = (int)version;
     if (version == ES__FORMAT_VERSION) return ES_OK;
     if (version == ES__FORMAT_VERSION_BESIDE) {
         size_t n;

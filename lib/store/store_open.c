@@ -179,6 +179,7 @@ static es_status create_impl(es_ctx *ctx, const char *path, int64_t nverts, int6
     strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", &tmv);
     /* format 3: results beside the store (store_beside.c), tied to it by its id */
     s->beside = true;
+    s->version = ES__FORMAT_VERSION_BESIDE;
     es__beside_new_id(s->store_id);
     if ((rc = es__h5_write_attr_i64(ctx, s->file, "format_version", ES__FORMAT_VERSION_BESIDE)) ||
         (rc = es__h5_write_attr_str(ctx, s->file, "creator", "edgespace " ES_VERSION_STRING)) ||

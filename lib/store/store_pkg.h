@@ -70,6 +70,7 @@ struct es_store {
     int64_t ncols;
     char **colnames;
     char ***labels;        /* labels[col][row] */
+    int version;           /* format_version: 1, 2 or 3 */
     bool beside;           /* format 3: results live beside the store */
     char store_id[33];     /* format 3: the id its results carry */
     es__beside *side;      /* results beside the store this handle opened or wrote */

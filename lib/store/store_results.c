@@ -172,7 +172,10 @@ static es_status result_begin_impl(es_ctx *ctx, es_store *s, const char *kind, c
     hid_t f;
     const char *fp;
     if ((rc = es__result_locate(ctx, s, full + 10, ES__RESULT_CREATE, &f, &fp))) return rc;
-    if ((rc = es__result_find_link(ctx, f, fp, full, &exists))) return rc;
+    /* beside the store: whether this handle's working file has it already
+     * (begun twice); inside it, check_free looked in the very same bytes
+     * (and a working copy is not searched raw: that flushes it) */
+    if (s->beside && (rc = es__result_find_link(ctx, f, fp, full, &exists))) return rc;
     if (exists && H5Ldelete(f, full, H5P_DEFAULT) < 0) {
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot replace %s", full);
         goto fail;

@@ -6,7 +6,7 @@
  * unchanged and every visible result whole, and its stale working file is
  * removed by the next writer; a results folder left by a deleted store of
  * the same name is not taken for the new store's; a damaged result file is
- * refused with a message; and a store of format 1 (earlier releases) is
+ * refused with a message; and a store of format 2 (earlier releases) is
  * still read and written, its results inside it as before, until it is
  * upgraded when asked (es_store_upgrade), after which its results are
  * beside it and storing one copies nothing. */
@@ -332,7 +332,7 @@ static void test_damaged(es_ctx *ctx, const char *path)
     free(orig);
 }
 
-/* A store as earlier releases wrote it (format 1): read, and its results
+/* A store as earlier releases wrote it (format 2): read, and its results
  * still go inside it (published by the working copy, as before). */
 static void test_format1(es_ctx *ctx, const char *dir)
 {
@@ -340,7 +340,7 @@ static void test_format1(es_ctx *ctx, const char *dir)
     es_store *s = NULL;
     struct stat before, after;
     snprintf(path, sizeof path, "%s/old.h5", dir);
-    ES_CHECK(crafted_base(path) == 0);   /* format 1, a result mean/m inside */
+    ES_CHECK(crafted_base(path) == 0);   /* format 2, a result mean/m inside */
     ES_CHECK(stat(path, &before) == 0);
     ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_WRITE, &s));
     if (!s) return;
@@ -354,7 +354,7 @@ static void test_format1(es_ctx *ctx, const char *dir)
     ES_CHECK(stat(path, &after) == 0 && after.st_ino != before.st_ino);   /* copied, renamed */
     ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_READ, &s));
     ES_CHECK(s && result_whole(ctx, s, "point", "q", 6) && es_store_has(s, "mean/m"));
-    ES_CHECK(es_store_format_version(s) == 1);
+    ES_CHECK(es_store_format_version(s) == 2);
     ES_CHECK_FAILS(ctx, es_store_upgrade(ctx, s), ES_EINVAL, "read-only");
     es_store_close(s);
     s = NULL;
