@@ -99,6 +99,35 @@ static void on_progress(void *ud, const char *what, int64_t done, int64_t total)
     fflush(stderr);
 }
 
+static void finalize_mpi(void) { es_parallel_finalize(); }
+
+/* The commands that run on the ranks of an MPI job (datasets-spec/parallel.md). */
+static int runs_parallel(const char *verb) { return !strcmp(verb, "pca"); }
+
+/* Started by mpirun (a library built with -Dmpi=enabled): the context joins
+ * the job, and only rank 0 speaks (the others' stdout and stderr go to
+ * /dev/null: their messages are rank 0's, agreed on). A command that does
+ * not run on ranks yet is refused rather than run P times over one store. */
+static int join_job(es_ctx *ctx, const char *verb)
+{
+    static int registered;
+    if (!es_parallel_available() || !es_parallel_launched()) return 0;
+    if (es_parallel_init(ctx, NULL, NULL) != ES_OK || es_ctx_join_parallel(ctx) != ES_OK) {
+        fprintf(stderr, "edgespace %s: cannot join the MPI job: %s\n", verb, es_ctx_errmsg(ctx));
+        return -1;
+    }
+    if (!registered++) atexit(finalize_mpi);
+    if (es_ctx_rank(ctx) != 0 &&
+        (!freopen("/dev/null", "w", stdout) || !freopen("/dev/null", "w", stderr)))
+        return -1;
+    if (es_ctx_nranks(ctx) > 1 && !runs_parallel(verb)) {
+        fprintf(stderr, "edgespace %s: does not run on the ranks of an MPI job yet (pca does); "
+                "run it as one process\n", verb);
+        return -1;
+    }
+    return 0;
+}
+
 es_ctx *cli_ctx_new(const char *verb)
 {
     es_ctx *ctx = NULL;
@@ -106,8 +135,12 @@ es_ctx *cli_ctx_new(const char *verb)
         fprintf(stderr, "edgespace %s: out of memory\n", verb);
         return NULL;
     }
+    if (join_job(ctx, verb) != 0) {
+        es_ctx_free(ctx);
+        return NULL;
+    }
     state.verb = verb;
-    state.tty = isatty(STDERR_FILENO);
+    state.tty = isatty(STDERR_FILENO) && es_ctx_rank(ctx) == 0;
     es_ctx_set_log(ctx, on_log, &state);
     es_ctx_set_progress(ctx, on_progress, &state);
     /* the memory a command may plan to use (embeddings refuse above it) */

@@ -14,7 +14,8 @@
 # Installs exactly the missing Debian packages (apt-get, non-interactive,
 # idempotent: a second run installs nothing). Environment:
 #   BUILD_DIR   build directory (default: build)
-#   MESON_ARGS  extra arguments for 'meson setup' (e.g. -Dwerror=true)
+#   MESON_ARGS  extra arguments for 'meson setup' (e.g. -Dwerror=true; -Dmpi=enabled
+#               also installs Open MPI and parallel HDF5 and builds for mpirun)
 #   TEST_ARGS   extra arguments for 'meson test' (e.g. --no-suite slow)
 set -euo pipefail
 
@@ -49,6 +50,13 @@ packages=(
 # three.js for the explorer's page (an npm from another source, such as the
 # one bundled with NodeSource's nodejs, does as well and is left alone)
 commands=(npm:npm)
+
+# The MPI build (MESON_ARGS with -Dmpi=enabled): Open MPI and Debian's
+# openmpi build of HDF5 (parallel I/O), beside the serial one, which the
+# default build keeps using (meson.build asks for hdf5-serial by name).
+case " ${MESON_ARGS:-} " in
+  *" -Dmpi=enabled "*) packages+=(libopenmpi-dev openmpi-bin libhdf5-openmpi-dev) ;;
+esac
 
 install_missing() {
   local missing=()

@@ -41,6 +41,11 @@ void es__info(es_ctx *ctx, const char *fmt, ...) ES__PRINTF(2, 3);
  * input order) and restore it. */
 void es__ctx_get_log(const es_ctx *ctx, es_log_fn *fn, void **userdata);
 
+/* The state lib/parallel keeps for a context joined to an MPI job (NULL
+ * when it is alone); release frees it with the context. */
+void *es__ctx_parallel(const es_ctx *ctx);
+void es__ctx_set_parallel(es_ctx *ctx, void *state, void (*release)(void *));
+
 /* Progress callback (no-op without one), then the cancel check: ES_ECANCELED
  * (recorded, naming `what`) once es_ctx_cancel was called, else ES_OK. A
  * loop stops on it and returns it; loops of no work worth stopping may

@@ -35,6 +35,8 @@ struct es_ctx {
     bool has_alloc;
     atomic_int cancel;     /* es_ctx_cancel: set from anywhere, read at progress reports */
     uint64_t memory_limit; /* bytes, 0: the machine's */
+    void *parallel;              /* lib/parallel's state: the job this context joined */
+    void (*parallel_free)(void *);
 };
 
 const char *es_version(void) { return ES_VERSION_STRING; }
@@ -69,7 +71,20 @@ es_status es_ctx_new(es_ctx **out)
     return ES_OK;
 }
 
-void es_ctx_free(es_ctx *ctx) { free(ctx); }
+void es_ctx_free(es_ctx *ctx)
+{
+    if (ctx && ctx->parallel_free) ctx->parallel_free(ctx->parallel);
+    free(ctx);
+}
+
+void *es__ctx_parallel(const es_ctx *ctx) { return ctx ? ctx->parallel : NULL; }
+
+void es__ctx_set_parallel(es_ctx *ctx, void *state, void (*release)(void *))
+{
+    if (ctx->parallel_free) ctx->parallel_free(ctx->parallel);
+    ctx->parallel = state;
+    ctx->parallel_free = release;
+}
 
 const char *es_ctx_errmsg(const es_ctx *ctx) { return ctx ? ctx->errmsg : ""; }
 void es_ctx_clear_error(es_ctx *ctx) { ctx->errmsg[0] = '\0'; }

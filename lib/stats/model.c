@@ -19,6 +19,7 @@
  * that of the full model fitted to the permuted data (RRPP's SS.iter).
  */
 #include "stats/stats_pkg.h"
+#include "parallel/parallel_private.h"
 
 #include <cblas.h>
 #include <float.h>
@@ -248,7 +249,12 @@ static es_status constant_in_blocks(es_ctx *ctx, const es_model *m, const double
     return ES_OK;
 }
 
-/* Permutations for term j: F of each into m->fperm, the count into pval. */
+/* Permutations for term j: F of each into m->fperm, the count into pval.
+ * On the ranks of an MPI job each rank evaluates a contiguous share of the
+ * B permutations; every rank draws all of them from the one seeded stream
+ * (drawing is O(n), evaluating O(n r df)), so permutation b is the same
+ * whatever P, and the shares, zero elsewhere, are summed: the same bits as
+ * one process, p-values identical. */
 static es_status permute_term(es_ctx *ctx, es_model *m, int64_t j, const double *dd, int64_t df,
                               const double *e)
 {
@@ -264,14 +270,16 @@ static es_status permute_term(es_ctx *ctx, es_model *m, int64_t j, const double 
     int64_t *perm = es__alloc_array(ctx, n, sizeof *perm);
     es__perm g;
     es_status rc = es__perm_init(ctx, &g, n, pv->blocks, m->seed);
-    if (rc != ES_OK || !w || !a || !perm) {
-        if (rc == ES_OK) rc = ES_ENOMEM;
-        goto done;
-    }
-    int64_t count = 0;
+    if (rc == ES_OK && (!w || !a || !perm)) rc = ES_ENOMEM;
+    if ((rc = es__par_agree(ctx, rc)) != ES_OK) goto done;   /* no rank left in a sum */
+    int64_t count = 0, lo, hi;
     const double fobs = m->f[j];
-    for (int64_t b0 = 0; b0 < B; b0 += batch) {
-        int64_t nb = B - b0 < batch ? B - b0 : batch;
+    es__par_split(B, es__par_size(ctx), es__par_rank(ctx), &lo, &hi);
+    if (!es__par_alone(ctx))
+        for (int64_t b = 0; b < B; b++) m->fperm[b + j * B] = m->ssperm[b + j * B] = 0.0;
+    for (int64_t b = 0; b < lo; b++) es__perm_next(&g, perm);   /* the other ranks' */
+    for (int64_t b0 = lo; b0 < hi; b0 += batch) {
+        int64_t nb = hi - b0 < batch ? hi - b0 : batch;
         /* W[perm[i], :] = [D Qf][i, :] for each permutation of the batch */
         for (int64_t k = 0; k < nb; k++) {
             es__perm_next(&g, perm);
@@ -300,6 +308,11 @@ static es_status permute_term(es_ctx *ctx, es_model *m, int64_t j, const double 
         if ((rc = es__progress(ctx, "model: permutations", j * B + b0 + nb, m->nterms * B)))
             goto done;
     }
+    if (!es__par_alone(ctx) &&
+        ((rc = es__par_sum(ctx, m->fperm + j * B, B)) != ES_OK ||
+         (rc = es__par_sum(ctx, m->ssperm + j * B, B)) != ES_OK ||
+         (rc = es__par_sum_i64(ctx, &count, 1)) != ES_OK))
+        goto done;
     m->pval[j] = (double)(count + 1) / (double)(B + 1);
 done:
     es__perm_clear(ctx, &g);

@@ -20,6 +20,7 @@
  * or "dual" route); LAPACK dsyevr (Dhillon & Parlett's MRRR).
  */
 #include "stats/stats_pkg.h"
+#include "parallel/parallel_private.h"
 
 #include <cblas.h>
 #include <lapacke.h>
@@ -141,6 +142,110 @@ static int64_t rank_of(const double *w, int64_t m, int64_t dim, int64_t N, int64
     return r;
 }
 
+es_status es__gram_decompose(es_ctx *ctx, double *G, int64_t N, int64_t E, int64_t K,
+                             es__gram_fit *g)
+{
+    es_status rc;
+    int64_t m;
+    memset(g, 0, sizeof *g);
+    g->N = N;
+    double *rmean = es__alloc_array(ctx, N, sizeof *rmean);
+    g->w = es__alloc_array(ctx, N, sizeof *g->w);
+    /* eigenvectors take only K columns when K is given */
+    g->V = es__alloc_array(ctx, N * (K > 0 ? K : N), sizeof *g->V);
+    if (!rmean || !g->w || !g->V) {
+        es__free(ctx, rmean);
+        return ES_ENOMEM;
+    }
+    /* symmetrize, then double-centre: Gc = J G J with J = I - 11^T/N */
+    for (int64_t j = 0; j < N; j++)
+        for (int64_t i = j + 1; i < N; i++) G[i + j * N] = G[j + i * N];
+    double s = 0;
+    for (int64_t i = 0; i < N; i++) {
+        double r = 0;
+        for (int64_t j = 0; j < N; j++) r += G[i + j * N];
+        rmean[i] = r / (double)N;
+        s += rmean[i];
+    }
+    s /= (double)N;
+    for (int64_t j = 0; j < N; j++)
+        for (int64_t i = 0; i < N; i++) G[i + j * N] += s - rmean[i] - rmean[j];
+    for (int64_t i = 0; i < N; i++) g->trace += G[i + i * N];
+    es__free(ctx, rmean);
+    if ((rc = sym_eigen(ctx, N, G, K, g->w, g->V, &m)) != ES_OK) return rc;
+    g->r = m > 0 ? rank_of(g->w, m, N > E ? N : E, N, K) : 0;
+    return ES_OK;
+}
+
+es_status es__gram_share(es_ctx *ctx, es__gram_fit *g)
+{
+    es_status rc;
+    int64_t hdr[2] = {g->r, 0};
+    double tr = g->trace;
+    if (es__par_alone(ctx)) return ES_OK;
+    if ((rc = es__par_bcast(ctx, hdr, sizeof hdr, 0)) != ES_OK ||
+        (rc = es__par_bcast(ctx, &tr, sizeof tr, 0)) != ES_OK)
+        return rc;
+    g->r = hdr[0];
+    g->trace = tr;
+    if (es__par_rank(ctx) != 0) {
+        es__free(ctx, g->w);
+        es__free(ctx, g->V);
+        g->w = es__alloc_array(ctx, g->r > 0 ? g->r : 1, sizeof *g->w);
+        g->V = es__alloc_array(ctx, g->N * (g->r > 0 ? g->r : 1), sizeof *g->V);
+    }
+    if ((rc = es__par_agree(ctx, g->w && g->V ? ES_OK : ES_ENOMEM)) != ES_OK ||
+        (rc = es__par_bcast(ctx, g->w, (size_t)g->r * sizeof *g->w, 0)) != ES_OK)
+        return rc;
+    return es__par_bcast(ctx, g->V, (size_t)(g->N * g->r) * sizeof *g->V, 0);
+}
+
+void es__gram_fill(const es__gram_fit *g, es_pca *p)
+{
+    const int64_t N = g->N;
+    p->method = ES_PCA_GRAM;
+    p->total_variance = g->trace / (double)(N - 1);
+    for (int64_t k = 0; k < g->r; k++) {
+        p->eigenvalues[k] = g->w[k] / (double)(N - 1);
+        double sq = sqrt(g->w[k]);
+        for (int64_t i = 0; i < N; i++) p->scores[i + k * N] = sq * g->V[i + k * N];
+    }
+}
+
+void es__gram_fit_clear(es_ctx *ctx, es__gram_fit *g)
+{
+    es__free(ctx, g->w);
+    es__free(ctx, g->V);
+    memset(g, 0, sizeof *g);
+}
+
+es_status es__unit_columns(es_ctx *ctx, double *U, int64_t n, int64_t r, int64_t ldu,
+                           bool sum_ranks)
+{
+    es_status rc;
+    double *nrm = es__alloc_array(ctx, r > 0 ? r : 1, sizeof *nrm);
+    if (!nrm) return ES_ENOMEM;
+    for (int64_t k = 0; k < r; k++) {
+        double acc = 0;
+        for (int64_t e = 0; e < n; e++) acc += U[e + k * ldu] * U[e + k * ldu];
+        nrm[k] = acc;
+    }
+    if (sum_ranks && (rc = es__par_sum(ctx, nrm, r)) != ES_OK) {
+        es__free(ctx, nrm);
+        return rc;
+    }
+    for (int64_t k = 0; k < r; k++) {
+        double s = sqrt(nrm[k]);
+        if (!(s > 0)) {
+            es__free(ctx, nrm);
+            ES_FAIL(ctx, ES_ENUMERIC, "pca: component %lld vanished", (long long)(k + 1));
+        }
+        for (int64_t e = 0; e < n; e++) U[e + k * ldu] /= s;
+    }
+    es__free(ctx, nrm);
+    return ES_OK;
+}
+
 /* Read a block and subtract the vector c from every column. */
 static es_status read_minus(es_ctx *ctx, const es_source *src, int64_t r0, int64_t n,
                             const double *c, double *buf)
@@ -158,6 +263,18 @@ static es_status read_minus(es_ctx *ctx, const es_source *src, int64_t r0, int64
 static es_status fit_gram(es_ctx *ctx, const es_source *src, int64_t K, es_pca **out)
 {
     const int64_t E = src->nedges, N = src->nrows;
+    es_mat m;
+    const int64_t *cols;
+    if (!es__par_alone(ctx)) return es__pca_fit_gram_parallel(ctx, src, K, out);
+    if (es__source_matrix_of(src, &m, &cols)) {
+        /* in memory: read in place, edges at a time (pca_strip.c) */
+        es__strip s = {m.data, m.ld, E, N, cols, 0, 0};
+        for (int64_t j = 0; cols && j < N; j++)
+            if (cols[j] < 0 || cols[j] >= m.cols)
+                ES_FAIL(ctx, ES_ERANGE, "source: row %lld refers to column %lld of a %lld-column "
+                        "matrix", (long long)j, (long long)cols[j], (long long)m.cols);
+        return es__pca_fit_gram_strip(ctx, &s, E, K, out);
+    }
     /* square tiles: thin ones (a few rows against thousands of edges) run
      * BLAS at a tenth of its speed */
     int64_t BO = src->block > 0 ? src->block : TILE_BYTES / (8 * E);
@@ -175,11 +292,10 @@ static es_status fit_gram(es_ctx *ctx, const es_source *src, int64_t K, es_pca *
     /* N < 2^31 (LAPACK's int), so N * N does not overflow; eigenvectors take
      * only K columns when K is given */
     double *G = es__alloc_array(ctx, N * N, sizeof *G);
-    double *w = es__alloc_array(ctx, N, sizeof *w);
-    double *V = es__alloc_array(ctx, N * (K > 0 ? K : N), sizeof *V);
-    double *rmean = es__alloc_array(ctx, N, sizeof *rmean);
+    es__gram_fit g;
     es_pca *p = NULL;
-    if (!x0 || !ysum || !outer || !inner || !G || !w || !V || !rmean) {
+    memset(&g, 0, sizeof g);
+    if (!x0 || !ysum || !outer || !inner || !G) {
         rc = ES_ENOMEM;
         goto done;
     }
@@ -206,55 +322,23 @@ static es_status fit_gram(es_ctx *ctx, const es_source *src, int64_t K, es_pca *
         }
         if ((rc = es__progress(ctx, "pca: Gram matrix", nread, total_reads))) goto done;
     }
-    /* symmetrize, then double-centre: Gc = J G J with J = I - 11^T/N */
-    for (int64_t j = 0; j < N; j++)
-        for (int64_t i = j + 1; i < N; i++) G[i + j * N] = G[j + i * N];
-    double s = 0;
-    for (int64_t i = 0; i < N; i++) {
-        double r = 0;
-        for (int64_t j = 0; j < N; j++) r += G[i + j * N];
-        rmean[i] = r / (double)N;
-        s += rmean[i];
-    }
-    s /= (double)N;
-    double trace = 0;
-    for (int64_t j = 0; j < N; j++)
-        for (int64_t i = 0; i < N; i++) G[i + j * N] += s - rmean[i] - rmean[j];
-    for (int64_t i = 0; i < N; i++) trace += G[i + i * N];
-
-    int64_t m;
-    if ((rc = sym_eigen(ctx, N, G, K, w, V, &m)) != ES_OK) goto done;
-    int64_t r = m > 0 ? rank_of(w, m, N > E ? N : E, N, K) : 0;
-    if ((rc = es__pca_alloc(ctx, E, N, r, &p)) != ES_OK) goto done;
-    p->method = ES_PCA_GRAM;
-    p->total_variance = trace / (double)(N - 1);
+    if ((rc = es__gram_decompose(ctx, G, N, E, K, &g)) != ES_OK ||
+        (rc = es__pca_alloc(ctx, E, N, g.r, &p)) != ES_OK)
+        goto done;
+    es__gram_fill(&g, p);
     for (int64_t e = 0; e < E; e++) p->mean[e] = x0[e] + ysum[e] / (double)N;
-    for (int64_t k = 0; k < r; k++) {
-        p->eigenvalues[k] = w[k] / (double)(N - 1);
-        double sq = sqrt(w[k]);
-        for (int64_t i = 0; i < N; i++) p->scores[i + k * N] = sq * V[i + k * N];
-    }
 
     /* components: U = (X - mean 1^T) V diag(1/sqrt(mu)) */
-    if (r > 0) {
-        memset(p->components, 0, (size_t)(E * r) * sizeof(double));
+    if (g.r > 0) {
+        memset(p->components, 0, (size_t)(E * g.r) * sizeof(double));
         for (int64_t j0 = 0; j0 < N; j0 += BO) {
             int64_t bj = N - j0 < BO ? N - j0 : BO;
             if ((rc = read_minus(ctx, src, j0, bj, p->mean, outer)) != ES_OK) goto done;
-            cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, ne, (int)r, (int)bj,
-                        1.0, outer, ne, V + j0, nn, 1.0, p->components, ne);
+            cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, ne, (int)g.r, (int)bj,
+                        1.0, outer, ne, g.V + j0, nn, 1.0, p->components, ne);
             if ((rc = es__progress(ctx, "pca: components", j0 + bj, N))) goto done;
         }
-        for (int64_t k = 0; k < r; k++) {
-            double *u = p->components + k * E;
-            double nrm = cblas_dnrm2(ne, u, 1);
-            if (!(nrm > 0)) {
-                rc = es__fail(ctx, ES_ENUMERIC, "pca: component %lld vanished",
-                              (long long)(k + 1));
-                goto done;
-            }
-            cblas_dscal(ne, 1.0 / nrm, u, 1);
-        }
+        if ((rc = es__unit_columns(ctx, p->components, E, g.r, E, false)) != ES_OK) goto done;
     }
     es__pca_finish(p);
     *out = p;
@@ -266,70 +350,100 @@ done:
     es__free(ctx, outer);
     es__free(ctx, inner);
     es__free(ctx, G);
-    es__free(ctx, w);
-    es__free(ctx, V);
-    es__free(ctx, rmean);
+    es__gram_fit_clear(ctx, &g);
     return rc;
 }
 
 /* ---- covariance route ------------------------------------------------------ */
 
+/* In a job, each rank reads its share of the rows (rounds in step, for a
+ * collective reader); the partial covariances are summed on rank 0, which
+ * decomposes; the scores of each rank's rows are gathered. */
 static es_status fit_covariance(es_ctx *ctx, const es_source *src, int64_t K, es_pca **out)
 {
     const int64_t E = src->nedges, N = src->nrows, B = es__source_block(src);
+    const bool alone = es__par_alone(ctx), root = es__par_rank(ctx) == 0;
     es_status rc;
     int ne;
     if ((rc = es__lapack_int(ctx, E, &ne)) != ES_OK) return rc;
-    int64_t ee;
+    int64_t ee, lo, hi, rounds;
     if (!es__mul_i64(E, E, &ee))
         ES_FAIL(ctx, ES_ERANGE, "pca: a %lld x %lld covariance overflows", (long long)E,
                 (long long)E);
+    es__source_share(ctx, src, B, &lo, &hi, &rounds);
     double *x0 = es__alloc_array(ctx, E, sizeof *x0);
     double *ysum = es__calloc(ctx, (size_t)E, sizeof *ysum);
     double *buf = es__alloc_array(ctx, E * B, sizeof *buf);
-    double *C = es__alloc_array(ctx, ee, sizeof *C);
+    double *C = es__calloc(ctx, (size_t)ee, sizeof *C);
     double *w = es__alloc_array(ctx, E, sizeof *w);
     double *Z = es__alloc_array(ctx, E * (K > 0 ? K : E), sizeof *Z);
+    double *mine = NULL;
     es_pca *p = NULL;
-    if (!x0 || !ysum || !buf || !C || !w || !Z) {
-        rc = ES_ENOMEM;
-        goto done;
-    }
-    if ((rc = es__source_read(ctx, src, 0, 1, x0)) != ES_OK) goto done;
-    memset(C, 0, (size_t)ee * sizeof *C);
-    for (int64_t r0 = 0; r0 < N; r0 += B) {
-        int64_t n = N - r0 < B ? N - r0 : B;
-        if ((rc = read_minus(ctx, src, r0, n, x0, buf)) != ES_OK) goto done;
+    int64_t r = 0, hdr[1];
+    double trace = 0;
+    rc = x0 && ysum && buf && C && w && Z ? ES_OK : ES_ENOMEM;
+    if (rc == ES_OK) rc = es__source_read(ctx, src, 0, 1, x0);
+    if ((rc = es__par_agree(ctx, rc)) != ES_OK) goto done;
+    for (int64_t k = 0; k < rounds; k++) {
+        int64_t r0, n;
+        es__source_round(lo, hi, B, k, &r0, &n);
+        if ((rc = es__par_agree(ctx, read_minus(ctx, src, r0, n, x0, buf))) != ES_OK) goto done;
         for (int64_t j = 0; j < n; j++)
             for (int64_t e = 0; e < E; e++) ysum[e] += buf[e + j * E];
-        cblas_dsyrk(CblasColMajor, CblasUpper, CblasNoTrans, ne, (int)n, 1.0, buf, ne, 1.0,
-                    C, ne);
-        if ((rc = es__progress(ctx, "pca: covariance", r0 + n, N))) goto done;
+        if (n > 0)
+            cblas_dsyrk(CblasColMajor, CblasUpper, CblasNoTrans, ne, (int)n, 1.0, buf, ne, 1.0,
+                        C, ne);
+        if ((rc = es__par_agree(ctx, es__progress(ctx, "pca: covariance", alone ? r0 + n : k + 1,
+                                                  alone ? N : rounds))) != ES_OK)
+            goto done;
     }
-    /* Cc = Y^T Y - N ybar ybar^T, upper triangle */
-    double trace = 0;
-    for (int64_t j = 0; j < E; j++) {
-        double yj = ysum[j] / (double)N;
-        for (int64_t i = 0; i <= j; i++) C[i + j * E] -= (double)N * (ysum[i] / (double)N) * yj;
-        trace += C[j + j * E];
+    if ((rc = es__par_sum_root(ctx, C, ee)) != ES_OK || (rc = es__par_sum(ctx, ysum, E)) != ES_OK)
+        goto done;
+    if (root) {
+        /* Cc = Y^T Y - N ybar ybar^T, upper triangle */
+        for (int64_t j = 0; j < E; j++) {
+            double yj = ysum[j] / (double)N;
+            for (int64_t i = 0; i <= j; i++)
+                C[i + j * E] -= (double)N * (ysum[i] / (double)N) * yj;
+            trace += C[j + j * E];
+        }
+        int64_t m;
+        if ((rc = sym_eigen(ctx, E, C, K, w, Z, &m)) == ES_OK)
+            r = m > 0 ? rank_of(w, m, N > E ? N : E, N, K) : 0;
     }
-    int64_t m;
-    if ((rc = sym_eigen(ctx, E, C, K, w, Z, &m)) != ES_OK) goto done;
-    int64_t r = m > 0 ? rank_of(w, m, N > E ? N : E, N, K) : 0;
-    if ((rc = es__pca_alloc(ctx, E, N, r, &p)) != ES_OK) goto done;
+    hdr[0] = r;
+    if ((rc = es__par_agree(ctx, rc)) != ES_OK ||
+        (rc = es__par_bcast(ctx, hdr, sizeof hdr, 0)) != ES_OK ||
+        (rc = es__par_bcast(ctx, &trace, sizeof trace, 0)) != ES_OK ||
+        (rc = es__par_bcast(ctx, w, (size_t)hdr[0] * sizeof *w, 0)) != ES_OK ||
+        (rc = es__par_bcast(ctx, Z, (size_t)(E * hdr[0]) * sizeof *Z, 0)) != ES_OK)
+        goto done;
+    r = hdr[0];
+    rc = es__pca_alloc(ctx, E, N, r, &p);
+    if (rc == ES_OK && !alone &&
+        !(mine = es__alloc_array(ctx, (hi - lo) * r > 0 ? (hi - lo) * r : 1, sizeof *mine)))
+        rc = ES_ENOMEM;
+    if ((rc = es__par_agree(ctx, rc)) != ES_OK) goto done;
     p->method = ES_PCA_COVARIANCE;
     p->total_variance = trace / (double)(N - 1);
     for (int64_t e = 0; e < E; e++) p->mean[e] = x0[e] + ysum[e] / (double)N;
     for (int64_t k = 0; k < r; k++) p->eigenvalues[k] = w[k] / (double)(N - 1);
     memcpy(p->components, Z, (size_t)(E * r) * sizeof(double));
-    /* scores: S = (X - mean 1^T)^T U, one more pass */
-    for (int64_t r0 = 0; r0 < N && r > 0; r0 += B) {
-        int64_t n = N - r0 < B ? N - r0 : B;
-        if ((rc = read_minus(ctx, src, r0, n, p->mean, buf)) != ES_OK) goto done;
-        cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, (int)n, (int)r, ne, 1.0, buf, ne,
-                    p->components, ne, 0.0, p->scores + r0, (int)N);
-        if ((rc = es__progress(ctx, "pca: scores", r0 + n, N))) goto done;
+    /* scores: S = (X - mean 1^T)^T U, one more pass (this rank's rows) */
+    for (int64_t k = 0; k < rounds && r > 0; k++) {
+        int64_t r0, n;
+        es__source_round(lo, hi, B, k, &r0, &n);
+        if ((rc = es__par_agree(ctx, read_minus(ctx, src, r0, n, p->mean, buf))) != ES_OK)
+            goto done;
+        if (n > 0)
+            cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, (int)n, (int)r, ne, 1.0, buf,
+                        ne, p->components, ne, 0.0, alone ? p->scores + r0 : mine + (r0 - lo),
+                        alone ? (int)N : (int)(hi - lo));
+        if ((rc = es__par_agree(ctx, es__progress(ctx, "pca: scores", alone ? r0 + n : k + 1,
+                                                  alone ? N : rounds))) != ES_OK)
+            goto done;
     }
+    if (!alone && r > 0 && (rc = es__gather_split(ctx, mine, N, r, p->scores)) != ES_OK) goto done;
     es__pca_finish(p);
     *out = p;
     p = NULL;
@@ -341,6 +455,7 @@ done:
     es__free(ctx, C);
     es__free(ctx, w);
     es__free(ctx, Z);
+    es__free(ctx, mine);
     return rc;
 }
 

@@ -12,6 +12,7 @@
  */
 #include "stats/stats_pkg.h"
 #include "core/strmap.h"
+#include "parallel/parallel_private.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -44,6 +45,24 @@ es_source es_source_matrix(es_mat X, const int64_t *rows, int64_t nrows)
     s.mat = X;
     s.rows = rows;
     return s;
+}
+
+bool es__source_matrix_of(const es_source *src, es_mat *m, const int64_t **rows)
+{
+    if (!src || src->read != matrix_read) return false;
+    *m = src->mat;
+    *rows = src->rows;
+    return true;
+}
+
+void es__source_share(es_ctx *ctx, const es_source *src, int64_t block, int64_t *lo,
+                      int64_t *hi, int64_t *rounds)
+{
+    const int P = es__par_size(ctx);
+    int64_t most = src->nrows / P + (src->nrows % P != 0);
+    es__par_split(src->nrows, P, es__par_rank(ctx), lo, hi);
+    if (block < 1) block = 1;
+    *rounds = (most + block - 1) / block;
 }
 
 es_status es__source_check(es_ctx *ctx, const es_source *src, const char *what)

@@ -25,6 +25,87 @@ int64_t es__source_block(const es_source *src);
 es_status es__source_read(es_ctx *ctx, const es_source *src, int64_t row0, int64_t n,
                           double *buf);
 
+/* A source whose rows are columns of a matrix in memory (es_source_matrix):
+ * fills *m and *rows (NULL: all columns in order) and returns true; false
+ * for any other reader. */
+bool es__source_matrix_of(const es_source *src, es_mat *m, const int64_t **rows);
+
+/* Rows [*lo, *hi) of src that this rank of ctx's job reads (all of them
+ * when alone), and in how many rounds of at most `block` rows every rank
+ * reads its share: a collective reader (parallel HDF5) needs every rank to
+ * call it as often as the others, with n = 0 once its rows are done. */
+void es__source_share(es_ctx *ctx, const es_source *src, int64_t block, int64_t *lo,
+                      int64_t *hi, int64_t *rounds);
+
+/* Round k of a share: rows [*r0, *r0 + *n), n = 0 (at hi) once the share
+ * is done. */
+static inline void es__source_round(int64_t lo, int64_t hi, int64_t block, int64_t k,
+                                    int64_t *r0, int64_t *n)
+{
+    int64_t a = lo + k * block;
+    if (a > hi) a = hi;
+    *r0 = a;
+    *n = hi - a < block ? hi - a : block;
+}
+
+/* ---- the Gram route, in pieces (pca.c, pca_strip.c, pca_parallel.c) ---- */
+
+/* Edges [edge0, edge0 + nedges) of the N rows, in memory: column j of the
+ * strip is data + cols[j] * ld (cols NULL: j * ld). row0/edge0 name rows
+ * and edges in messages. */
+typedef struct es__strip {
+    const double *data;
+    int64_t ld, nedges, nrows;
+    const int64_t *cols;
+    int64_t row0, edge0;
+} es__strip;
+
+/* G (N x N, upper triangle) += Y^T Y and ysum[e] += sum_j Y[e, j] for
+ * Y = strip - shift 1^T (shift: the strip's nedges values). */
+es_status es__strip_gram(es_ctx *ctx, const es__strip *s, const double *shift, double *G,
+                         double *ysum);
+/* U (nedges x r, ld ldu) = (strip - centre 1^T) V, V N x r (ld N). */
+es_status es__strip_project(es_ctx *ctx, const es__strip *s, const double *centre,
+                            const double *V, int64_t r, double *U, int64_t ldu);
+/* The whole Gram route on a strip of all E edges (alone: the fast path of
+ * matrix sources), or, in a job, on this rank's strip of E_total edges:
+ * partial Gram matrices summed on rank 0, which decomposes, and the fit
+ * (components gathered) returned on every rank. */
+es_status es__pca_fit_gram_strip(es_ctx *ctx, const es__strip *s, int64_t E_total, int64_t K,
+                                 es_pca **out);
+
+/* The same on the ranks of ctx's job for any source: rows read in shares,
+ * exchanged into strips of edges (pca_parallel.c). */
+es_status es__pca_fit_gram_parallel(es_ctx *ctx, const es_source *src, int64_t K,
+                                    es_pca **out);
+/* out (total x r, ld total) from every rank's rows of it: rank q holds rows
+ * es__par_split(total, P, q) as mine (n_q x r, ld n_q). On every rank. */
+es_status es__gather_split(es_ctx *ctx, const double *mine, int64_t total, int64_t r,
+                           double *out);
+
+/* The eigenpairs the Gram route keeps. */
+typedef struct es__gram_fit {
+    int64_t N, r;
+    double trace;    /* of the centred Gram matrix: (N - 1) x total variance */
+    double *w;       /* r eigenvalues of the centred Gram matrix, descending */
+    double *V;       /* N x r unit eigenvectors (ld N) */
+} es__gram_fit;
+/* Double-centre G (N x N, upper triangle of Y^T Y; destroyed) and keep its
+ * top eigenpairs: K of them (0: all), fewer where the numerical rank (E
+ * edges) is lower. */
+es_status es__gram_decompose(es_ctx *ctx, double *G, int64_t N, int64_t E, int64_t K,
+                             es__gram_fit *g);
+/* Rank 0's g (it decomposed) copied to every rank of ctx's job. */
+es_status es__gram_share(es_ctx *ctx, es__gram_fit *g);
+/* method, total variance, eigenvalues and scores of p from g. */
+void es__gram_fill(const es__gram_fit *g, es_pca *p);
+void es__gram_fit_clear(es_ctx *ctx, es__gram_fit *g);
+/* Scale each of the r columns of U (n x r, ld ldu) to unit length, the
+ * lengths summed over ctx's job when sum_ranks (each rank holds rows of U);
+ * ES_ENUMERIC if one vanished. */
+es_status es__unit_columns(es_ctx *ctx, double *U, int64_t n, int64_t r, int64_t ldu,
+                           bool sum_ranks);
+
 /* Fit helpers of the randomized route (pca_randomized.c). */
 es_status es__pca_fit_randomized(es_ctx *ctx, const es_source *src, const es_pca_opts *opts,
                                  es_pca *pca);

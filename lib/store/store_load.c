@@ -257,15 +257,29 @@ static es_status load_kind(es_store *s, es__h5_raw *raw)
     if (es__h5_read_attr_i64(ctx, s->file, "the root group", "format_version", &version))
         return es__fail(ctx, ES_EFORMAT, "store: '%s' is not an edgespace store (%s)", s->path,
                         es_ctx_errmsg(ctx));
-    if (version != ES__FORMAT_VERSION && version != ES__FORMAT_VERSION_KIND)
+    if (version != ES__FORMAT_VERSION && version != ES__FORMAT_VERSION_KIND &&
+        version != ES__FORMAT_VERSION_BESIDE)
         ES_FAIL(ctx, ES_EFORMAT, "store: '%s' has format version %lld; this edgespace reads "
-                "versions %d and %d", s->path, (long long)version, ES__FORMAT_VERSION,
-                ES__FORMAT_VERSION_KIND);
+                "versions %d to %d", s->path, (long long)version, ES__FORMAT_VERSION,
+                ES__FORMAT_VERSION_BESIDE);
     s->kind = ES_TOPOLOGY_MESH;
-    if (version != ES__FORMAT_VERSION_KIND) return ES_OK;
-    if (es__h5_read_attr_text(ctx, raw, s->file, "topology_kind", kind, sizeof kind))
-        ES_FAIL(ctx, ES_EFORMAT, "store: '%s' has format version 2 but no topology_kind "
-                "attribute", s->path);
+    s->version = (int)version;
+    if (version == ES__FORMAT_VERSION) return ES_OK;
+    if (version == ES__FORMAT_VERSION_BESIDE) {
+        size_t n;
+        es_status rc = es__h5_read_attr_text(ctx, raw, s->file, "store_id", s->store_id,
+                                             sizeof s->store_id);
+        if (rc == ES_ENOMEM) return rc;
+        if (rc || (n = strlen(s->store_id)) < 8 || strspn(s->store_id, "0123456789abcdef") != n)
+            ES_FAIL(ctx, ES_EFORMAT, "store: '%s' has format version 3 but no store_id of "
+                    "hex digits", s->path);
+        s->beside = true;
+    }
+    es_status krc = es__h5_read_attr_text(ctx, raw, s->file, "topology_kind", kind, sizeof kind);
+    if (krc == ES_ENOMEM) return krc;
+    if (krc)
+        ES_FAIL(ctx, ES_EFORMAT, "store: '%s' has format version %lld but no topology_kind "
+                "attribute", s->path, (long long)version);
     if (!strcmp(kind, "mesh")) s->kind = ES_TOPOLOGY_MESH;
     else if (!strcmp(kind, "truss")) s->kind = ES_TOPOLOGY_TRUSS;
     else if (!strcmp(kind, "none")) s->kind = ES_TOPOLOGY_NONE;

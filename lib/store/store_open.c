@@ -30,6 +30,7 @@ static void release(es_store *s, bool keep_work)
     if (s->file >= 0) es__h5_file_close(ctx, s->file, !(s->work && !keep_work), s->path);
     s->file = -1;
     if (s->work && !keep_work) unlink(s->work);
+    es__beside_release(s);
     es__store_free_rows(s);
     es__free(ctx, s->work);
     es__free(ctx, s->path);
@@ -180,14 +181,16 @@ static es_status create_impl(es_ctx *ctx, const char *path, int64_t nverts, int6
     }
     gmtime_r(&now, &tmv);
     strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", &tmv);
-    if ((rc = es__h5_write_attr_i64(ctx, s->file, "format_version",
-                                    s->kind == ES_TOPOLOGY_MESH ? ES__FORMAT_VERSION
-                                                         : ES__FORMAT_VERSION_KIND)) ||
+    /* format 3: results beside the store (store_beside.c), tied to it by its id */
+    s->beside = true;
+    s->version = ES__FORMAT_VERSION_BESIDE;
+    es__beside_new_id(s->store_id);
+    if ((rc = es__h5_write_attr_i64(ctx, s->file, "format_version", ES__FORMAT_VERSION_BESIDE)) ||
         (rc = es__h5_write_attr_str(ctx, s->file, "creator", "edgespace " ES_VERSION_STRING)) ||
         (rc = es__h5_write_attr_str(ctx, s->file, "created", when)) ||
-        (s->kind != ES_TOPOLOGY_MESH &&
-         (rc = es__h5_write_attr_str(ctx, s->file, "topology_kind",
-                                     es_topology_kind_name(s->kind)))))
+        (rc = es__h5_write_attr_str(ctx, s->file, "topology_kind",
+                                    es_topology_kind_name(s->kind))) ||
+        (rc = es__h5_write_attr_str(ctx, s->file, "store_id", s->store_id)))
         goto fail;
     if ((g = H5Gcreate2(s->file, "/topology", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) < 0) {
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot create /topology");
@@ -266,7 +269,15 @@ static es_status rollback_impl(es_ctx *ctx, es_store *s)
 {
     hid_t fapl;
     es_status rc;
-    if (!s->work) return ES_OK;
+    if (!s->work) {
+        /* only results beside the store written (format 3): they are
+         * dropped unpublished, the store itself was never touched */
+        if (es__beside_pending(s)) {
+            es__beside_release(s);
+            s->broken = false;
+        }
+        return ES_OK;
+    }
     if (s->is_new)
         ES_FAIL(ctx, ES_EINVAL, "store: '%s' was never committed; abort it instead of rolling "
                 "back", s->path);
@@ -304,13 +315,16 @@ es_status es_store_rollback(es_ctx *ctx, es_store *store)
     return rc;
 }
 
-int es_store_pending(const es_store *store) { return store && store->work; }
+int es_store_pending(const es_store *store)
+{
+    return store && (store->work || es__beside_pending(store));
+}
 
 void es_store_close(es_store *store)
 {
     if (!store) return;
     H5E_BEGIN_TRY {
-        if (store->work && !store->broken) {
+        if ((store->work || es__beside_pending(store)) && !store->broken) {
             es_status rc = es__store_publish(store->ctx, store);
             if (rc != ES_OK)
                 es__warn(store->ctx, "%s", es_ctx_errmsg(store->ctx));

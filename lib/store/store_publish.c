@@ -17,7 +17,9 @@
  * and the rename hold an advisory lock on the folder. This is the "write a
  * new file, then rename" scheme of editors and package managers (SQLite
  * keeps every fsync and rename in os_unix.c for the same reason); HDF5 1.10
- * has no transactional writes of its own.
+ * has no transactional writes of its own. Results of a format-3 store are
+ * not written here at all but beside it, a file each (store_beside.c):
+ * storing one never copies the store.
  */
 #include "store/store_pkg.h"
 #include "core/files.h"
@@ -50,11 +52,14 @@ void es__store_clean_stale(const char *path)
  * symbolic link its target (a commit renames over the target and keeps the
  * link; it used to replace the link by a file and leave the target as it
  * was). */
-static const char *target_of(const es_store *s) { return s->target ? s->target : s->path; }
+const char *es__store_target(const es_store *s) { return s->target ? s->target : s->path; }
+static const char *target_of(const es_store *s) { return es__store_target(s); }
 
-char *es__store_temp_name(es_store *s)
+/* A temporary sibling of path (the one naming scheme, core/): the working
+ * copy of a store, a result file being written beside it. */
+char *es__store_temp_for(es_store *s, const char *path)
 {
-    const char *tp = target_of(s), *base = es__path_base(tp);
+    const char *tp = path, *base = es__path_base(tp);
     size_t dn = (size_t)(base - tp), n = strlen(tp) + 64;
     char sb[NAME_MAX + 1], *t = es__malloc(s->ctx, n);
     struct timespec ts;
@@ -66,6 +71,8 @@ char *es__store_temp_name(es_store *s)
                     (unsigned long)(uintptr_t)s, (unsigned long)ts.tv_nsec, s->tmp_counter++);
     return t;
 }
+
+char *es__store_temp_name(es_store *s) { return es__store_temp_for(s, target_of(s)); }
 
 static es_status copy_file(es_ctx *ctx, const char *src, const char *dst, struct stat *st)
 {
@@ -120,6 +127,11 @@ static es_status fsync_path(es_ctx *ctx, const char *path, bool dir)
     }
     close(fd);
     return ES_OK;
+}
+
+es_status es__store_fsync(es_ctx *ctx, const char *path, bool dir)
+{
+    return fsync_path(ctx, path, dir);
 }
 
 /* Another writer's commit replaces the file (a new inode) and an in-place
@@ -182,7 +194,7 @@ es_status es__store_publish(es_ctx *ctx, es_store *s)
     struct stat now, done;
     char *dir = NULL;
     hid_t fapl;
-    if (!s->work) return ES_OK; /* nothing written */
+    if (!s->work) return es__beside_publish(ctx, s); /* the store itself unchanged */
     if (s->broken)
         ES_FAIL(ctx, ES_EIO, "store: an earlier write to '%s' failed; nothing committed",
                 s->path);
@@ -252,7 +264,8 @@ es_status es__store_publish(es_ctx *ctx, es_store *s)
     es__h5_close(fapl);
     if (s->file < 0)
         return es__h5_fail(ctx, ES_EIO, "store: committed '%s' but cannot reopen it", s->path);
-    return ES_OK;
+    /* results beside it after the store: one of them may name its new rows */
+    return es__beside_publish(ctx, s);
 fail:
     s->broken = true;
     return rc;

@@ -19,7 +19,7 @@
 #include <time.h>
 
 /* Split "a/b/c" into validated components; returns how many (max 8). */
-static int split_path(es_ctx *ctx, const char *path, char parts[8][128], es_status *rc)
+int es__result_split(es_ctx *ctx, const char *path, char parts[8][128], es_status *rc)
 {
     int n = 0;
     *rc = ES_OK;
@@ -39,12 +39,14 @@ static int split_path(es_ctx *ctx, const char *path, char parts[8][128], es_stat
     return n;
 }
 
-/* Whether every component of full exists. Each object below /analysis is
+/* Whether every component of full exists in file (the store's, or a
+ * result file beside it: fpath names it). Each object below /analysis is
  * checked (its header by store_headers.c, a group's symbol table by
  * store_groups.c) before HDF5 looks the next name up in it or opens it: a
  * result's groups and datasets come from the file like everything else.
  * ES_OK with *exists, or the check's refusal. */
-static es_status find_link(es_ctx *ctx, es_store *s, const char *full, bool *exists)
+es_status es__result_find_link(es_ctx *ctx, hid_t file, const char *fpath, const char *full,
+                               bool *exists)
 {
     char buf[1200];
     size_t n = strlen(full);
@@ -58,11 +60,11 @@ static es_status find_link(es_ctx *ctx, es_store *s, const char *full, bool *exi
         if (*p != '/' && *p != '\0') continue;
         char save = *p;
         *p = '\0';
-        if (H5Lexists(s->file, buf, H5P_DEFAULT) <= 0) break;
+        if (H5Lexists(file, buf, H5P_DEFAULT) <= 0) break;
         if (++depth >= 2) {   /* /analysis itself was checked at open */
-            if ((raw || (rc = es__h5_raw_open(ctx, s->file, s->path, &raw)) == ES_OK) &&
-                (rc = es__h5_check_named(raw, s->file, buf)) == ES_OK && save) {
-                hid_t g = H5Gopen2(s->file, buf, H5P_DEFAULT);
+            if ((raw || (rc = es__h5_raw_open(ctx, file, fpath, &raw)) == ES_OK) &&
+                (rc = es__h5_check_named(raw, file, buf)) == ES_OK && save) {
+                hid_t g = H5Gopen2(file, buf, H5P_DEFAULT);
                 if (g >= 0) {
                     rc = es__h5_check_group(raw, g, buf);
                     H5Gclose(g);
@@ -80,9 +82,48 @@ static es_status find_link(es_ctx *ctx, es_store *s, const char *full, bool *exi
     return rc;
 }
 
-static void full_path(char *buf, size_t n, const char *rel)
+void es__result_full_path(char *buf, size_t n, const char *rel)
 {
     snprintf(buf, n, "/analysis/%s", rel);
+}
+
+
+/* The file that holds result path rel ("kind/name[/...]"), *f, named *fpath
+ * in messages: for a store of format 3 the result's own file beside it
+ * (store_beside.c), else (and for a result a format-3 store holds inside)
+ * the store. ES__RESULT_READ: as this handle sees it; ES__RESULT_WRITE_BEGUN: to write into a
+ * result begun through this handle; ES__RESULT_CREATE: to begin one. Writes into the
+ * store itself switch it to its working copy (store_publish.c). */
+es_status es__result_locate(es_ctx *ctx, es_store *s, const char *rel, int how, hid_t *f,
+                        const char **fpath)
+{
+    char parts[8][128];
+    es_status rc;
+    int np = es__result_split(ctx, rel, parts, &rc);
+    if (np < 0) return rc;
+    *f = s->file;
+    *fpath = s->path;
+    if (s->beside && np >= 2) {
+        if (how != ES__RESULT_READ && s->mode == ES_STORE_READ)
+            ES_FAIL(ctx, ES_EINVAL, "store: '%s' is open read-only", s->path);
+        if (how != ES__RESULT_READ && s->broken)
+            ES_FAIL(ctx, ES_EIO, "store: an earlier write to '%s' failed; reopen the store",
+                    s->path);
+        hid_t g;
+        const char *gp;
+        if ((rc = es__beside_file(s, parts[0], parts[1], how == ES__RESULT_CREATE, &g, &gp))) return rc;
+        if (how == ES__RESULT_WRITE_BEGUN && !es__beside_writing(s, parts[0], parts[1]))
+            ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object /analysis/%s/%s: it was not "
+                    "begun (es_store_result_begin)", parts[0], parts[1]);
+        if (g >= 0 || how != ES__RESULT_READ) {
+            *f = g;
+            *fpath = gp;
+        }
+        return ES_OK;
+    }
+    if (how != ES__RESULT_READ && (rc = es__store_begin_write(s))) return rc;
+    *f = s->file;
+    return ES_OK;
 }
 
 /* The name must be free unless the handle replaces results. */
@@ -95,7 +136,11 @@ static es_status check_free(es_ctx *ctx, es_store *s, const char *kind, const ch
                 name ? name : "");
     snprintf(full, sizeof full, "/analysis/%s/%s", kind, name);
     es_status rc;
-    if ((rc = find_link(ctx, s, full, exists))) return rc;
+    hid_t f;
+    const char *fp;
+    if ((rc = es__result_locate(ctx, s, full + 10, ES__RESULT_READ, &f, &fp)) ||
+        (rc = es__result_find_link(ctx, f, fp, full, exists)))
+        return rc;
     if (*exists && s->mode != ES_STORE_REPLACE)
         ES_FAIL(ctx, ES_EEXIST, "store: result %s/%s exists already in '%s' (give another name, "
                 "or replace it: --replace, replace=True in Python)", kind, name, s->path);
@@ -128,14 +173,20 @@ static es_status result_begin_impl(es_ctx *ctx, es_store *s, const char *kind, c
             if (prov->rows[i] < 0 || prov->rows[i] >= s->nrows)
                 ES_FAIL(ctx, ES_ERANGE, "store: provenance row %lld is out of range",
                         (long long)prov->rows[i]);
-    if ((rc = es__store_begin_write(s))) return rc;
     snprintf(full, sizeof full, "/analysis/%s/%s", kind, name);
-    if (exists && H5Ldelete(s->file, full, H5P_DEFAULT) < 0) {
+    hid_t f;
+    const char *fp;
+    if ((rc = es__result_locate(ctx, s, full + 10, ES__RESULT_CREATE, &f, &fp))) return rc;
+    /* beside the store: whether this handle's working file has it already
+     * (begun twice); inside it, check_free looked in the very same bytes
+     * (and a working copy is not searched raw: that flushes it) */
+    if (s->beside && (rc = es__result_find_link(ctx, f, fp, full, &exists))) return rc;
+    if (exists && H5Ldelete(f, full, H5P_DEFAULT) < 0) {
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot replace %s", full);
         goto fail;
     }
     if ((lcpl = H5Pcreate(H5P_LINK_CREATE)) < 0 || H5Pset_create_intermediate_group(lcpl, 1) < 0 ||
-        (g = H5Gcreate2(s->file, full, lcpl, H5P_DEFAULT, H5P_DEFAULT)) < 0) {
+        (g = H5Gcreate2(f, full, lcpl, H5P_DEFAULT, H5P_DEFAULT)) < 0) {
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot create %s", full);
         goto fail;
     }
@@ -193,23 +244,25 @@ es_status es_store_result_begin(es_ctx *ctx, es_store *s, const char *kind, cons
 
 /* Prepare a put: the path must be kind/name/dataset inside a begun result;
  * an existing dataset of that name is removed. */
-static es_status put_prepare(es_ctx *ctx, es_store *s, const char *path, char *full, size_t n)
+static es_status put_prepare(es_ctx *ctx, es_store *s, const char *path, char *full, size_t n,
+                             hid_t *f)
 {
     char parts[8][128], group[600];
     es_status rc;
     bool e;
-    int np = split_path(ctx, path, parts, &rc);
+    const char *fp;
+    int np = es__result_split(ctx, path, parts, &rc);
     if (np < 0) return rc;
     if (np < 3) ES_FAIL(ctx, ES_EINVAL, "store: '%s' is not kind/name/dataset", path);
-    if ((rc = es__store_begin_write(s))) return rc;
+    if ((rc = es__result_locate(ctx, s, path, ES__RESULT_WRITE_BEGUN, f, &fp))) return rc;
     snprintf(group, sizeof group, "/analysis/%s/%s", parts[0], parts[1]);
-    if ((rc = find_link(ctx, s, group, &e))) return rc;
+    if ((rc = es__result_find_link(ctx, *f, fp, group, &e))) return rc;
     if (!e)
         ES_FAIL(ctx, ES_ENOTFOUND, "store: result %s/%s was not begun "
                 "(es_store_result_begin)", parts[0], parts[1]);
-    full_path(full, n, path);
-    if ((rc = find_link(ctx, s, full, &e))) return rc;
-    if (e && H5Ldelete(s->file, full, H5P_DEFAULT) < 0) {
+    es__result_full_path(full, n, path);
+    if ((rc = es__result_find_link(ctx, *f, fp, full, &e))) return rc;
+    if (e && H5Ldelete(*f, full, H5P_DEFAULT) < 0) {
         s->broken = true;
         return es__h5_fail(ctx, ES_EIO, "store: cannot replace %s", full);
     }
@@ -220,14 +273,14 @@ static es_status put_impl(es_ctx *ctx, es_store *s, const char *path, int rank,
                           const hsize_t *dims, hid_t ftype, hid_t mtype, const void *buf)
 {
     char full[700];
-    hid_t sp = -1, ds = -1, lcpl = -1;
-    es_status rc = put_prepare(ctx, s, path, full, sizeof full);
+    hid_t sp = -1, ds = -1, lcpl = -1, f = -1;
+    es_status rc = put_prepare(ctx, s, path, full, sizeof full, &f);
     hsize_t total = 1;
     if (rc) return rc;
     for (int k = 0; k < rank; k++) total *= dims[k];
     if ((lcpl = H5Pcreate(H5P_LINK_CREATE)) < 0 || H5Pset_create_intermediate_group(lcpl, 1) < 0 ||
         (sp = H5Screate_simple(rank, dims, NULL)) < 0 ||
-        (ds = H5Dcreate2(s->file, full, ftype, sp, lcpl, H5P_DEFAULT, H5P_DEFAULT)) < 0 ||
+        (ds = H5Dcreate2(f, full, ftype, sp, lcpl, H5P_DEFAULT, H5P_DEFAULT)) < 0 ||
         (total > 0 && H5Dwrite(ds, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0)) {
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot write %s", full);
         s->broken = true;
@@ -313,6 +366,26 @@ typedef struct attr_value {
     int64_t i;
 } attr_value;
 
+es_status es__result_find(es_ctx *ctx, es_store *s, const char *path, int how, char *full,
+                          size_t n, hid_t *f, const char **fpath, bool *exists)
+{
+    es_status rc = es__result_locate(ctx, s, path, how, f, fpath);
+    if (rc) return rc;
+    es__result_full_path(full, n, path);
+    return es__result_find_link(ctx, *f, *fpath, full, exists);
+}
+
+/* The header of obj, every attribute message, checked (store_headers.c)
+ * before HDF5 decodes any of them. */
+es_status es__result_check_attrs(es_ctx *ctx, const char *fpath, hid_t obj, const char *full)
+{
+    es__h5_raw *raw = NULL;
+    es_status rc = es__h5_raw_open(ctx, obj, fpath, &raw);
+    if (rc == ES_OK) rc = es__h5_check_object(raw, obj, full);
+    es__h5_raw_close(raw);
+    return rc;
+}
+
 static es_status put_attr_impl(es_ctx *ctx, es_store *s, const char *path, const char *key,
                                const attr_value *v)
 {
@@ -320,18 +393,19 @@ static es_status put_attr_impl(es_ctx *ctx, es_store *s, const char *path, const
     es_status rc;
     hid_t obj;
     bool e;
-    int np = split_path(ctx, path, parts, &rc);
+    int np = es__result_split(ctx, path, parts, &rc);
     if (np < 0) return rc;
     if (np < 2 || !key || !*key || (v->type == 0 && !v->s))
         ES_FAIL(ctx, ES_EINVAL, "store: bad attribute '%s' on '%s'", key ? key : "", path);
-    if ((rc = es__store_begin_write(s))) return rc;
-    full_path(full, sizeof full, path);
-    if ((rc = find_link(ctx, s, full, &e))) return rc;
+    hid_t f;
+    const char *fp;
+    if ((rc = es__result_find(ctx, s, path, ES__RESULT_WRITE_BEGUN, full, sizeof full, &f, &fp, &e))) return rc;
     if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
-    /* (find_link checked its header: every attribute HDF5 decodes) */
-    if ((obj = H5Oopen(s->file, full, H5P_DEFAULT)) < 0)
+    if ((obj = H5Oopen(f, full, H5P_DEFAULT)) < 0)
         return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
-    rc = v->type == 1 ? es__h5_write_attr_f64(ctx, obj, key, v->d)
+    rc = es__result_check_attrs(ctx, fp, obj, full);
+    if (rc == ES_OK)
+        rc = v->type == 1 ? es__h5_write_attr_f64(ctx, obj, key, v->d)
              : v->type == 2 ? es__h5_write_attr_i64(ctx, obj, key, v->i)
                             : es__h5_write_attr_str(ctx, obj, key, v->s);
     H5Oclose(obj);
@@ -377,11 +451,12 @@ static es_status get_open(es_ctx *ctx, es_store *s, const char *path, int rank, 
     es_status rc;
     hid_t sp;
     bool e;
-    if (split_path(ctx, path, parts, &rc) < 0) return rc;
-    full_path(full, sizeof full, path);
-    if ((rc = find_link(ctx, s, full, &e))) return rc;
+    hid_t f;
+    const char *fp;
+    (void)parts;
+    if ((rc = es__result_find(ctx, s, path, ES__RESULT_READ, full, sizeof full, &f, &fp, &e))) return rc;
     if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no dataset %s", full);
-    if ((*ds = H5Dopen2(s->file, full, H5P_DEFAULT)) < 0)
+    if ((*ds = H5Dopen2(f, full, H5P_DEFAULT)) < 0)
         return es__h5_fail(ctx, ES_EFORMAT, "store: %s is not a dataset", full);
     sp = H5Dget_space(*ds);
     if (sp < 0 || H5Sget_simple_extent_ndims(sp) != rank) {
@@ -493,7 +568,7 @@ static es_status get_strings_impl(es_ctx *ctx, es_store *s, const char *path, ch
     uint64_t disk, need;
     es_status rc = get_open(ctx, s, path, 1, dims, &ds);
     if (rc) return rc;
-    full_path(full, sizeof full, path);
+    es__result_full_path(full, sizeof full, path);
     count = (int64_t)dims[0];
     if ((t = H5Dget_type(ds)) < 0 || H5Tget_class(t) != H5T_STRING) {
         rc = es__fail(ctx, ES_EFORMAT, "store: '%s': %s is not strings", s->path, full);
@@ -514,7 +589,10 @@ static es_status get_strings_impl(es_ctx *ctx, es_store *s, const char *path, ch
         rc = ES_ENOMEM;
         goto done;
     }
-    if ((rc = es__h5_read_strings(ctx, raw, s->file, full, count, v)) != ES_OK) {
+    hid_t file = H5Iget_file_id(ds);   /* the store, or the result's file beside it */
+    rc = es__h5_read_strings(ctx, raw, file, full, count, v);
+    es__h5_close(file);
+    if (rc != ES_OK) {
         for (int64_t i = 0; i < count; i++) es__free(ctx, v[i]);
         es__free(ctx, v);
         goto done;
@@ -546,21 +624,25 @@ static es_status get_attr_impl(es_ctx *ctx, es_store *s, const char *path, const
     es_status rc;
     hid_t obj;
     bool e;
-    if (split_path(ctx, path, parts, &rc) < 0) return rc;
-    full_path(full, sizeof full, path);
-    if ((rc = find_link(ctx, s, full, &e))) return rc;
+    hid_t f;
+    const char *fp;
+    (void)parts;
+    if ((rc = es__result_find(ctx, s, path, ES__RESULT_READ, full, sizeof full, &f, &fp, &e))) return rc;
     if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
-    /* HDF5 decodes every attribute of the object to find one: find_link
-     * checked them all */
-    if ((obj = H5Oopen(s->file, full, H5P_DEFAULT)) < 0)
+    if ((obj = H5Oopen(f, full, H5P_DEFAULT)) < 0)
         return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
+    /* HDF5 decodes every attribute of the object to find one: checked first */
+    if ((rc = es__result_check_attrs(ctx, fp, obj, full))) {
+        H5Oclose(obj);
+        return rc;
+    }
     if (H5Aexists(obj, key) <= 0) {
         H5Oclose(obj);
         ES_FAIL(ctx, ES_ENOTFOUND, "store: %s has no attribute '%s'", full, key);
     }
     {
         es__h5_raw *raw = NULL;
-        if ((rc = es__h5_raw_open(ctx, obj, s->path, &raw)) == ES_OK)
+        if ((rc = es__h5_raw_open(ctx, obj, fp, &raw)) == ES_OK)
             rc = es__h5_read_attr_text(ctx, raw, obj, key, buf, n);
         es__h5_raw_close(raw);
     }
@@ -590,176 +672,4 @@ es_status es_store_get_attr_double(es_ctx *ctx, es_store *s, const char *path,
                 buf);
     *value = v;
     return ES_OK;
-}
-
-int es_store_has(es_store *s, const char *path)
-{
-    char full[700];
-    int r = 0;
-    if (!s || !path || !*path) return 0;
-    full_path(full, sizeof full, path);
-    H5E_BEGIN_TRY {
-        bool e = false;
-        r = find_link(s->ctx, s, full, &e) == ES_OK && e;
-    } H5E_END_TRY
-    return r;
-}
-
-typedef struct name_list { es_ctx *ctx; char **names; int64_t n, cap; es_status rc; } name_list;
-
-static herr_t list_cb(hid_t g, const char *name, const H5L_info_t *info, void *data)
-{
-    name_list *l = data;
-    (void)g;
-    (void)info;
-    if (l->n == l->cap) {
-        int64_t cap = l->cap ? 2 * l->cap : 16;
-        char **p = es__realloc(l->ctx, l->names, (size_t)cap * sizeof *p);
-        if (!p) { l->rc = ES_ENOMEM; return -1; }
-        l->names = p;
-        l->cap = cap;
-    }
-    if (!(l->names[l->n] = es__strdup(l->ctx, name))) { l->rc = ES_ENOMEM; return -1; }
-    l->n++;
-    return 0;
-}
-
-static es_status list_impl(es_ctx *ctx, es_store *s, const char *kind, char ***names,
-                           int64_t *n)
-{
-    char full[600];
-    name_list l = {ctx, NULL, 0, 0, ES_OK};
-    hid_t g;
-    if (kind && *kind && es__h5_bad_name(kind))
-        ES_FAIL(ctx, ES_EINVAL, "store: bad result kind '%s'", kind);
-    snprintf(full, sizeof full, "/analysis%s%s", kind && *kind ? "/" : "", kind ? kind : "");
-    {
-        bool e;
-        es__h5_raw *raw = NULL;
-        es_status rc;
-        if ((rc = find_link(ctx, s, full, &e))) return rc;
-        if (!e) return ES_OK;
-        if ((g = H5Gopen2(s->file, full, H5P_DEFAULT)) < 0)
-            return es__h5_fail(ctx, ES_EFORMAT, "store: %s is not a group", full);
-        /* the group listed is searched by HDF5 too */
-        if (kind && *kind && ((rc = es__h5_raw_open(ctx, g, s->path, &raw)) ||
-                              (rc = es__h5_check_group(raw, g, full)))) {
-            es__h5_raw_close(raw);
-            H5Gclose(g);
-            return rc;
-        }
-        es__h5_raw_close(raw);
-    }
-    if (H5Literate(g, H5_INDEX_NAME, H5_ITER_INC, NULL, list_cb, &l) < 0) {
-        es_status rc = l.rc ? l.rc : es__h5_fail(ctx, ES_EIO, "store: cannot list %s", full);
-        H5Gclose(g);
-        for (int64_t i = 0; i < l.n; i++) es__free(ctx, l.names[i]);
-        es__free(ctx, l.names);
-        return rc;
-    }
-    H5Gclose(g);
-    *names = l.names;
-    *n = l.n;
-    return ES_OK;
-}
-
-static herr_t attr_cb(hid_t loc, const char *name, const H5A_info_t *info, void *data)
-{
-    (void)info;
-    return list_cb(loc, name, NULL, data);
-}
-
-static es_status attrs_impl(es_ctx *ctx, es_store *s, const char *path, char ***keys, int64_t *n)
-{
-    char parts[8][128], full[700];
-    es_status rc;
-    name_list l = {ctx, NULL, 0, 0, ES_OK};
-    if (split_path(ctx, path, parts, &rc) < 0) return rc;
-    full_path(full, sizeof full, path);
-    bool e;
-    if ((rc = find_link(ctx, s, full, &e))) return rc;
-    if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
-    /* (its header, every attribute message, checked by find_link) */
-    hid_t obj = H5Oopen(s->file, full, H5P_DEFAULT);
-    if (obj < 0) return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
-    if (H5Aiterate2(obj, H5_INDEX_NAME, H5_ITER_INC, NULL, attr_cb, &l) < 0) {
-        rc = l.rc ? l.rc : es__h5_fail(ctx, ES_EIO, "store: cannot list the attributes of %s",
-                                       full);
-        H5Oclose(obj);
-        for (int64_t i = 0; i < l.n; i++) es__free(ctx, l.names[i]);
-        es__free(ctx, l.names);
-        return rc;
-    }
-    H5Oclose(obj);
-    *keys = l.names;
-    *n = l.n;
-    return ES_OK;
-}
-
-es_status es_store_list_attrs(es_ctx *ctx, es_store *s, const char *path, char ***keys,
-                              int64_t *n)
-{
-    es_status rc;
-    if (!s || !keys || !n) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument");
-    *keys = NULL;
-    *n = 0;
-    H5E_BEGIN_TRY { rc = attrs_impl(ctx, s, path, keys, n); } H5E_END_TRY
-    return rc;
-}
-
-es_status es_store_list_results(es_ctx *ctx, es_store *s, const char *kind, char ***names,
-                                int64_t *n)
-{
-    es_status rc;
-    if (!s || !names || !n) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument");
-    *names = NULL;
-    *n = 0;
-    H5E_BEGIN_TRY { rc = list_impl(ctx, s, kind, names, n); } H5E_END_TRY
-    return rc;
-}
-
-static es_status delete_impl(es_ctx *ctx, es_store *s, const char *kind, const char *name)
-{
-    char full[600], group[300];
-    es_status rc;
-    if (es__h5_bad_name(kind) || es__h5_bad_name(name) || strlen(kind) > 120 ||
-        strlen(name) > 120)
-        ES_FAIL(ctx, ES_EINVAL, "store: bad result kind/name '%s/%s'", kind ? kind : "",
-                name ? name : "");
-    snprintf(group, sizeof group, "/analysis/%s", kind);
-    snprintf(full, sizeof full, "%s/%s", group, name);
-    bool e;
-    if ((rc = find_link(ctx, s, full, &e))) return rc;
-    if (!e) {
-        char hint[400];
-        es_store_result_hint(ctx, s, kind, name, hint, sizeof hint);
-        ES_FAIL(ctx, ES_ENOTFOUND, "store: no result %s/%s in '%s'%s", kind, name, s->path, hint);
-    }
-    if ((rc = es__store_begin_write(s))) return rc;
-    if (H5Ldelete(s->file, full, H5P_DEFAULT) < 0) {
-        s->broken = true;
-        return es__h5_fail(ctx, ES_EIO, "store: cannot delete %s", full);
-    }
-    /* the last result of its kind takes the kind's group with it */
-    H5G_info_t info;
-    hid_t g = H5Gopen2(s->file, group, H5P_DEFAULT);
-    if (g < 0 || H5Gget_info(g, &info) < 0) {
-        es__h5_close(g);
-        s->broken = true;
-        return es__h5_fail(ctx, ES_EIO, "store: cannot read %s", group);
-    }
-    H5Gclose(g);
-    if (info.nlinks == 0 && H5Ldelete(s->file, group, H5P_DEFAULT) < 0) {
-        s->broken = true;
-        return es__h5_fail(ctx, ES_EIO, "store: cannot delete %s", group);
-    }
-    return ES_OK;
-}
-
-es_status es_store_delete_result(es_ctx *ctx, es_store *s, const char *kind, const char *name)
-{
-    es_status rc;
-    if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
-    H5E_BEGIN_TRY { rc = delete_impl(ctx, s, kind, name); } H5E_END_TRY
-    return rc;
 }

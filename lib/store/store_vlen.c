@@ -39,6 +39,7 @@ struct es__h5_raw {
     es_ctx *ctx;
     const char *path;        /* for messages */
     int fd;
+    char *mem;               /* a file in memory (a result being written): its image */
     uint64_t base, eof;      /* addresses are relative to base; eof: file size */
     unsigned sa, ss;         /* sizes of addresses and lengths (8 and 8 as written) */
     gcol **map;              /* open addressing by collection address */
@@ -76,6 +77,18 @@ es_status es__h5_raw_open(es_ctx *ctx, hid_t obj, const char *path, es__h5_raw *
         rc = es__h5_fail(ctx, ES_EFORMAT, "store: '%s': cannot read the file's properties", path);
         goto done;
     }
+    if (H5Pget_driver(fapl) == H5FD_CORE) {
+        /* a result this handle is writing (store_beside.c): read its image */
+        ssize_t size;
+        if (H5Fflush(fid, H5F_SCOPE_LOCAL) < 0 || (size = H5Fget_file_image(fid, NULL, 0)) < 0 ||
+            !(r->mem = es__malloc(ctx, size > 0 ? (size_t)size : 1)) ||
+            H5Fget_file_image(fid, r->mem, (size_t)size) != size) {
+            rc = r->mem ? es__h5_fail(ctx, ES_EIO, "store: cannot read '%s'", path) : ES_ENOMEM;
+            goto done;
+        }
+        st.st_size = (off_t)size;
+        goto sized;
+    }
     if (H5Pget_driver(fapl) != H5FD_SEC2 || H5Fget_vfd_handle(fid, H5P_DEFAULT, &handle) < 0 ||
         !handle) {
         rc = es__fail(ctx, ES_EFORMAT, "store: '%s': not a plain file (HDF5 driver)", path);
@@ -91,6 +104,7 @@ es_status es__h5_raw_open(es_ctx *ctx, hid_t obj, const char *path, es__h5_raw *
         rc = es__fail(ctx, ES_EIO, "store: cannot read '%s': %s", path, strerror(errno));
         goto done;
     }
+sized:
     if ((sa != 4 && sa != 8) || (ss != 4 && ss != 8)) {
         rc = es__fail(ctx, ES_EFORMAT, "store: '%s': %zu-byte addresses and %zu-byte lengths "
                       "(edgespace reads 4 or 8)", path, sa, ss);
@@ -105,6 +119,7 @@ done:
     es__h5_close(fcpl);
     es__h5_close(fid);
     if (rc != ES_OK) {
+        es__free(ctx, r->mem);
         es__free(ctx, r);
         return rc;
     }
@@ -166,6 +181,7 @@ void es__h5_raw_close(es__h5_raw *r)
             es__free(r->ctx, r->map[i]);
         }
     es__free(r->ctx, r->map);
+    es__free(r->ctx, r->mem);
     es__free(r->ctx, r);
 }
 
@@ -177,6 +193,10 @@ static es_status raw_read(es__h5_raw *r, uint64_t addr, uint64_t n, void *buf, c
         ES_FAIL(r->ctx, ES_EFORMAT, "store: '%s' is corrupt: %s (%llu bytes at %llu) lies past "
                 "the end of the file (%llu bytes)", r->path, what, (unsigned long long)n,
                 (unsigned long long)at, (unsigned long long)r->eof);
+    if (r->mem) {
+        memcpy(buf, r->mem + at, (size_t)n);
+        return ES_OK;
+    }
     for (uint64_t done = 0; done < n;) {
         ssize_t k = pread(r->fd, (char *)buf + done, (size_t)(n - done), (off_t)(at + done));
         if (k < 0 && errno == EINTR) continue;

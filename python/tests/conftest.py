@@ -56,6 +56,17 @@ def base_store(faces_dir, tmp_path_factory):
     return path
 
 
+def copy_store(src, dst):
+    """A copy of a store with its results: the file and, for format 3, the
+    folder of result files beside it (`<store>.results/`), as the README
+    says to copy them."""
+    shutil.copyfile(src, dst)
+    side = f"{src}.results"
+    if os.path.isdir(side):
+        shutil.copytree(side, f"{dst}.results")
+    return dst
+
+
 @pytest.fixture
 def store_path(base_store, tmp_path):
     """A fresh copy of the synthetic store for one test."""

@@ -150,7 +150,9 @@ def test_gpa_and_compare(store_path, cli_copy, tmp_path, cli, ctx):
         assert np.allclose(g.mean, g.aligned.mean(0), rtol=0, atol=1e-12)
         c = s.compare("g", by="expression", permutations=99, name="g")
     # the binding's GPA is the command's, dataset by dataset
-    with h5py.File(store_path, "r") as a, h5py.File(cli_copy, "r") as b:
+    # each result is its own file beside the store (format 3), laid out as inside one
+    with h5py.File(f"{store_path}.results/gpa/g.h5", "r") as a, \
+            h5py.File(f"{cli_copy}.results/gpa/g.h5", "r") as b:
         for ds in ("aligned", "mean", "pc_sdev", "pc_scores", "pc_loadings", "rotation"):
             assert np.array_equal(a["analysis/gpa/g/" + ds][()], b["analysis/gpa/g/" + ds][()])
     _, DL = columns(tmp_path / "cmp" / "distances_lengths.csv", 1)

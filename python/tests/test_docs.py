@@ -85,7 +85,7 @@ def test_r_snippets_of_the_store_format(package, doc_store, ctx):
     with es.Store(doc_store / "faces.h5", ctx=ctx) as s:
         L = s.lengths()
         N, E = L.shape
-        want = [str(E), str(N), str(E), "10", s.ids[0], s.label("expression")[0], "1"]
+        want = [str(E), str(N), str(E), "10", s.ids[0], s.label("expression")[0], "3"]
         if package == "hdf5r":
             want += s.columns
         want += ["%.17g" % v for v in L[1, :3]]   # R's column 2 is row 1

@@ -26,7 +26,8 @@ def test_a_store_point_matches_the_command(store_path, tmp_path, cli, ctx):
         assert np.array_equal(V, s.mesh.read_positions(tmp_path / "cli.ply"))
         assert np.array_equal(F, s.faces)
     # the report is the stored one, field by field (%.17g attributes)
-    with h5py.File(cli_store, "r") as f:
+    # each result is its own file beside the store (format 3), laid out as inside one
+    with h5py.File(f"{cli_store}.results/embed/e.h5", "r") as f:
         attrs = dict(f["analysis/embed/e"].attrs)
     def text(v):
         return v.decode() if isinstance(v, bytes) else str(v)

@@ -29,7 +29,7 @@ pytest.importorskip("aiohttp")
 from edgespace.explore import Explorer, RequestError   # noqa: E402 (needs aiohttp)
 
 from browser import chromium, screenshot_dir, wait_for   # noqa: E402
-from conftest import cli_path   # noqa: E402
+from conftest import cli_path, copy_store   # noqa: E402
 
 URL_RE = re.compile(r"^(http://127\.0\.0\.1:(\d+)/\?token=([A-Za-z0-9_-]+))$", re.M)
 
@@ -207,9 +207,21 @@ def test_bad_positions_are_refused_with_a_message(cold, coords, message):
     assert cold.embed({"pc1": 0.5}).expr == "mean + 0.5*pc:1"   # and it goes on
 
 
+def stored_digest(store):
+    """SHA-256 over a store's file and every result file beside it."""
+    h = hashlib.sha256(store.read_bytes())
+    for root, dirs, files in sorted(os.walk(f"{store}.results")):
+        dirs.sort()
+        for name in sorted(files):
+            h.update(name.encode())
+            with open(os.path.join(root, name), "rb") as f:
+                h.update(f.read())
+    return h.hexdigest()
+
+
 def test_saving_writes_a_mesh_and_a_point_and_nothing_else(study, tmp_path):
     store = tmp_path / "faces.h5"
-    shutil.copyfile(study, store)
+    copy_store(study, store)
     digest = hashlib.sha256(store.read_bytes()).hexdigest()
     ex = Explorer(store, pca="p", warm=False)
     try:
@@ -226,18 +238,19 @@ def test_saving_writes_a_mesh_and_a_point_and_nothing_else(study, tmp_path):
         with es.Store(store) as s:
             assert np.array_equal(s.mesh.read_positions(out["path"]), shape.V)
             pt = s.point_weights(shape.expr, pca="p")
-        with h5py.File(store, "r") as f:
+        with h5py.File(f"{store}.results/point/smile_ish.h5", "r") as f:   # beside it
             g = f["analysis/point/smile_ish"]
             assert np.array_equal(g["lengths"][()], pt.lengths)
             assert g.attrs["expression"] in (shape.expr, shape.expr.encode())
-        # a second save of that name: refused, nothing written
-        digest = hashlib.sha256(store.read_bytes()).hexdigest()
+        # a second save of that name: refused, nothing written (the store
+        # and its result files)
+        digest = stored_digest(store)
         with pytest.raises(RequestError, match="exists"):
             ex.save("smile_ish", shape, fmt="ply")
         with pytest.raises(RequestError, match="point/smile_ish"):
             ex.save("smile_ish", shape, fmt="obj")       # the file is new, the point is not
         assert not (tmp_path / "smile_ish.obj").exists()
-        assert hashlib.sha256(store.read_bytes()).hexdigest() == digest
+        assert stored_digest(store) == digest
         png = ex.save_png("view", b"\x89PNG\r\n\x1a\n")
         assert os.path.exists(png) and ex.saved["view.png"] == png
     finally:
@@ -446,7 +459,7 @@ def test_the_page_in_chromium(study, tmp_path):
                                        "node_modules", "three", "build", "three.module.js")):
         pytest.skip("three.js is not installed (tools/setup.sh: npm ci)")
     store = tmp_path / "faces.h5"
-    shutil.copyfile(study, store)
+    copy_store(study, store)
     srv = Server(store, "--pca", "p", "--cold")
     d = None
     try:

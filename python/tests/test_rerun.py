@@ -6,6 +6,8 @@ library's own embedding of a file: point (the same mesh written as OBJ:
 its ridge-regression weights and prior) against Store.embed of the array, numpy's edge
 lengths of the embedded mesh against the target, and a model refitted with
 the same seed."""
+import os
+
 import h5py
 import numpy as np
 import pytest
@@ -23,10 +25,12 @@ def test_a_stored_pca_is_refused_then_replaced(store_path, ctx):
             s.pca("faces", ncomp=4)
         s.mean(by="expression", name="m")
         s.mean(by="expression", filter="expression=happy", name="m", replace=True)
-    with h5py.File(store_path, "r") as f:
+    # each result a file beside the store (format 3), laid out as inside one
+    with h5py.File(f"{store_path}.results/pca/faces.h5", "r") as f:
         g = f["analysis/pca/faces"]
         assert np.allclose(g["eigenvalues"][:], p.eigenvalues, rtol=0, atol=0)
         assert g["eigenvalues"].shape == (2,)
+    with h5py.File(f"{store_path}.results/mean/m.h5", "r") as f:
         assert f["analysis/mean/m/means"].shape[0] == 1   # one group: happy
 
 
@@ -42,6 +46,7 @@ def test_delete_result_and_what_is_left(store_path, ctx):
         assert "pca" not in s.results()
     with h5py.File(store_path, "r") as f:
         assert "pca" not in f.get("analysis", {})
+    assert not os.path.exists(f"{store_path}.results/pca")   # the kind's folder went too
 
 
 def test_read_handle_cannot_replace(store_path, ctx):

@@ -308,8 +308,8 @@ static void check_layout(es_ctx *ctx, const char *tag)
         ES_CHECK(f >= 0);
         if (f < 0) continue;
         attr_str(f, "topology_kind", kind, sizeof kind);
-        ES_CHECK_MSG(attr_i64(f, "format_version") == (i < 2 ? 2 : 1), "%s", kinds[i]);
-        ES_CHECK_MSG(!strcmp(kind, i < 2 ? kinds[i] : ""), "%s: kind '%s'", kinds[i], kind);
+        ES_CHECK_MSG(attr_i64(f, "format_version") == 3, "%s", kinds[i]);
+        ES_CHECK_MSG(!strcmp(kind, kinds[i]), "%s: kind '%s'", kinds[i], kind);
         if (i < 2) ES_CHECK(ds_rows(f, "/topology/faces", &d1) == 0 && d1 == 3);
         ES_CHECK((ds_rows(f, "/topology/edges", &d1) == 0) == (i == 0) && d1 == 2);
         ES_CHECK((ds_rows(f, "/shapes/lengths", NULL) < 0) == (i == 0));
@@ -318,7 +318,7 @@ static void check_layout(es_ctx *ctx, const char *tag)
         H5Fclose(f);
     }
     /* tampered copies of the truss store: the format checks refuse them */
-    static const char *const bad[3] = {"blob", NULL, "version3"};
+    static const char *const bad[3] = {"blob", NULL, "version4"};
     for (int i = 0; i < 3; i++) {
         char q[760], cmd[1600];
         es_store *s = NULL;
@@ -330,14 +330,14 @@ static void check_layout(es_ctx *ctx, const char *tag)
         if (i == 0) set_attr_str(f, "topology_kind", bad[i]);
         if (i == 1) H5Adelete(f, "topology_kind");
         if (i == 2) {
-            int64_t v = 3;
+            int64_t v = 4;
             hid_t a = H5Aopen(f, "format_version", H5P_DEFAULT);
             H5Awrite(a, H5T_NATIVE_INT64, &v);
             H5Aclose(a);
         }
         H5Fclose(f);
         ES_CHECK_FAILS(ctx, es_store_open(ctx, q, ES_STORE_READ, &s), ES_EFORMAT,
-                       i == 0 ? "topology_kind 'blob'" : i == 1 ? "topology_kind" : "version 3");
+                       i == 0 ? "topology_kind 'blob'" : i == 1 ? "topology_kind" : "version 4");
         ES_CHECK(s == NULL);
         unlink(q);
     }

@@ -3,7 +3,7 @@
 from the sources on every test run:
 
   1. lib/<module>/ includes only modules at or below its own place in the data
-     flow (core < mesh < meshio < store < ingest < stats < procrustes < embed <
+     flow (core < parallel < mesh < meshio < store < ingest < stats < procrustes < embed <
      morph < study < figure, synth), whether through their library-private headers or
      their public headers; siblings (figure, synth) do not include each other;
      the numerical modules (stats, procrustes, embed, morph) take arrays and row
@@ -13,7 +13,7 @@ from the sources on every test run:
   3. the include graph has no circles;
   4. no file in lib/ is over 800 lines, no command file (tools/cmd/) over 250;
   5. hdf5.h only under lib/store, cholmod.h only under lib/embed, cairo.h only
-     under lib/figure (among lib/, tools/ and notebooks-c/);
+     under lib/figure, mpi.h only under lib/parallel (among lib/, tools/ and notebooks-c/);
   6. tools/ and notebooks-c/ include no private header of the library.
 
 Usage: check_layout.py SOURCE_ROOT. Prints every violation; exit 1 if any.
@@ -22,12 +22,13 @@ import os
 import re
 import sys
 
-ORDER = ["core", "mesh", "meshio", "store", "ingest", "stats", "procrustes", "embed",
+ORDER = ["core", "parallel", "mesh", "meshio", "store", "ingest", "stats", "procrustes", "embed",
          "morph", "study", "figure", "synth"]
 LEVEL = {m: i for i, m in enumerate(ORDER)}
 LEVEL["synth"] = LEVEL["figure"]          # beside figure, above study
 PUBLIC = {
-    "es_core.h": "core", "es_mesh.h": "mesh", "es_geom.h": "mesh", "es_io.h": "meshio",
+    "es_core.h": "core", "es_parallel.h": "parallel", "es_mesh.h": "mesh",
+    "es_geom.h": "mesh", "es_io.h": "meshio",
     "es_store.h": "store", "es_ingest.h": "ingest", "es_landmarks.h": "ingest",
     "es_stats.h": "stats", "es_point.h": "stats", "es_model.h": "stats",
     "es_procrustes.h": "procrustes",
@@ -40,6 +41,7 @@ FOREIGN = {  # header pattern -> the only module that may include it
     re.compile(r"^(hdf5|H5[A-Za-z]*)\.h$"): "store",
     re.compile(r"^cholmod[a-z_]*\.h$"): "embed",
     re.compile(r"^cairo[a-z-]*\.h$"): "figure",
+    re.compile(r"^mpi\.h$"): "parallel",
 }
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]', re.M)
 LIB_MAX, CMD_MAX = 800, 250

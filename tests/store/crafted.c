@@ -16,6 +16,19 @@ enum { V = 4, F = 4, E = 6, N = 3 };
 static const int64_t faces[3 * F] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
 static const int64_t edges[2 * E] = {0, 1, 0, 2, 0, 3, 1, 2, 1, 3, 2, 3};
 
+int crafted_make_legacy(const char *path)
+{
+    const int64_t two = 2;
+    hid_t f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT), a = -1;
+    int bad = f < 0;
+    if (!bad && H5Aexists(f, "store_id") > 0) bad |= H5Adelete(f, "store_id") < 0;
+    if (!bad) bad |= (a = H5Aopen(f, "format_version", H5P_DEFAULT)) < 0 ||
+                     H5Awrite(a, H5T_NATIVE_INT64, &two) < 0;
+    if (a >= 0) H5Aclose(a);
+    if (f >= 0) H5Fclose(f);
+    return bad ? -1 : 0;
+}
+
 int crafted_base(const char *path)
 {
     static const double base[3 * V] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
@@ -45,8 +58,13 @@ int crafted_base(const char *path)
     es_provenance prov = {"crafted", NULL, -1, "k=1"};
     remove(path);
     if (es_ctx_new(&ctx) != ES_OK) return -1;
+    /* a version-2 store (results inside it): the layout this suite crafts;
+     * results beside a version-3 store are crafted by test_store_results */
     if (es_mesh_new(ctx, V, F, faces, base, &mesh) == ES_OK &&
         es_store_create(ctx, path, mesh, &s) == ES_OK && es_store_append(ctx, s, &r) == ES_OK &&
+        es_store_commit(ctx, s) == ES_OK && (es_store_close(s), s = NULL, 1) &&
+        crafted_make_legacy(path) == 0 &&
+        es_store_open(ctx, path, ES_STORE_WRITE, &s) == ES_OK &&
         es_store_result_begin(ctx, s, "mean", "m", &prov) == ES_OK &&
         es_store_put_matrix(ctx, s, "mean/m/means", (es_mat){len, E, 2, E}) == ES_OK &&
         es_store_put_ints(ctx, s, "mean/m/counts", counts, 2) == ES_OK &&

@@ -27,8 +27,12 @@ typedef struct crafted_mutation {
 } crafted_mutation;
 
 /* The base store (a tetrahedron, 3 rows, label columns grp and subj, a mean
- * result mean/m) at path; 0 on success. */
+ * result mean/m inside it: format version 2) at path; 0 on success. */
 int crafted_base(const char *path);
+/* Turn the store at path (no results yet) into format version 2, as
+ * earlier releases wrote it (no store_id): results go inside it. 0 on
+ * success. */
+int crafted_make_legacy(const char *path);
 
 extern const crafted_mutation crafted_mutations[];
 extern const int crafted_nmutations;

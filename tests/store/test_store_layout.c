@@ -8,15 +8,16 @@
 #include "es_test_meshes.h"
 #include "edgespace/edgespace.h"
 
-static char store[4200];
+static char store[4200], store_file[4300];
+static const char *target = store;   /* the file dumped: the store or a result beside it */
 
-/* Output of `h5dump ARGS store` (malloc'd), or NULL. */
+/* Output of `h5dump ARGS target` (malloc'd), or NULL. */
 static char *dump(const char *args)
 {
     char cmd[8600], *buf = NULL;
     size_t n = 0, cap = 0, r;
     FILE *p;
-    snprintf(cmd, sizeof cmd, "h5dump %s '%s' 2>&1", args, store);
+    snprintf(cmd, sizeof cmd, "h5dump %s '%s' 2>&1", args, target);
     if (!(p = popen(cmd, "r"))) return NULL;
     do {
         if (n + 4096 + 1 > cap) {
@@ -76,8 +77,10 @@ int main(void)
     }
     es_store_close(s);
 
-    /* root: format version 1 */
-    EXPECT("-a /format_version", "H5T_STD_I64LE", "SCALAR", "(0): 1");
+    /* root: format version 3, its topology kind and id */
+    EXPECT("-a /format_version", "H5T_STD_I64LE", "SCALAR", "(0): 3");
+    EXPECT("-a /topology_kind", VSTR, "\"mesh\"");
+    EXPECT("-a /store_id", VSTR, "SCALAR");
     EXPECT("-a /creator", VSTR, "\"edgespace ");
     /* topology: F x 3 and E x 2 int64, nverts, fingerprint */
     EXPECT("-p -H -d /topology/faces", "H5T_STD_I64LE", "SIMPLE { ( 120, 3 ) / ( 120, 3 ) }");
@@ -102,13 +105,19 @@ int main(void)
     EXPECT("-d /labels/expression", VSTR, "SIMPLE { ( 3 ) / ( H5S_UNLIMITED ) }",
            "(0): \"neutral\", \"happy\", \"neutral\"");
     EXPECT("-d /labels/subject", "(0): \"s1\", \"s1\", \"s2\"");
-    /* analysis results with provenance */
+    /* analysis results with provenance, each in its own file beside the
+     * store (format 3) that carries the store's id; none inside the store */
+    EXPECT("-g /analysis/pca", "unable to open group");
+    snprintf(store_file, sizeof store_file, "%s.results/pca/all.h5", store);
+    target = store_file;
+    EXPECT("-a /store_id", VSTR, "SCALAR");
     EXPECT("-a /analysis/pca/all/command", VSTR, "\"edgespace pca\"");
     EXPECT("-a /analysis/pca/all/tool_version", "\"edgespace ");
     EXPECT("-a /analysis/pca/all/time", "Z\"");
     EXPECT("-a /analysis/pca/all/params", "\"k=2\"");
     EXPECT("-d /analysis/pca/all/input_rows", "H5T_STD_I64LE", "(0): 0, 1, 2");
     EXPECT("-d /analysis/pca/all/eigenvalues", "H5T_IEEE_F64LE", "(0): 1, 2, 3");
+    target = store;
     /* the lengths read by h5dump are the library's: row 1 sums to 1 */
     {
         char *out = dump("-d /shapes/lengths -s 1,0 -c 1,180 -m %.17g");

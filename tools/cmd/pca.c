@@ -95,8 +95,14 @@ int cmd_pca(int argc, char **argv)
     es_pca *p = NULL;
     int64_t *rows = NULL, nrows = 0;
     int ret = CLI_FAIL;
-    es_status rc = es_store_open(ctx, argv[optind], wmode, &st);
-    if (rc == ES_OK) rc = es_study_pca(ctx, st, name, where, &o, cmdline, &p, &rows, &nrows);
+    /* on the ranks of an MPI job every rank reads and fits (collectively),
+     * rank 0 alone writes; a refusal before the fit is agreed on by all */
+    const int writer = es_ctx_rank(ctx) == 0;
+    es_status rc = es_store_open(ctx, argv[optind], writer ? wmode : ES_STORE_READ, &st);
+    if (rc == ES_OK && writer) rc = es_store_result_check(ctx, st, "pca", name);
+    rc = es_ctx_agree(ctx, rc);
+    if (rc == ES_OK)
+        rc = es_study_pca(ctx, st, writer ? name : NULL, where, &o, cmdline, &p, &rows, &nrows);
     if (rc != ES_OK) {
         cli_fail("pca", ctx, rc);
         goto done;
@@ -113,8 +119,8 @@ int cmd_pca(int argc, char **argv)
     }
     if (p->ncomp > 10) printf("  ... (%lld more)\n", (long long)(p->ncomp - 10));
     /* the tables first: a failure leaves the store as it was */
-    if ((csv && (rc = es_study_write_pca_tables(ctx, st, p, rows, csv)) != ES_OK) ||
-        (rc = es_store_commit(ctx, st)) != ES_OK) {
+    if (writer && ((csv && (rc = es_study_write_pca_tables(ctx, st, p, rows, csv)) != ES_OK) ||
+                   (rc = es_store_commit(ctx, st)) != ES_OK)) {
         cli_fail("pca", ctx, rc);
         goto done;
     }

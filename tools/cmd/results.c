@@ -1,6 +1,8 @@
 /* tools/cmd/results.c — edgespace results: list a store's analysis results
- * (es_store_list_results) with when and how each was made, or delete some
- * (es_store_delete_result: all or nothing, at the commit). */
+ * (es_store_list_results) with when and how each was made, delete some
+ * (es_store_delete_result: all or nothing, at the commit), or upgrade a
+ * store of an earlier release so that its results live beside it
+ * (es_store_upgrade). */
 #include "cli.h"
 #include "commands.h"
 
@@ -12,15 +14,19 @@
 #define MAX_DELETE 64
 
 static const char usage[] =
-    "usage: edgespace results STORE [--kind KIND] [--delete KIND/NAME]...\n"
+    "usage: edgespace results STORE [--kind KIND] [--delete KIND/NAME]... [--upgrade]\n"
     "\n"
     "List the analysis results of STORE, one line each: KIND/NAME, when it was\n"
     "made and the command that made it (export --result KIND/NAME writes its\n"
     "tables). With --delete, remove the named results instead: all of them or,\n"
-    "when one is missing, none.\n"
+    "when one is missing, none. Results are files beside the store\n"
+    "(STORE.results/KIND/NAME.h5); a store of an earlier release (format 1 or 2)\n"
+    "keeps them inside, and each stored result copies it, until --upgrade moves\n"
+    "them out (one copy of the store).\n"
     "\n"
     "  -k, --kind KIND        list only results of KIND (mean, pca, gpa, model, ...)\n"
     "  -d, --delete KIND/NAME delete this result (repeat for several)\n"
+    "  -u, --upgrade          upgrade a store of format 1 or 2 to format 3\n"
     "  -h, --help             show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -56,13 +62,15 @@ int cmd_results(int argc, char **argv)
 {
     static const struct option lo[] = {
         {"kind", required_argument, NULL, 'k'}, {"delete", required_argument, NULL, 'd'},
-        {"help", no_argument, NULL, 'h'}, {NULL, 0, NULL, 0}};
+        {"upgrade", no_argument, NULL, 'u'}, {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0}};
     const char *kind = NULL, *del[MAX_DELETE];
-    int ndel = 0, c;
+    int ndel = 0, c, upgrade = 0;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "k:d:h", lo, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "k:d:uh", lo, NULL)) != -1) {
         switch (c) {
         case 'k': kind = optarg; break;
+        case 'u': upgrade = 1; break;
         case 'd':
             if (ndel == MAX_DELETE) return cli_usage_error(VERB, "too many --delete");
             if (!strchr(optarg, '/') || strchr(optarg, '/') == optarg)
@@ -78,7 +86,12 @@ int cmd_results(int argc, char **argv)
     es_ctx *ctx = cli_ctx_new(VERB);
     if (!ctx) return CLI_FAIL;
     es_store *s = NULL;
-    es_status rc = es_store_open(ctx, argv[optind], ndel ? ES_STORE_WRITE : ES_STORE_READ, &s);
+    es_status rc = es_store_open(ctx, argv[optind], ndel || upgrade ? ES_STORE_WRITE : ES_STORE_READ,
+                                 &s);
+    int before = es_store_format_version(s);
+    if (rc == ES_OK && upgrade && (rc = es_store_upgrade(ctx, s)) == ES_OK)
+        printf("%s: format %d%s\n", argv[optind], es_store_format_version(s),
+               before == es_store_format_version(s) ? " already" : " (upgraded)");
     for (int i = 0; rc == ES_OK && i < ndel; i++) {
         char k[128];
         size_t len = (size_t)(strchr(del[i], '/') - del[i]);
@@ -86,7 +99,7 @@ int cmd_results(int argc, char **argv)
         rc = es_store_delete_result(ctx, s, k, del[i] + len + 1);
     }
     if (rc == ES_OK && ndel) rc = es_store_commit(ctx, s);
-    if (rc == ES_OK && !ndel) rc = list(ctx, s, kind);
+    if (rc == ES_OK && !ndel && !upgrade) rc = list(ctx, s, kind);
     if (rc == ES_OK)
         for (int i = 0; i < ndel; i++) printf("deleted %s\n", del[i]);
     int ret = rc == ES_OK ? CLI_OK : cli_fail(VERB, ctx, rc);

@@ -7,6 +7,7 @@
 
 #include "es_config.h"
 #include "es_core.h"        /* core */
+#include "es_parallel.h"    /* parallel */
 #include "es_mesh.h"        /* mesh */
 #include "es_geom.h"
 #include "es_io.h"          /* meshio */

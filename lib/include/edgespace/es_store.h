@@ -288,13 +288,27 @@ ES_API es_status es_store_list_results(es_ctx *ctx, es_store *store, const char 
  * array. */
 ES_API es_status es_store_list_attrs(es_ctx *ctx, es_store *store, const char *path,
                                      char ***keys, int64_t *n);
-/* Delete /analysis/<kind>/<name> (and the kind's group when it was the last
- * of its kind) in the working copy; like every write it becomes visible
- * at es_store_commit/es_store_close, and a failure leaves the store as it
- * was. HDF5 does not give the bytes back: the file keeps its size until it
- * is repacked (h5repack). ES_ENOTFOUND if there is no such result. */
+/* Delete result kind/name; like every write it becomes visible at
+ * es_store_commit/es_store_close, and a failure leaves the store as it
+ * was. Beside a store of version 3 its file is removed; inside one of
+ * version 1 or 2 the group is unlinked in the working copy, and HDF5 does
+ * not give the bytes back until the file is repacked (h5repack).
+ * ES_ENOTFOUND if there is no such result. */
 ES_API es_status es_store_delete_result(es_ctx *ctx, es_store *store, const char *kind,
                                         const char *name);
+
+/* The store's format version (datasets-spec/store-format.md): 3 for every
+ * store written since 0.2, whose results are files beside it
+ * (<store>.results/<kind>/<name>.h5, published without copying the store);
+ * 1 or 2 for a store of an earlier release, whose results stay inside it
+ * (each commit copies the store) until it is upgraded. */
+ES_API int es_store_format_version(const es_store *store);
+/* Upgrade a store of version 1 or 2, opened for writing with nothing
+ * uncommitted, to version 3: its results are moved to files beside it and
+ * the store is published once more (one copy); ES_OK at once for version 3.
+ * The result files are published before the store, so a failure or crash
+ * part way leaves the old store as it was (the new files are not yet its). */
+ES_API es_status es_store_upgrade(es_ctx *ctx, es_store *store);
 
 /* ---- statismo shape models --------------------------------------------
  * A linear shape model mean + sum_k b_k sqrt(variance_k) basis_k (b ~

@@ -1,0 +1,144 @@
+/* tests/parallel/test_parallel_cli.c — `mpirun -n P edgespace pca STORE`
+ * (the -Dmpi=enabled build) stores the result one process stores: the same
+ * eigenvalues, components and scores to 1e-12, for the Gram and the
+ * randomized route, at P = 2 and 4; the store file itself is untouched
+ * (results live beside it), a taken name is refused by all ranks with one
+ * message, and a command that does not run on ranks yet says so.
+ *
+ * Usage: test_parallel_cli MPIRUN (meson passes the mpirun it found). */
+#include "edgespace/edgespace.h"
+#include "es_test.h"
+#include "es_test_files.h"
+#include "es_test_meshes.h"
+#include "es_test_run.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *mpirun, *dir;
+static char store[800];
+
+/* `mpirun -n P edgespace ARGS`, stderr into err; its exit status. */
+static int run_mpi(int P, const char *args, char *err, size_t n)
+{
+    char cmd[4096], errfile[900];
+    snprintf(errfile, sizeof errfile, "%s/mpi.err", dir);
+    snprintf(cmd, sizeof cmd, "'%s' -n %d --oversubscribe --allow-run-as-root '%s' %s "
+             ">'%s/mpi.out' 2>'%s'", mpirun, P, es_test_edgespace(), args, dir, errfile);
+    int st = system(cmd);
+    es_test_read_small(errfile, err, n);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : 128;
+}
+
+static double maxdiff(const double *a, const double *b, int64_t n)
+{
+    double m = 0;
+    for (int64_t i = 0; i < n; i++) m = fmax(m, fabs(a[i] - b[i]));
+    return m;
+}
+
+static double maxabs(const double *a, int64_t n)
+{
+    double m = 0;
+    for (int64_t i = 0; i < n; i++) m = fmax(m, fabs(a[i]));
+    return m;
+}
+
+/* pca/<a> and pca/<b> agree: eigenvalues and scores to 1e-12 of their
+ * scale, components to 1e-9 (unit vectors). */
+static void same_pca(es_ctx *ctx, const char *a, const char *b)
+{
+    es_store *s = NULL;
+    ES_CHECK_OK(ctx, es_store_open(ctx, store, ES_STORE_READ, &s));
+    if (!s) return;
+    static const char *const ds[] = {"eigenvalues", "mean", "components", "scores"};
+    for (int k = 0; k < 4; k++) {
+        char pa[200], pb[200];
+        es_mat ma = {0}, mb = {0};
+        snprintf(pa, sizeof pa, "pca/%s/%s", a, ds[k]);
+        snprintf(pb, sizeof pb, "pca/%s/%s", b, ds[k]);
+        if (k < 2) {
+            ES_CHECK_OK(ctx, es_store_get_vector(ctx, s, pa, &ma.data, &ma.rows));
+            ES_CHECK_OK(ctx, es_store_get_vector(ctx, s, pb, &mb.data, &mb.rows));
+            ma.cols = mb.cols = 1;
+        } else {
+            ES_CHECK_OK(ctx, es_store_get_matrix(ctx, s, pa, &ma));
+            ES_CHECK_OK(ctx, es_store_get_matrix(ctx, s, pb, &mb));
+        }
+        int64_t n = ma.rows * ma.cols;
+        ES_CHECK_MSG(ma.data && mb.data && ma.rows == mb.rows && ma.cols == mb.cols, "%s vs %s: "
+                     "%s shapes differ", a, b, ds[k]);
+        if (ma.data && mb.data && ma.rows == mb.rows && ma.cols == mb.cols) {
+            double tol = k == 2 ? 1e-9 : 1e-12 * maxabs(ma.data, n) + 1e-300;
+            ES_CHECK_MSG(maxdiff(ma.data, mb.data, n) <= tol, "%s vs %s: %s differ by %g", a, b,
+                         ds[k], maxdiff(ma.data, mb.data, n));
+        }
+        es_free(ctx, ma.data);
+        es_free(ctx, mb.data);
+    }
+    es_store_close(s);
+}
+
+int main(int argc, char **argv)
+{
+    ES_TEST_BEGIN();
+    if (argc < 2) ES_TEST_SKIP("give the mpirun to use");
+    mpirun = argv[1];
+    es_ctx *ctx = NULL;
+    es_test_out r;
+    char m[900], p[900], err[65536], args[1200];
+    ES_CHECK(es_ctx_new(&ctx) == ES_OK);
+    dir = es_test_tmpdir("parallel-cli");
+    snprintf(store, sizeof store, "%s/s.h5", dir);
+    snprintf(m, sizeof m, "%s/m.csv", dir);
+    FILE *f = fopen(m, "w");
+    ES_CHECK(f != NULL);
+    if (!f) ES_TEST_END();
+    fprintf(f, "file,grp\n");
+    for (int k = 0; k < 9; k++) {
+        snprintf(p, sizeof p, "%s/shape%d.obj", dir, k);
+        ES_CHECK(es_test_write_torus(p, 14, 8, k) == 0);
+        fprintf(f, "shape%d.obj,%c\n", k, "ab"[k % 2]);
+    }
+    fclose(f);
+    ES_CHECK_OK(ctx, es_ingest_manifest(ctx, store, m, NULL, NULL));
+    size_t nbase = 0;
+    char *base = es_test_slurp(store, &nbase);
+
+    ES_RUN(&r, dir, "pca", store, "--name", "serial");
+    ES_CHECK_MSG(r.status == 0, "%s", r.err);
+    ES_RUN(&r, dir, "pca", store, "--name", "serial_rand", "--method", "randomized",
+           "--components", "4", "--seed", "7");
+    ES_CHECK_MSG(r.status == 0, "%s", r.err);
+    for (int P = 2; P <= 4; P += 2) {
+        char name[32], rname[32];
+        snprintf(name, sizeof name, "np%d", P);
+        snprintf(rname, sizeof rname, "np%d_rand", P);
+        snprintf(args, sizeof args, "pca '%s' --name %s", store, name);
+        ES_CHECK_MSG(run_mpi(P, args, err, sizeof err) == 0, "mpirun -n %d pca: %s", P, err);
+        same_pca(ctx, "serial", name);
+        snprintf(args, sizeof args, "pca '%s' --name %s --method randomized --components 4 "
+                 "--seed 7", store, rname);
+        ES_CHECK_MSG(run_mpi(P, args, err, sizeof err) == 0, "mpirun -n %d pca randomized: %s",
+                     P, err);
+        same_pca(ctx, "serial_rand", rname);
+        /* the name is taken now: every rank refuses, rank 0 says so once */
+        snprintf(args, sizeof args, "pca '%s' --name %s", store, name);
+        ES_CHECK_MSG(run_mpi(P, args, err, sizeof err) != 0 && strstr(err, "exists already"),
+                     "mpirun -n %d pca again: %s", P, err);
+        char *first = strstr(err, "exists already");
+        ES_CHECK_MSG(first && !strstr(first + 1, "exists already"), "the refusal is not said "
+                     "once: %s", err);
+    }
+    /* a command that does not run on ranks yet */
+    snprintf(args, sizeof args, "mean '%s' --no-store", store);
+    ES_CHECK_MSG(run_mpi(2, args, err, sizeof err) != 0 && strstr(err, "does not run on the "
+                 "ranks"), "mpirun mean: %s", err);
+    /* results live beside the store: its file never changed */
+    ES_CHECK(base && es_test_same_bytes(store, base, nbase));
+    free(base);
+    es_ctx_free(ctx);
+    ES_TEST_END();
+}
