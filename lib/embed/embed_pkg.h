@@ -94,6 +94,8 @@ struct es_embedder {
     cholmod_factor *F1;
     cholmod_dense *LB, *LX, *LY, *LE;
     double *lg_w, *lg_rest, *lg_work, lg_eps;
+    double *lg_wf;         /* the weights F1 was factored with */
+    int lg_have_factor;    /* F1 holds a numeric factor of A1 with lg_wf */
     es__lbfgs lg_hist;
 };
 
@@ -251,6 +253,10 @@ typedef struct es__lg_opts {
     int max_iter, history;
     double rms_tol, max_tol, rtol;
     int verbose;
+    /* > 0: keep the factor of an earlier solve while no edge's weight moved
+     * more than this fraction from the weights it was made with (a warm
+     * start: the next frame of a walk or slider); 0: factor every solve */
+    double factor_reuse;
 } es__lg_opts;
 
 typedef struct es__lg_result {
@@ -290,6 +296,8 @@ typedef struct es__solve_ext {
                                  lengths, and keep the closer start */
     double start_max_rms;
     const double *align_ref;  /* align the output to this (3 x V) */
+    int warm;                 /* start_xyz is an earlier solve's output corrected (a walk,
+                                 a slider): the solver may keep that solve's factor */
     es__bend_prior *bp;       /* NULL: lengths only */
 } es__solve_ext;
 

@@ -567,7 +567,7 @@ void es_embedder_free(es_embedder *emb)
                     emb->jw, emb->fanwork, emb->fanr, emb->fanth, emb->fanal, emb->vclos,
                     emb->verr, emb->flap, emb->omega, emb->prior_alpha, emb->vdev,
                     emb->perm, emb->pinv, emb->eslot, emb->eswap, emb->vslot,
-                    emb->lg_w, emb->lg_rest, emb->lg_work};
+                    emb->lg_w, emb->lg_wf, emb->lg_rest, emb->lg_work};
     for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++) es__free(ctx, bufs[i]);
     es__lbfgs_free(ctx, &emb->lg_hist);
     es__free(ctx, emb);

@@ -236,6 +236,7 @@ es_status es_embed_prior_solve(es_ctx *ctx, es_embedder *emb, const double *targ
     /* a closed mesh without the term: the dihedral path from the prior's
      * dihedrals, which is what interpolation does */
     ext.start_xyz = bend ? (prior->start ? prior->start : prior->xyz) : NULL;
+    ext.warm = bend && prior->start;
     ext.start_auto = 1;
     ext.start_max_rms = opts->prior_start_max_rms;
     ext.align_ref = prior->xyz;

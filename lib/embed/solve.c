@@ -271,12 +271,14 @@ static int shape_iters(const es_embed_opts *o)
  * lengths) is solved to a third of the tolerances. The report measures the
  * output against the asked lengths and says how far the projection went. */
 static es_status shape_from_start(es_embedder *emb, const es_embed_opts *o, es__bend_prior *bp,
-                                  const double *L, double *xyz, es_embed_report *rep)
+                                  const double *L, int warm, double *xyz, es_embed_report *rep)
 {
     const double *Lr = L;
     es__lg_result res;
+    /* a warm start keeps the last factor while the weights are within 10 %
+     * of its own (local_global.c: assemble) */
     es__lg_opts lo = {shape_iters(o), o->lg_history, o->lg_rms_tol, o->lg_max_tol, o->lg_rtol,
-                      o->verbose};
+                      o->verbose, warm ? 0.1 : 0};
     es_status rc;
     if (rep->n_bad_faces > 0 && o->realize_margin >= 0) {
         rep->n_projected = es__lengths_project(emb, L, o->realize_margin, emb->len,
@@ -403,7 +405,8 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
             return rc;
         es__progress(ctx, "embedding", 1, emb->progress_total);
         t1 = now_s();
-        rc = lg ? shape_from_start(emb, o, bp, L, xyz, &rep) : refine_from_start(emb, o, bp, L, xyz, &rep);
+        rc = lg ? shape_from_start(emb, o, bp, L, ext && ext->warm, xyz, &rep)
+                : refine_from_start(emb, o, bp, L, xyz, &rep);
         if (rc != ES_OK) return rc;
         rep.t_refine = now_s() - t1;
         es__progress(ctx, "embedding", emb->progress_total, emb->progress_total);
