@@ -247,6 +247,16 @@ void *es__calloc(es_ctx *ctx, size_t n, size_t size)
         es__fail(ctx, ES_ENOMEM, "allocation size overflows (%zu x %zu bytes)", n, size);
         return NULL;
     }
+    if (!ctx->has_alloc) {
+        /* libc's calloc hands out fresh pages of a large block as the kernel
+         * zeroed them, untouched: a memset here touched every page of every
+         * large buffer (a fresh `embed` spent 10 % of its CPU zeroing, and
+         * as much again in the page faults it took) */
+        p = calloc(bytes ? bytes : 1, 1);
+        if (!p) es__fail(ctx, ES_ENOMEM, "out of memory (%zu bytes)", bytes);
+        if (p && bytes >= ((size_t)4 << 20)) es__advise_huge(p, bytes);
+        return p;
+    }
     p = es__malloc(ctx, bytes);
     if (p && bytes >= ((size_t)4 << 20)) es__advise_huge(p, bytes);
     if (p) memset(p, 0, bytes ? bytes : 1);
