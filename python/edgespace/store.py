@@ -772,16 +772,40 @@ class Store:
         return p
 
     def interp(self, from_=None, to=None, steps=9, t0=0.0, t1=1.0, weights=None, pca=None,
-               name=None, output=None, cold=False, replace=False, **opts):
+               name=None, output=None, cold=False, replace=False, method="edge-length",
+               knn=None, sigma=None, seed=None, tries=None, **opts):
         """A walk from `from_` (t = t0) to `to` (t = t1) in `steps` frames, or one
         weighted combination of rows (weights="0.3*row:a + 0.7*row:b"), each
         frame embedded as es_study_interp embeds it: from the last frame's
         correction of its prior (a warm start), or with cold=True from its own
         prior, as embed() does. Returns a list of Embedding (report["t_heading"]
         says which t). output: a mesh file pattern ("walk_%02d.obj") to keep the
-        frames; name stores them."""
+        frames; name stores them.
+
+        method: as `edgespace interp --method`: "edge-length" (the above),
+        "multiscale" (Winkler et al. 2010; tries hierarchies from seed on),
+        "shape-space" (Wuhrer et al. 2010), "data-driven" and
+        "data-driven-el" (Gao et al. 2017; knn neighbours per row, sigma the
+        examples' fall-off), "paper" (the published pipeline) or
+        "conformal" (from_ mapped to the sphere, t its k; no `to`). The
+        other methods join two rows: from_="row:A", to="row:B"."""
         o = ffi.new("es_study_interp_opts *")
         lib.es_study_interp_opts_init(o)
+        m = ffi.new("es_morph_method *")
+        self.ctx.call(lib.es_morph_method_from_name, _s(str(method)), m)
+        o.method = m[0]
+        if knn is not None:
+            o.path.knn = A.index(knn, "knn")
+            if o.path.knn < 1:
+                raise ValueError(f"interp: knn={knn!r}; it wants a count >= 1")
+        if sigma is not None:
+            if not float(sigma) > 0:
+                raise ValueError(f"interp: sigma={sigma!r}; it wants a positive number")
+            o.path.sigma = float(sigma)
+        if tries is not None:
+            if not 1 <= int(tries) <= 64:
+                raise ValueError(f"interp: tries={tries!r}; it wants 1 .. 64")
+            o.multiscale.tries = int(tries)
         frames = []
 
         def on_frame(ud, i, n, path, heading, report):
@@ -798,8 +822,14 @@ class Store:
             o.cold = 1 if cold else 0
             o.frame = cb
             set_embed_opts(o.embed, opts)
-            with self._replacing(replace):
-                self._call(lib.es_study_interp, o)
+            old_seed = self.ctx.seed
+            if seed is not None:   # the multiscale hierarchies' seeds, as --seed
+                self.ctx.seed = seed
+            try:
+                with self._replacing(replace):
+                    self._call(lib.es_study_interp, o)
+            finally:
+                self.ctx.seed = old_seed
             out = []
             F = self.mesh.faces
             for i, path, heading, rep in sorted(frames):

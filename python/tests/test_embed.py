@@ -174,3 +174,33 @@ def test_sessions_embed_as_the_command_and_keep_their_work(store_path, faces_dir
         assert s.embed("mean").V.shape == cold[0].shape
     with pytest.raises(ValueError, match="closed"):
         se.embed("mean")
+
+
+@pytest.mark.parametrize("method, extra, cli_extra", [
+    ("multiscale", {"seed": 5, "tries": 2}, ["--seed", "5", "--tries", "2"]),
+    ("data-driven-el", {"knn": 3, "sigma": 2.0}, ["--knn", "3", "--sigma", "2"]),
+])
+def test_interp_takes_the_commands_methods(store_path, tmp_path, cli, ctx, method, extra,
+                                           cli_extra):
+    """Store.interp(method=...) walks as `edgespace interp --method` does with
+    the same options: the command's frame files are the oracle, frame by
+    frame (written by the same library; each run alone)."""
+    a, b = "row:face_s01_neutral", "row:face_s01_happy"
+    pat = str(tmp_path / "c_%02d.obj")
+    cli("interp", store_path, "--from", a, "--to", b, "-k", "3", "--method", method,
+        *cli_extra, "-o", pat, "--no-store")
+    with es.Store(store_path, ctx=ctx) as s:
+        frames = s.interp(a, b, steps=3, method=method, **extra)
+        assert len(frames) == 3
+        for i, f in enumerate(frames):
+            V = s.mesh.read_positions(tmp_path / f"c_{i:02d}.obj")
+            assert np.allclose(f.V, V, rtol=0, atol=1e-6 * np.ptp(V)), (method, i)
+
+
+def test_interp_refuses_a_method_it_does_not_know(store_path, ctx):
+    with es.Store(store_path, ctx=ctx) as s:
+        with pytest.raises(es.Error, match="nope"):
+            s.interp("row:face_s01_neutral", "row:face_s01_happy", steps=3, method="nope")
+        with pytest.raises(ValueError, match="knn"):
+            s.interp("row:face_s01_neutral", "row:face_s01_happy", steps=3,
+                     method="data-driven", knn=0)
