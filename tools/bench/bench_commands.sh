@@ -29,9 +29,12 @@ held=${files[-1]}
     echo "file"
     for f in "${files[@]:0:${#files[@]}-3}"; do echo "$f"; done
 } > "$work/manifest.csv"
-"$new" ingest "$work/new.h5" --manifest "$work/manifest.csv" > /dev/null
-"$new" pca "$work/new.h5" --name default --components 5 > /dev/null
-cp "$work/new.h5" "$work/old.h5"
+# each build makes its own store (a build reads the store formats of its own
+# release and before: format 3 keeps results in files beside the store)
+for b in new old; do
+    "${!b}" ingest "$work/$b.h5" --manifest "$work/manifest.csv" > /dev/null
+    "${!b}" pca "$work/$b.h5" --name default --components 5 > /dev/null
+done
 echo "# $(basename "$data"): $(( ${#files[@]} - 3 )) rows; load average $(cut -d' ' -f1-3 /proc/loadavg)"
 printf "%-44s %18s %18s %8s %8s\n" "command" "new cpu / wall" "old cpu / wall" "cpu old/new" "wall"
 

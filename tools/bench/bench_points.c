@@ -17,13 +17,18 @@
  * CPU is the process's (clock_gettime CLOCK_PROCESS_CPUTIME_ID); run it
  * with nothing else on the machine for the wall times to mean anything.
  *
- *   bench_points [dataset [levels [frames]]]
+ *   bench_points [dataset [levels [frames [few]]]]
  *     dataset: face-study (default), sfm_surrey_face_3448, facecap_arkit, ...
  *     (a folder of ../shared/data with OBJ files in correspondence)
+ *     frames 0: no walks; "few": the mean and mean + 2 sd on PC 2 only, without
+ *     the previous solver (the scaling table's rows: 216K vertices take minutes
+ *     a point with it), each with its stages' times
  */
+#define _XOPEN_SOURCE 700   /* nftw */
 #include <edgespace/edgespace.h>
 
 #include <dirent.h>
+#include <ftw.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -110,6 +115,12 @@ static result embed(es_ctx *ctx, es_study_embedder *se, const char *pt, const es
     return x;
 }
 
+static int remove_one(const char *path, const struct stat *st, int flag, struct FTW *ftw)
+{
+    (void)st, (void)flag, (void)ftw;
+    return remove(path);
+}
+
 static double rms_between(int64_t nv, const double *a, const double *b)
 {
     double s = 0;
@@ -126,13 +137,15 @@ static void row(const char *pt, const char *solver, const result *x, double trut
            100 * r->prior_rms);
     if (truth >= 0) printf("  real %.4f %%", 100 * truth);
     if (r->n_bad_faces) printf("  (not realizable: %lld faces)", (long long)r->n_bad_faces);
-    printf("\n");
+    printf("\n    stages: refinement %.3f s (local-global %.3f s of it), total %.3f s\n",
+           r->t_refine, r->t_local_global, r->t_total);
 }
 
 int main(int argc, char **argv)
 {
     const char *set = argc > 1 ? argv[1] : "face-study";
     int levels = argc > 2 ? atoi(argv[2]) : 0, frames = argc > 3 ? atoi(argv[3]) : 20;
+    int few = argc > 4 && !strcmp(argv[4], "few");
     char dir[4096], path[4300], store[256], held[4300];
     char **names = NULL;
     es_ctx *ctx;
@@ -199,8 +212,9 @@ int main(int argc, char **argv)
     snprintf(lerp, sizeof lerp, "lerp(row:%s, row:%s, 0.5)", es_store_row_id(s, 0),
              es_store_row_id(s, 1));
     pts[7] = lerp;
+    if (few) pts[1] = "mean + 2*pc:2", pts[2] = NULL;
     double *out = malloc(sizeof(double) * (size_t)(3 * nv)), *truth = NULL;
-    if (levels == 0) {
+    if (levels == 0 && !few) {
         snprintf(file, sizeof file, "file:%s", held);
         pts[8] = file;
         truth = malloc(sizeof(double) * (size_t)(3 * nv));
@@ -218,6 +232,7 @@ int main(int argc, char **argv)
         const es_embed_opts *os[3] = {&dflt, &lm, &fast};
         const char *nm[3] = {"new", "lm", "fast"};
         for (int q = 0; q < 3; q++) {
+            if (few && q == 1) continue;
             result x = embed(ctx, se, pts[k], os[q], 0, out);
             double d = -1;
             if (truth && pts[k] == file) {
@@ -237,12 +252,13 @@ int main(int argc, char **argv)
             tot[q] += x.cpu;
         }
     }
-    printf("mean CPU per point: new %.3f s, lm %.3f s (ratio %.2f), fast %.3f s\n",
-           tot[0] / npts, tot[1] / npts, tot[1] / tot[0], tot[2] / npts);
+    if (few) printf("mean CPU per point: new %.3f s, fast %.3f s\n", tot[0] / npts, tot[2] / npts);
+    else printf("mean CPU per point: new %.3f s, lm %.3f s (ratio %.2f), fast %.3f s\n",
+                tot[0] / npts, tot[1] / npts, tot[1] / tot[0], tot[2] / npts);
 
     /* walks along PC 1 */
     double *cold = malloc(sizeof(double) * (size_t)(3 * nv) * (size_t)frames);
-    for (int mode = 0; mode < 5; mode++) {
+    for (int mode = 0; mode < 5 && frames > 0; mode++) {
         /* 0 cold, 1 warm, 2 lm cold, 3 fast cold, 4 fast warm */
         const es_embed_opts *o = mode == 2 ? &lm : mode >= 3 ? &fast : &dflt;
         int warm = mode == 1 || mode == 4;
@@ -274,6 +290,8 @@ int main(int argc, char **argv)
     remove(store);
     snprintf(path, sizeof path, "%s.es-cache", store);
     remove(path);
+    snprintf(path, sizeof path, "%s.results", store);   /* format 3: results beside */
+    nftw(path, remove_one, 16, FTW_DEPTH | FTW_PHYS);
     for (int64_t i = 0; i < nfiles; i++) free(names[i]);
     free(names), free(out), free(truth), free(cold);
     es_ctx_free(ctx);
