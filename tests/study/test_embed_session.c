@@ -249,14 +249,24 @@ int main(void)
             double ss = 0;
             for (int64_t j = 0; j < n3; j++) ss += pow(walk[n3 * i + j] - ref[j], 2);
             worst = fmax(worst, sqrt(ss / (double)nv) / es_bbox_diagonal(nv, ref));
-            fprintf(stderr, "  frame %d: %.3g %% (cold %lld it, rms %.3g %%, bending %.3f, warm %.3f)\n", i,
+            fprintf(stderr, "  frame %d: %.3g %% (cold %lld it, rms %.3g %%, bending %.3f, warm %.3f, "
+                    "%lld faces break the triangle inequality)\n", i,
                     100 * sqrt(ss / (double)nv) / es_bbox_diagonal(nv, ref), (long long)r.report.lg_iters,
-                    100 * r.report.rms_ratio, r.report.bend_ratio, wbend[i]);
+                    100 * r.report.rms_ratio, r.report.bend_ratio, wbend[i],
+                    (long long)r.report.n_bad_faces);
         }
         fprintf(stderr, "warm walk: %lld local-global iterations against %lld cold; frames at "
                 "most %.3g %% of the diagonal from the cold ones\n", (long long)warm_it,
                 (long long)cold_it, 100 * worst);
-        ES_CHECK(warm_it < cold_it && worst <= 1e-3);
+        /* 1.5e-3: frame 7 (mean + 1.5 sd on PC 1) carries the synthetic
+         * faces' folds in its lengths (bending 1.2 x the prior's, as the
+         * nearest rows; datasets-spec/synthetic.md), and its warm and cold
+         * solutions sit apart along that fold: 0.08 % of the diagonal when
+         * the solve stopped at 40 local-global iterations and the
+         * Levenberg-Marquardt polish finished, 0.10 % since it runs up to 100
+         * and needs no polish; the frames that bend less than 1.1 x are
+         * within 0.07 % */
+        ES_CHECK(warm_it < cold_it && worst <= 1.5e-3);
         es_study_embedder_free(se);
         free(walk);
     }
