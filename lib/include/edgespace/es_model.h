@@ -42,7 +42,9 @@ extern "C" {
  * Variables are label columns: NAME (numeric when every value is a number,
  * else categorical), factor(NAME) (categorical), log(NAME) (the natural log
  * of a positive numeric column); a:b is an interaction, a*b means a + b +
- * a:b, parentheses group sums ((a + b)*c). Terms are ordered by degree
+ * a:b, parentheses group sums ((a + b)*c); R's nesting: a/b means a + a:b
+ * (b within a; (a + b)/c is a + b + a:b:c, a/b/c is a + a:b + a:b:c), and
+ * b %in% a the term b:a. Terms are ordered by degree
  * (main effects, then two-way interactions, ...), keeping the written order
  * within a degree, as R's terms() does. Every model has an intercept. */
 typedef struct es_formula es_formula;
@@ -54,9 +56,9 @@ typedef enum es_var_kind {
 } es_var_kind;
 
 /* Parse text. Errors are ES_EFORMAT naming the 1-based column:
- * "formula: column 9: expected a column name, found '+'". A formula that
- * expands to more than ES_FORMULA_MAX_TERMS terms is refused before it is
- * expanded (a*b*...*r, 18 names, would be 262,143 terms). */
+ * "formula: column 9: expected a term after the '/' at column 8, found '+'".
+ * A formula that expands to more than ES_FORMULA_MAX_TERMS terms is refused
+ * before it is expanded (a*b*...*r, 18 names, would be 262,143 terms). */
 #define ES_FORMULA_MAX_TERMS 1024
 ES_API es_status es_formula_parse(es_ctx *ctx, const char *text, es_formula **out);
 /* Whether a variable's column exists: 1 if it does; 0 if not, with the
