@@ -7,6 +7,9 @@
  *    equal vegan 2.6-4's adonis2(dist(Y) ~ ..., by = "terms") on the same
  *    data (the R commands above the table), and an error term of the
  *    nested factor gives F = MS_pop / MS_pop:ind of those numbers;
+ *  - types II and III of ~ w + pop/ind against their definitions on R's
+ *    model.matrix, and pop's LS means in ~ pop/ind against the means of
+ *    each population's own cells (R's aggregate), as emmeans nests;
  *  - the malformed forms (a/, /b, a//b, %in% without a side, an unknown
  *    %op%) are refused naming their column.
  */
@@ -213,7 +216,7 @@ static const struct {
 };
 
 static es_model *fit(es_ctx *ctx, const nested *x, const char *formula, es_design **d,
-                     const int64_t *error)
+                     const int64_t *error, es_ss_type type)
 {
     es_model_column cols[3] = {{"pop", x->pop, NULL, NULL}, {"ind", x->ind, NULL, NULL},
                                {"w", NULL, x->w, NULL}};
@@ -229,6 +232,7 @@ static es_model *fit(es_ctx *ctx, const nested *x, const char *formula, es_desig
     es_model_opts_init(&o);
     o.permutations = 0;
     o.error = error;
+    o.ss_type = type;
     ES_CHECK_OK(ctx, es_model_fit(ctx, *d, &src, &o, &m));
     return m;
 }
@@ -237,7 +241,7 @@ static void test_adonis(es_ctx *ctx, const nested *x)
 {
     for (size_t k = 0; k < sizeof adonis / sizeof *adonis; k++) {
         es_design *d = NULL;
-        es_model *m = fit(ctx, x, adonis[k].formula, &d, NULL);
+        es_model *m = fit(ctx, x, adonis[k].formula, &d, NULL, ES_SS_TYPE_I);
         const int t = adonis[k].nterms;
         ES_CHECK_MSG(m && m->nterms == t, "%s: %lld terms", adonis[k].formula,
                      m ? (long long)m->nterms : -1LL);
@@ -260,18 +264,80 @@ static void test_adonis(es_ctx *ctx, const nested *x)
     }
 }
 
+/* Types II and III of ~ w + pop/ind: pop:ind contains pop, so pop's type
+ * II is after w alone, its type III after w and pop:ind as coded (treatment
+ * contrasts, ind by indicators within pop). R, the definitions on
+ * model.matrix (d and Y as above):
+ *   X <- model.matrix(~ w + pop/ind, d); a <- attr(X, "assign")
+ *   rss <- function(keep) sum(qr.resid(qr(X[, keep, drop = FALSE]), Y)^2)
+ *   type III of term j: rss(a != j) - rss(a >= 0)
+ *   type II: the same within the columns of the terms not containing j */
+static void test_types(es_ctx *ctx, const nested *x)
+{
+    static const double ss2[3] = {2.5693907382793668, 5.8117741078693612, 12.875450018646546};
+    static const double ss3[3] = {2.5693907382793668, 5.5139318288640595, 12.875450018646546};
+    const double rss = 26.180558789493226, df_resid = 12;   /* adonis[3] */
+    const int df[3] = {1, 2, 4};
+    for (int type = 2; type <= 3; type++) {
+        es_design *d = NULL;
+        es_model *m = fit(ctx, x, "~ w + pop/ind", &d, NULL, (es_ss_type)type);
+        for (int j = 0; m && m->nterms == 3 && j < 3; j++) {
+            const double want = type == 2 ? ss2[j] : ss3[j];
+            ES_CHECK(m->df[j] == df[j]);
+            ES_CHECK_CLOSE(m->ss[j], want, 1e-10, 0);
+            ES_CHECK_CLOSE(m->f[j], (want / df[j]) / (rss / df_resid), 1e-10, 0);
+        }
+        ES_CHECK(m && m->nterms == 3);
+        es_model_free(m);
+        es_design_free(d);
+    }
+}
+
 /* --error pop=pop:ind: the population tested against the individuals
  * within it, F = (SS_pop / 2) / (SS_pop:ind / 4) of adonis2's sums. */
 static void test_error_term(es_ctx *ctx, const nested *x)
 {
     const int64_t error[2] = {1, -1};
     es_design *d = NULL;
-    es_model *m = fit(ctx, x, "~ pop/ind", &d, error);
+    es_model *m = fit(ctx, x, "~ pop/ind", &d, error, ES_SS_TYPE_I);
     if (m) {
         ES_CHECK(m->error[0] == 1 && m->error[1] == -1);
         ES_CHECK_CLOSE(m->f[0], (9.0723236836165242 / 2) / (10.467863887014463 / 4), 1e-10, 0);
         ES_CHECK_CLOSE(m->f[1], adonis[0].f[1], 1e-10, 0);
     }
+    es_model_free(m);
+    es_design_free(d);
+}
+
+/* Pairwise LS means of pop in ~ pop/ind: each population's mean of its own
+ * individuals' cell means (ind is nested: A has i1..i3, B and C only i1,
+ * i2), as emmeans averages a nested factor. The model is saturated in the
+ * cells, so these are the data's cell means; R (Y, pop, ind as above):
+ *   cm <- aggregate(Y, list(pop = pop, ind = ind), mean)
+ *   t(as.matrix(aggregate(cm[, 3:6], list(cm$pop), mean)[, -1]))
+ * The distances are those of the rows; ind itself cannot be compared. */
+static void test_pairwise(es_ctx *ctx, const nested *x)
+{
+    static const double want[3][P] = {
+        {0.22057697577724733, 0.19070247621726119, -0.013842426753334296, -0.22325544420934623},
+        {-0.10057299836295805, 0.63192207992489846, -0.022068500153252735, 0.12504881164059733},
+        {-0.0049828019600954565, 1.7636017808861653, 0.20848932939120812, 0.10136651111740463}};
+    es_design *d = NULL;
+    es_model *m = fit(ctx, x, "~ pop/ind", &d, NULL, ES_SS_TYPE_I);
+    es_model_pairwise *pw = NULL;
+    if (m) ES_CHECK_OK(ctx, es_model_pairwise_fit(ctx, m, "pop", NULL, &pw));
+    for (int a = 0; pw && a < 3; a++) {
+        for (int e = 0; e < P; e++) ES_CHECK_CLOSE(pw->lsmeans[a + e * 3], want[a][e], 1e-10, 1e-12);
+        for (int b = 0; b < 3; b++) {
+            double dd = 0;
+            for (int e = 0; e < P; e++) dd += (want[a][e] - want[b][e]) * (want[a][e] - want[b][e]);
+            ES_CHECK_CLOSE(pw->dist[a + b * 3], sqrt(dd), 1e-10, 1e-12);
+        }
+    }
+    es_model_pairwise_free(pw);
+    pw = NULL;
+    if (m) ES_CHECK_FAILS(ctx, es_model_pairwise_fit(ctx, m, "ind", NULL, &pw), ES_EINVAL,
+                          "'ind' is nested in 'pop'");
     es_model_free(m);
     es_design_free(d);
 }
@@ -288,7 +354,9 @@ int main(void)
     static nested x;
     make(&x);
     test_adonis(ctx, &x);
+    test_types(ctx, &x);
     test_error_term(ctx, &x);
+    test_pairwise(ctx, &x);
     es_ctx_free(ctx);
     ES_TEST_END();
 }

@@ -240,7 +240,9 @@ ES_API es_status es_model_permutations(es_ctx *ctx, int64_t n, const int64_t *bl
 
 /* Pairwise comparisons of the levels of factor variable `var` (its label):
  *  - of their least-squares means over a reference grid (the other factors'
- *    levels weighted equally, numeric variables at opts->at, default their
+ *    levels weighted equally, a factor nested in `var` (~ pop/ind: every
+ *    term holding ind holds pop) over the levels seen with each level of
+ *    var, as emmeans does; numeric variables at opts->at, default their
  *    mean as the formula uses them: mean of log(size), not log of mean
  *    size), or
  *  - with opts->covariate (a numeric variable of the model, "log(size)"),
@@ -255,7 +257,9 @@ ES_API es_status es_model_permutations(es_ctx *ctx, int64_t n, const int64_t *bl
  * s: p = #{s* >= s} / (1 + permutations) with the observed counted (RRPP's
  * pval), Z = es_effect_size of the observed and permuted values (RRPP's
  * effect.size), UCL = their quantile at opts->confidence (R's quantile
- * type 7, RRPP's upper confidence limit). */
+ * type 7, RRPP's upper confidence limit). A factor nested in another is
+ * refused (ES_EINVAL): its levels differ from one level of the other to the
+ * next. */
 typedef struct es_model_pairwise_opts {
     const char *covariate;  /* compare slopes on this numeric variable; NULL: LS means */
     double confidence;      /* 0.95 */
