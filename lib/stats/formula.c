@@ -2,7 +2,7 @@
  * recursive-descent parser into a set of terms, each term a set of
  * variables held as a bit mask.
  *
- * Grammar (datasets-spec/models.md):
+ * Grammar (datasets-spec/analysis-results.md, "model/<name>"):
  *     formula := ['~'] sum
  *     sum     := product ('+' product)*
  *     product := in (('*' | '/') in)*        a*b = a + b + a:b; a/b = a + a:b,
@@ -13,9 +13,9 @@
  *                                            joins all the right's variables
  *     inter   := atom (':' atom)*            a:b = every union of a term of
  *                                            a with a term of b
+ *     atom    := '(' sum ')' | NAME | factor '(' NAME ')' | log '(' NAME ')'
  * '*' and '/' share a precedence and group left to right (a/b*c is
  * (a/b)*c), '%in%' binds tighter and ':' tighter still, as in R.
- *     atom    := '(' sum ')' | NAME | factor '(' NAME ')' | log '(' NAME ')'
  * NAME is letters, digits, '_' and '.', or any text in double quotes. The
  * terms are then ordered by degree, written order within a degree, as R's
  * terms() orders them, so that sequential sums of squares follow R's.

@@ -53,7 +53,8 @@ static double code(int cd, int64_t k, int64_t l, int64_t L)
 }
 
 /* Whether factor u is nested in factor v: some term holds u and every term
- * that does holds v (~ pop/ind: ind within pop). */
+ * that does holds v (~ pop/ind: ind within pop). A factor held only with a
+ * covariate (~ w/pop) is not nested: its levels are the same everywhere. */
 static int nested_in(const es_design *d, int64_t u, int64_t v)
 {
     const int64_t T = d->nterms;
@@ -63,7 +64,7 @@ static int nested_in(const es_design *d, int64_t u, int64_t v)
         if (!d->term_vars[t + v * T]) return 0;
         any = 1;
     }
-    return any && u != v && d->var_factor[u];
+    return any && u != v && d->var_factor[u] && d->var_factor[v];
 }
 
 /* seen[u + l2 V] = 1 when level l2 of a factor u nested in v occurs in a

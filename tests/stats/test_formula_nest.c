@@ -328,7 +328,8 @@ static void test_error_term(es_ctx *ctx, const nested *x)
  * cells, so these are the data's cell means; R (Y, pop, ind as above):
  *   cm <- aggregate(Y, list(pop = pop, ind = ind), mean)
  *   t(as.matrix(aggregate(cm[, 3:6], list(cm$pop), mean)[, -1]))
- * The distances are those of the rows; ind itself cannot be compared. */
+ * The distances are those of the rows; ind itself cannot be compared, pop
+ * in ~ w/pop (held only with a covariate) can. */
 static void test_pairwise(es_ctx *ctx, const nested *x)
 {
     static const double want[3][P] = {
@@ -351,6 +352,14 @@ static void test_pairwise(es_ctx *ctx, const nested *x)
     pw = NULL;
     if (m) ES_CHECK_FAILS(ctx, es_model_pairwise_fit(ctx, m, "ind", NULL, &pw), ES_EINVAL,
                           "'ind' is nested in 'pop'");
+    es_model_free(m);
+    es_design_free(d);
+    /* pop held only with the covariate (~ w/pop: slopes by population) is
+     * not nested: its levels are the same at every w, and are compared */
+    m = fit(ctx, x, "~ w/pop", &d, NULL, ES_SS_TYPE_I);
+    if (m) ES_CHECK_OK(ctx, es_model_pairwise_fit(ctx, m, "pop", NULL, &pw));
+    ES_CHECK(pw && pw->nlevels == 3);
+    es_model_pairwise_free(pw);
     es_model_free(m);
     es_design_free(d);
 }
