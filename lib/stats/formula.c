@@ -2,13 +2,20 @@
  * recursive-descent parser into a set of terms, each term a set of
  * variables held as a bit mask.
  *
- * Grammar (datasets-spec/models.md):
+ * Grammar (datasets-spec/analysis-results.md, "model/<name>"):
  *     formula := ['~'] sum
  *     sum     := product ('+' product)*
- *     product := inter ('*' inter)*          a*b = a + b + a:b
+ *     product := in (('*' | '/') in)*        a*b = a + b + a:b; a/b = a + a:b,
+ *                                            and (a+b)/c = a + b + a:b:c: the
+ *                                            left side's variables all join
+ *                                            each right term (R's nesting)
+ *     in      := inter ('%in%' inter)*       b %in% a = b:a: each left term
+ *                                            joins all the right's variables
  *     inter   := atom (':' atom)*            a:b = every union of a term of
  *                                            a with a term of b
  *     atom    := '(' sum ')' | NAME | factor '(' NAME ')' | log '(' NAME ')'
+ * '*' and '/' share a precedence and group left to right (a/b*c is
+ * (a/b)*c), '%in%' binds tighter and ':' tighter still, as in R.
  * NAME is letters, digits, '_' and '.', or any text in double quotes. The
  * terms are then ordered by degree, written order within a degree, as R's
  * terms() orders them, so that sequential sums of squares follow R's.
@@ -188,6 +195,18 @@ static es_status check_expansion(fparser *p, size_t at, int64_t a, int64_t b, in
                 (long long)n);
 }
 
+/* An operator at column at (op) must have a term after it: say so, naming
+ * both places, rather than "expected a column name" alone. */
+static es_status operand_follows(fparser *p, size_t at, const char *op)
+{
+    ws(p);
+    char c = p->s[p->pos];
+    if (c == '(' || c == '"' || name_char(c)) return ES_OK;
+    char b[8];
+    return ferr(p, p->pos, "expected a term after the '%s' at column %zu, found %s", op, at + 1,
+                what(p, b, sizeof b));
+}
+
 static es_status parse_sum(fparser *p, tset *out);
 
 static es_status parse_atom(fparser *p, tset *out)
@@ -209,6 +228,9 @@ static es_status parse_atom(fparser *p, tset *out)
         p->depth--;
         return ES_OK;
     }
+    if (p->s[at] && strchr("+*/:%", p->s[at]))
+        return ferr(p, at, "'%.*s' has no term before it",
+                    strncmp(p->s + at, "%in%", 4) ? 1 : 4, p->s + at);
     const char *w = NULL;
     size_t len = 0;
     if ((rc = read_name(p, &w, &len)) != ES_OK) return rc;
@@ -252,6 +274,39 @@ static es_status cross(es_ctx *ctx, const tset *a, const tset *b, tset *out)
     return rc;
 }
 
+/* The union of the variables of every term of t: R's nesting operators
+ * treat a whole side as one term (terms.formula's NestTerms, InTerms). */
+static uint64_t all_vars(const tset *t)
+{
+    uint64_t u = 0;
+    for (int64_t i = 0; i < t->n; i++) u |= t->m[i];
+    return u;
+}
+
+/* out = a/b (R: a + every term of b joined with all of a's variables) or,
+ * nest_in set, a %in% b (every term of a joined with all of b's). */
+static es_status nest(es_ctx *ctx, const tset *a, const tset *b, int nest_in, tset *out)
+{
+    es_status rc = ES_OK;
+    if (nest_in) {
+        uint64_t u = all_vars(b);
+        for (int64_t i = 0; i < a->n && rc == ES_OK; i++) rc = tset_add(ctx, out, a->m[i] | u);
+        return rc;
+    }
+    uint64_t u = all_vars(a);
+    for (int64_t i = 0; i < a->n && rc == ES_OK; i++) rc = tset_add(ctx, out, a->m[i]);
+    for (int64_t j = 0; j < b->n && rc == ES_OK; j++) rc = tset_add(ctx, out, u | b->m[j]);
+    return rc;
+}
+
+/* Replace *out by *with (which is left empty). */
+static void tset_take(es_ctx *ctx, tset *out, tset *with)
+{
+    tset_clear(ctx, out);
+    *out = *with;
+    memset(with, 0, sizeof *with);
+}
+
 static es_status parse_inter(fparser *p, tset *out)
 {
     es_status rc = parse_atom(p, out);
@@ -260,38 +315,76 @@ static es_status parse_inter(fparser *p, tset *out)
         if (p->s[p->pos] != ':') break;
         size_t at = p->pos++;
         tset b = {0}, c = {0};
-        if ((rc = parse_atom(p, &b)) == ES_OK &&
+        if ((rc = operand_follows(p, at, ":")) == ES_OK &&
+            (rc = parse_atom(p, &b)) == ES_OK &&
             (rc = check_expansion(p, at, out->n, b.n, 0)) == ES_OK &&
-            (rc = cross(p->ctx, out, &b, &c)) == ES_OK) {
-            tset_clear(p->ctx, out);
-            *out = c;
-            c.m = NULL;
-        }
+            (rc = cross(p->ctx, out, &b, &c)) == ES_OK)
+            tset_take(p->ctx, out, &c);
         tset_clear(p->ctx, &b);
         tset_clear(p->ctx, &c);
     }
     return rc;
 }
 
-static es_status parse_product(fparser *p, tset *out)
+/* Whether "%in%" is at p->pos; any other %...% is refused by name. */
+static es_status at_in_operator(fparser *p, int *yes)
+{
+    const char *s = p->s + p->pos;
+    *yes = 0;
+    if (*s != '%') return ES_OK;
+    if (!strncmp(s, "%in%", 4)) {
+        *yes = 1;
+        return ES_OK;
+    }
+    const char *end = strchr(s + 1, '%');
+    int len = end && end - s < 40 ? (int)(end - s) + 1 : 1;
+    return ferr(p, p->pos, "unknown operator '%.*s' (the operators are '+', '*', ':', '/' and "
+                "'%%in%%')", len, s);
+}
+
+/* b %in% a binds tighter than * and /, looser than ':' (R's precedence). */
+static es_status parse_in(fparser *p, tset *out)
 {
     es_status rc = parse_inter(p, out);
     while (rc == ES_OK) {
         ws(p);
-        if (p->s[p->pos] != '*') break;
+        int in = 0;
+        if ((rc = at_in_operator(p, &in)) != ES_OK || !in) break;
+        size_t at = p->pos;
+        p->pos += 4;
+        tset b = {0}, c = {0};
+        if ((rc = operand_follows(p, at, "%in%")) == ES_OK &&
+            (rc = parse_inter(p, &b)) == ES_OK &&
+            (rc = nest(p->ctx, out, &b, 1, &c)) == ES_OK)
+            tset_take(p->ctx, out, &c);
+        tset_clear(p->ctx, &b);
+        tset_clear(p->ctx, &c);
+    }
+    return rc;
+}
+
+/* a*b and a/b: one precedence, left to right, as in R (a/b*c = (a/b)*c). */
+static es_status parse_product(fparser *p, tset *out)
+{
+    es_status rc = parse_in(p, out);
+    while (rc == ES_OK) {
+        ws(p);
+        char op = p->s[p->pos];
+        if (op != '*' && op != '/') break;
         size_t at = p->pos++;
         tset b = {0}, c = {0};
-        if ((rc = parse_inter(p, &b)) == ES_OK &&
-            (rc = check_expansion(p, at, out->n, b.n, 1)) == ES_OK) {
+        if ((rc = operand_follows(p, at, op == '*' ? "*" : "/")) != ES_OK ||
+            (rc = parse_in(p, &b)) != ES_OK) {
+            /* reported */
+        } else if (op == '/') {
+            if ((rc = check_expansion(p, at, out->n + b.n, 1, 0)) == ES_OK)
+                rc = nest(p->ctx, out, &b, 0, &c);
+        } else if ((rc = check_expansion(p, at, out->n, b.n, 1)) == ES_OK) {
             for (int64_t i = 0; rc == ES_OK && i < out->n; i++) rc = tset_add(p->ctx, &c, out->m[i]);
             for (int64_t i = 0; rc == ES_OK && i < b.n; i++) rc = tset_add(p->ctx, &c, b.m[i]);
             if (rc == ES_OK) rc = cross(p->ctx, out, &b, &c);
         }
-        if (rc == ES_OK) {
-            tset_clear(p->ctx, out);
-            *out = c;
-            c.m = NULL;
-        }
+        if (rc == ES_OK) tset_take(p->ctx, out, &c);
         tset_clear(p->ctx, &b);
         tset_clear(p->ctx, &c);
     }
@@ -310,7 +403,8 @@ static es_status parse_sum(fparser *p, tset *out)
         if (c != '+') break;
         size_t at = p->pos++;
         tset b = {0};
-        if ((rc = parse_product(p, &b)) == ES_OK &&
+        if ((rc = operand_follows(p, at, "+")) == ES_OK &&
+            (rc = parse_product(p, &b)) == ES_OK &&
             (rc = check_expansion(p, at, out->n + b.n, 1, 0)) == ES_OK)
             for (int64_t i = 0; rc == ES_OK && i < b.n; i++) rc = tset_add(p->ctx, out, b.m[i]);
         tset_clear(p->ctx, &b);
@@ -391,7 +485,8 @@ es_status es_formula_parse_checked(es_ctx *ctx, const char *text, es_formula_col
     ws(&p);
     if (text[p.pos]) {
         char b[8];
-        rc = ferr(&p, p.pos, "unexpected %s (terms are joined by '+', '*' or ':')",
+        rc = ferr(&p, p.pos, "unexpected %s (terms are joined by '+', '*', ':', '/' or "
+                  "'%%in%%')",
                   what(&p, b, sizeof b));
         goto done;
     }

@@ -11,7 +11,8 @@
  * angles):
  *  - an LS mean's c = Qf Rf^-T g for the reference-grid row g (Searle, Speed
  *    & Milliken 1980; emmeans' grid: other factors' levels weighted
- *    equally, numeric variables at their mean or at a given value);
+ *    equally, a nested factor's over those seen with the level, numeric
+ *    variables at their mean or at a given value);
  *  - a level's slope is the within-level regression of the fitted values on
  *    the covariate (RRPP's getSlopes: fitted ~ group * x + 0), c = Qf Qf^T w
  *    with w_i = (x_i - mean_l x) / S_xx,l on the level's rows.
@@ -51,8 +52,41 @@ static double code(int cd, int64_t k, int64_t l, int64_t L)
     return l == k ? 1.0 : 0.0;
 }
 
-/* Reference-grid row g (q) of level l of factor v, numeric variables at at[]. */
-static void grid_row(const es_design *d, int64_t v, int64_t l, const double *at, double *g)
+/* Whether factor u is nested in factor v: some term holds u and every term
+ * that does holds v (~ pop/ind: ind within pop). A factor held only with a
+ * covariate (~ w/pop) is not nested: its levels are the same everywhere. */
+static int nested_in(const es_design *d, int64_t u, int64_t v)
+{
+    const int64_t T = d->nterms;
+    int any = 0;
+    for (int64_t t = 0; t < T; t++) {
+        if (!d->term_vars[t + u * T]) continue;
+        if (!d->term_vars[t + v * T]) return 0;
+        any = 1;
+    }
+    return any && u != v && d->var_factor[u] && d->var_factor[v];
+}
+
+/* seen[u + l2 V] = 1 when level l2 of a factor u nested in v occurs in a
+ * row of level l of v: the levels its grid averages over. */
+static void nested_levels(const es_design *d, int64_t v, int64_t l, int64_t maxl,
+                          unsigned char *seen)
+{
+    const int64_t V = d->nvars, n = d->n;
+    memset(seen, 0, (size_t)(V * maxl));
+    for (int64_t u = 0; u < V; u++)
+        if (nested_in(d, u, v))
+            for (int64_t i = 0; i < n; i++)
+                if (d->codes[i + v * n] == l) seen[u + d->codes[i + u * n] * V] = 1;
+}
+
+/* Reference-grid row g (q) of level l of factor v, numeric variables at at[].
+ * Another factor's levels are weighted equally; one nested in v only over
+ * those that occur with level l (seen), as emmeans does for nesting: the
+ * individuals of one population are not those of another, and a cell that
+ * was never observed has no estimate to average. */
+static void grid_row(const es_design *d, int64_t v, int64_t l, const double *at,
+                     const unsigned char *seen, double *g)
 {
     const int64_t V = d->nvars, T = d->nterms;
     for (int64_t c = 0; c < d->ncols; c++) {
@@ -69,9 +103,14 @@ static void grid_row(const es_design *d, int64_t v, int64_t l, const double *at,
             if (u == v) {
                 x *= code(cd, k, l, L);
             } else {
-                double s = 0;
-                for (int64_t l2 = 0; l2 < L; l2++) s += code(cd, k, l2, L);
-                x *= s / (double)L;
+                double s = 0, nl = 0;
+                const int nested = nested_in(d, u, v);
+                for (int64_t l2 = 0; l2 < L; l2++)
+                    if (!nested || seen[u + l2 * V]) {
+                        s += code(cd, k, l2, L);
+                        nl++;
+                    }
+                x *= s / nl;
             }
         }
         g[c] = x;
@@ -252,6 +291,12 @@ static es_status check_request(es_ctx *ctx, const es_model *m, const char *var, 
     if (v < 0 || !d->var_factor[v])
         ES_FAIL(ctx, v < 0 ? ES_ENOTFOUND : ES_EINVAL, "pairwise: '%s' is not a %s of the model",
                 var, v < 0 ? "variable" : "categorical variable");
+    for (int64_t w = 0; w < d->nvars; w++)
+        if (nested_in(d, v, w))
+            ES_FAIL(ctx, ES_EINVAL, "pairwise: '%s' is nested in '%s' (every term holding it "
+                    "holds '%s'): its levels are not the same things under each level of "
+                    "'%s'; compare the levels of '%s'", var, d->vars[w], d->vars[w], d->vars[w],
+                    d->vars[w]);
     if (!cov) {
         for (int64_t t = 0; t < T; t++) use[t] = !d->term_vars[t + v * T];
         return ES_OK;
@@ -297,8 +342,12 @@ es_status es_model_pairwise_fit(es_ctx *ctx, const es_model *m, const char *var,
     double *cz = es__alloc_array(ctx, L * r, sizeof *cz);
     double *vals = es__alloc_array(ctx, (B + 1) * (nstat > 0 ? nstat : 1), sizeof *vals);
     double *cosine = es__alloc_array(ctx, np > 0 ? np : 1, sizeof *cosine);
+    int64_t maxl = 1;
+    for (int64_t w = 0; w < V; w++)
+        if (d->nlevels[w] > maxl) maxl = d->nlevels[w];
+    unsigned char *seen = es__alloc_array(ctx, V * maxl, 1);
     if (pw) pw->ctx = ctx;
-    if (!pw || !g || !cz || !vals || !cosine) {
+    if (!pw || !g || !cz || !vals || !cosine || !seen) {
         rc = ES_ENOMEM;
         goto done;
     }
@@ -332,7 +381,8 @@ es_status es_model_pairwise_fit(es_ctx *ctx, const es_model *m, const char *var,
         else if (pw->slopes)
             rc = slope_weights(ctx, m, v, l, d->values + u * n, g, pw->weights + l * n);
         else {
-            grid_row(d, v, l, pw->at, g);
+            nested_levels(d, v, l, maxl, seen);
+            grid_row(d, v, l, pw->at, seen, g);
             grid_weights(m, g, g + d->ncols, pw->weights + l * n);
         }
     }
@@ -371,5 +421,6 @@ done:
     es__free(ctx, cz);
     es__free(ctx, vals);
     es__free(ctx, cosine);
+    es__free(ctx, seen);
     return rc;
 }

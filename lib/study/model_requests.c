@@ -127,6 +127,37 @@ es_status es__model_at(es_ctx *ctx, const es_design *d, const es_formula *f, con
     return ES_OK;
 }
 
+/* The design term a name means: its label, or the same variables joined
+ * by ':' in another order ("ind:pop" for "pop:ind", which is how R labels
+ * ind %in% pop when pop comes first); -1 if none. */
+static int64_t find_term(const es_design *d, const char *name)
+{
+    const int64_t T = d->nterms, V = d->nvars;
+    for (int64_t t = 0; t < T; t++)
+        if (!strcmp(d->terms[t], name)) return t;
+    int64_t nvars = 0;
+    char held[64] = {0};   /* held[v]: the name lists variable v (formulas have <= 64) */
+    for (const char *s = name; V <= 64;) {
+        size_t len = strcspn(s, ":");
+        int64_t v = 0;
+        while (v < V && (strlen(d->vars[v]) != len || strncmp(d->vars[v], s, len))) v++;
+        if (v == V) return -1;
+        nvars += !held[v];
+        held[v] = 1;
+        if (!s[len]) break;
+        s += len + 1;
+    }
+    for (int64_t t = 0; t < T; t++) {
+        int64_t same = 0, size = 0;
+        for (int64_t v = 0; v < V; v++) {
+            size += d->term_vars[t + v * T] != 0;
+            same += d->term_vars[t + v * T] && held[v];
+        }
+        if (size == nvars && same == nvars) return t;
+    }
+    return -1;
+}
+
 es_status es__model_errors(es_ctx *ctx, const es_design *d, const char *const *spec,
                            int64_t count, int64_t *error)
 {
@@ -139,18 +170,19 @@ es_status es__model_errors(es_ctx *ctx, const es_design *d, const char *const *s
                                   &term, &err);
         if (rc != ES_OK) return rc;
         if (!err) ES_FAIL(ctx, ES_EINVAL, "model: --error %s: write TERM=ERROR_TERM", term);
-        int64_t j = -1, e = -1;
-        for (int64_t t = 0; t < T; t++) {
-            if (!strcmp(d->terms[t], term)) j = t;
-            if (!strcmp(d->terms[t], err)) e = t;
-        }
+        const int64_t j = find_term(d, term), e = find_term(d, err);
         const char *bad = j < 0 ? term : (e < 0 && strcmp(err, "Residual")) ? err : NULL;
         if (bad) {
             const char *why = es_design_dropped(d, bad);
             if (why) ES_FAIL(ctx, ES_EINVAL, "model: --error %s=%s: '%s' %s and was left out",
                              term, err, bad, why);
-            ES_FAIL(ctx, ES_ENOTFOUND, "model: --error %s=%s: the model has no term '%s'", term,
-                    err, bad);
+            char list[400] = "";
+            for (int64_t t = 0; t < T && strlen(list) < 300; t++) {
+                strcat(list, t ? ", " : "");
+                strncat(list, d->terms[t], 60);
+            }
+            ES_FAIL(ctx, ES_ENOTFOUND, "model: --error %s=%s: the model has no term '%s' (its "
+                    "terms: %s, and Residual)", term, err, bad, list);
         }
         error[j] = e;
     }

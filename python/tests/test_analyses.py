@@ -204,6 +204,33 @@ def test_model(store_path, cli_copy, tmp_path, cli, ctx):
             s.model("~ expression", permute="shuffle")
 
 
+def test_model_nested(store_path, ctx):
+    """A nested formula is a string like any other: ~ expression/log(size)
+    (a size slope within each expression) has R's terms, expression and
+    expression:log(size), and the nested term's type I SS is the drop in
+    the residual sum of squares from one slope to three, fitted here by
+    numpy's least squares on the same lengths and scales."""
+    with es.Store(store_path, write=True, ctx=ctx) as s:
+        m = s.model("~ expression/log(size)", permutations=19, errors={
+            "expression": "log(size):expression"})
+        assert m.terms == ["expression", "expression:log(size)"]
+        assert m.df.tolist() == [2, 3] and m.error == ["expression:log(size)", "Residual"]
+        L, expr = s.lengths()[m.rows], s.label("expression")[m.rows]
+        x = np.log(s.scales()[m.rows])
+        groups = [expr == g for g in np.unique(expr)]
+        within = np.column_stack(groups + [g * x for g in groups]).astype(float)
+        common = np.column_stack(groups).astype(float)
+
+        def rss(X):
+            return ((L - X @ np.linalg.lstsq(X, L, rcond=None)[0]) ** 2).sum()
+
+        assert np.isclose(m.ss[1], rss(common) - rss(within), rtol=1e-8, atol=0)   # numpy
+        assert np.isclose(m.rss, rss(within), rtol=1e-8)
+        assert np.isclose(m.f[0], m.ms[0] / m.ms[1], rtol=1e-12)
+        with pytest.raises(es.Error, match="column 14: expected a term after the '/' at column 13"):
+            s.model("~ expression/", permutations=0)
+
+
 def test_model_pairwise_z(store_path, cli_copy, tmp_path, cli, ctx):
     """Z and the pairwise table as `edgespace model -o` writes them, bit for
     bit; the LS means from their row weights (numpy); the summary; the

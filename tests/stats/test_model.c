@@ -128,7 +128,7 @@ static void test_formula(es_ctx *ctx)
     es_formula_free(f);
     ES_CHECK_FAILS(ctx, es_formula_parse(ctx, "y ~ a", &f), ES_EFORMAT, "left-hand side");
     ES_CHECK_FAILS(ctx, es_formula_parse(ctx, "~ a +", &f), ES_EFORMAT,
-                   "column 6: expected a column name, found the end");
+                   "column 6: expected a term after the '+' at column 5, found the end");
     ES_CHECK_FAILS(ctx, es_formula_parse(ctx, "~ sqrt(a)", &f), ES_EFORMAT, "unknown function");
     ES_CHECK_FAILS(ctx, es_formula_parse(ctx, "~ a - b", &f), ES_EFORMAT, "column 5");
     ES_CHECK_FAILS(ctx, es_formula_parse(ctx, "~ (a + b", &f), ES_EFORMAT, "expected ')'");

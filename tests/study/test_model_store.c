@@ -11,6 +11,9 @@
  * from the rows (the embedding's prior gets the right combination). In
  * Procrustes space (a GPA result) the response is the aligned coordinates,
  * and a coefficient there is refused as a point. log(size) brings the CAC.
+ * A nested model (~ expression + age %in% expression) takes --error by the
+ * term's variables in either order, F = MS_term / MS_error, and a term it
+ * lacks is refused with the model's terms listed.
  * A model cancelled from its progress callback stops and stores nothing
  * (the store's bytes unchanged), and a rolled-back result is gone.
  */
@@ -220,6 +223,32 @@ int main(void)
     es_study_model_free(r);
     r = NULL;
     ES_CHECK(es_store_has(s, "model/allo/cac") && es_store_has(s, "model/allo/cac_scores"));
+
+    /* ---- nested: a slope of age within each expression; --error names a
+     * term by its variables in any order (R labels age %in% expression
+     * "expression:age" here: expression comes first) ---- */
+    {
+        const char *errs[2] = {"expression=age:expression", "expression=expression:ages"};
+        o.formula = "~ expression + age %in% expression";
+        o.ss_type = ES_SS_TYPE_I;
+        o.errors = errs;
+        o.nerrors = 1;
+        o.name = NULL;
+        ES_CHECK_OK(ctx, es_study_model(ctx, s, &o, &r));
+        if (r) {
+            ES_CHECK(r->model->nterms == 2 && !strcmp(r->design->terms[1], "expression:age"));
+            ES_CHECK(r->model->error[0] == 1 && r->model->error[1] == -1);
+            ES_CHECK_CLOSE(r->model->f[0], r->model->ms[0] / r->model->ms[1], 1e-12, 0);
+        }
+        es_study_model_free(r);
+        r = NULL;
+        o.errors = errs + 1;
+        ES_CHECK_FAILS(ctx, es_study_model(ctx, s, &o, &r), ES_ENOTFOUND,
+                       "no term 'expression:ages' (its terms: expression, expression:age, "
+                       "and Residual)");
+        o.errors = NULL;
+        o.nerrors = 0;
+    }
 
     /* ---- Procrustes space ---- */
     es_gpa_opts go;

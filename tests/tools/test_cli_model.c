@@ -6,7 +6,8 @@
  * the lengths `export --lengths` wrote (type I expression and subject SS,
  * the residual, F), the same table read back with `export --result`, the
  * tables of a GPA result with the rows' labels, the per-edge figure, and
- * the shape-variation figure along a PC and along a coefficient, and
+ * the shape-variation figure along a PC and along a coefficient, a nested
+ * formula's labels and error term and a malformed one's column, and
  * `results` listing and deleting (all or nothing). */
 #include "core/core_private.h"
 #include "core/csv_table.h"
@@ -239,6 +240,16 @@ int main(void)
     ES_RUN(&r2, dir, "model", store, "~ expression", "--gpa", "g", "--no-store", "-p", "0");
     ES_CHECK_MSG(r2.status == 0 && strstr(r2.out, "expression") && !strstr(r2.out, "stored"),
                  "%s%s", r2.out, r2.err);
+    /* a nested formula: R's term labels in the table, its error term in the
+     * error column; a malformed one names its column (exit 1) */
+    ES_RUN(&r2, dir, "model", store, "~ expression/log(size)", "--error",
+           "expression=log(size):expression", "--no-store", "-p", "0", "-o", "-");
+    ES_CHECK_MSG(r2.status == 0 && strstr(r2.out, "\nexpression,2,") &&
+                 strstr(r2.out, "\nexpression:log(size),3,") &&
+                 strstr(r2.out, ",expression:log(size)\n"), "%s%s", r2.out, r2.err);
+    ES_RUN(&r2, dir, "model", store, "~ expression//subject", "--no-store");
+    ES_CHECK_MSG(r2.status == 1 && strstr(r2.err, "column 14: expected a term after the '/' at "
+                                          "column 13, found '/'"), "%s", r2.err);
 
 #if ES_HAVE_FIGURES
     ES_CHECK(is_png(fig));

@@ -42,7 +42,9 @@ extern "C" {
  * Variables are label columns: NAME (numeric when every value is a number,
  * else categorical), factor(NAME) (categorical), log(NAME) (the natural log
  * of a positive numeric column); a:b is an interaction, a*b means a + b +
- * a:b, parentheses group sums ((a + b)*c). Terms are ordered by degree
+ * a:b, parentheses group sums ((a + b)*c); R's nesting: a/b means a + a:b
+ * (b within a; (a + b)/c is a + b + a:b:c, a/b/c is a + a:b + a:b:c), and
+ * b %in% a the term b:a. Terms are ordered by degree
  * (main effects, then two-way interactions, ...), keeping the written order
  * within a degree, as R's terms() does. Every model has an intercept. */
 typedef struct es_formula es_formula;
@@ -54,9 +56,9 @@ typedef enum es_var_kind {
 } es_var_kind;
 
 /* Parse text. Errors are ES_EFORMAT naming the 1-based column:
- * "formula: column 9: expected a column name, found '+'". A formula that
- * expands to more than ES_FORMULA_MAX_TERMS terms is refused before it is
- * expanded (a*b*...*r, 18 names, would be 262,143 terms). */
+ * "formula: column 9: expected a term after the '/' at column 8, found '+'".
+ * A formula that expands to more than ES_FORMULA_MAX_TERMS terms is refused
+ * before it is expanded (a*b*...*r, 18 names, would be 262,143 terms). */
 #define ES_FORMULA_MAX_TERMS 1024
 ES_API es_status es_formula_parse(es_ctx *ctx, const char *text, es_formula **out);
 /* Whether a variable's column exists: 1 if it does; 0 if not, with the
@@ -238,7 +240,9 @@ ES_API es_status es_model_permutations(es_ctx *ctx, int64_t n, const int64_t *bl
 
 /* Pairwise comparisons of the levels of factor variable `var` (its label):
  *  - of their least-squares means over a reference grid (the other factors'
- *    levels weighted equally, numeric variables at opts->at, default their
+ *    levels weighted equally, a factor nested in `var` (~ pop/ind: every
+ *    term holding ind holds pop) over the levels seen with each level of
+ *    var, as emmeans does; numeric variables at opts->at, default their
  *    mean as the formula uses them: mean of log(size), not log of mean
  *    size), or
  *  - with opts->covariate (a numeric variable of the model, "log(size)"),
@@ -253,7 +257,9 @@ ES_API es_status es_model_permutations(es_ctx *ctx, int64_t n, const int64_t *bl
  * s: p = #{s* >= s} / (1 + permutations) with the observed counted (RRPP's
  * pval), Z = es_effect_size of the observed and permuted values (RRPP's
  * effect.size), UCL = their quantile at opts->confidence (R's quantile
- * type 7, RRPP's upper confidence limit). */
+ * type 7, RRPP's upper confidence limit). A factor nested in another is
+ * refused (ES_EINVAL): its levels differ from one level of the other to the
+ * next. */
 typedef struct es_model_pairwise_opts {
     const char *covariate;  /* compare slopes on this numeric variable; NULL: LS means */
     double confidence;      /* 0.95 */

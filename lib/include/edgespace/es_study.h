@@ -281,7 +281,8 @@ typedef struct es_study_model_opts {
     const char *reference;     /* baseline levels "LEVEL" or "FACTOR=LEVEL", comma-separated
                                   (LEVEL alone: the one factor of the formula that has it) */
     const char *const *errors; /* nerrors "TERM=ERROR": TERM's F over ERROR's mean square
-                                  (nested designs: "population=population:colony") */
+                                  (nested designs: "population=population:colony"); a term
+                                  is its label or its variables joined by ':' in any order */
     int64_t nerrors;
     const char *null_formula;  /* compare the model with this nested one (RRPP's anova(null,
                                   full)), or NULL */
