@@ -51,7 +51,7 @@ def test_pca(store_path, cli_copy, tmp_path, cli, ctx):
     _, eig = columns(tmp_path / "p_eigenvalues.csv", 1)
     head, body = table(tmp_path / "p_scores.csv")
     with es.Store(store_path, write=True, ctx=ctx) as s:
-        p = s.pca("p", ncomp=4)
+        p = s.pca("p", components=4)
         assert np.array_equal(p.mean, comp[:, 0])
         assert np.array_equal(p.components, comp[:, 1:].T)
         assert np.array_equal(p.eigenvalues, eig[:, 0])
@@ -68,7 +68,7 @@ def test_pca(store_path, cli_copy, tmp_path, cli, ctx):
         for k in range(4):   # unit components, up to sign
             assert np.isclose(abs(p.components[k] @ Vt[k]), 1, atol=1e-8)
         # the same PCA on the array (es_pca_fit on the matrix, no store)
-        q = es.pca(L, ncomp=4, ctx=ctx)
+        q = es.pca(L, components=4, ctx=ctx)
         assert np.allclose(q.eigenvalues, p.eigenvalues, rtol=1e-12, atol=0)
         # load it back; project rows onto it
         r = s.load_pca("p")
@@ -87,7 +87,7 @@ def test_paired_difference(store_path, cli_copy, tmp_path, cli, ctx):
         "--name", "smile", "--csv", tmp_path / "d.csv")
     _, D = columns(tmp_path / "d.csv", 3)
     with es.Store(store_path, write=True, ctx=ctx) as s:
-        d = s.diff("smile", key="subject", column="expression", from_="neutral", to="happy")
+        d = s.diff("smile", pair_by="subject", column="expression", from_="neutral", to="happy")
         for j, f in enumerate(("mean", "sd", "se", "t")):
             assert np.array_equal(getattr(d, f), D[:, j])
         L = s.lengths()
@@ -126,7 +126,7 @@ def test_projection(store_path, cli_copy, tmp_path, cli, ctx):
         tmp_path / "pr.csv", "face_s01_neutral")
     head, body = table(tmp_path / "pr.csv")
     with es.Store(store_path, write=True, ctx=ctx) as s:
-        s.pca("p", ncomp=3)
+        s.pca("p", components=3)
         r = s.project(["face_s01_neutral"], where="expression=angry", pca="p")
         assert r["names"] == [b[0] for b in body]
         assert np.array_equal(r["scores"], np.array([[float(x) for x in b[1:4]] for b in body]))

@@ -1,0 +1,54 @@
+"""The keywords of README "Options" (python/README.md "Keywords"): the new
+names work, the old ones give the same result with one DeprecationWarning
+naming the new keyword, and both at once is a TypeError.
+
+Oracle: the old spelling's result, computed by the call as it was before
+the rename, against the new one's, array for array; the row selection
+against numpy's comparison of the label column."""
+import warnings
+
+import numpy as np
+import pytest
+
+import edgespace as es
+
+
+def one_warning(fn, new):
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        out = fn()
+    dep = [x for x in w if issubclass(x.category, DeprecationWarning)]
+    assert len(dep) == 1 and f"is now {new}=" in str(dep[0].message), [str(x.message) for x in w]
+    return out
+
+
+def test_where_and_components_beside_the_old_names(store_path, ctx):
+    with es.Store(store_path, write=True, ctx=ctx) as s:
+        happy = np.flatnonzero(np.asarray(s.label("expression")) == "happy")
+        assert np.array_equal(s.select(where="expression=happy"), happy)
+        assert np.array_equal(one_warning(lambda: s.select(filter="expression=happy"), "where"),
+                              happy)
+        new = s.mean(by="subject", where="expression=happy")
+        old = one_warning(lambda: s.mean(by="subject", filter="expression=happy"), "where")
+        assert np.array_equal(new.means, old.means) and new.groups == old.groups
+        p = s.pca(where="expression=happy", components=2)
+        q = one_warning(lambda: s.pca(filter="expression=happy", components=2), "where")
+        r = one_warning(lambda: s.pca(where="expression=happy", ncomp=2), "components")
+        assert p.ncomp == q.ncomp == r.ncomp == 2
+        assert np.array_equal(p.eigenvalues, r.eigenvalues)
+        d = s.diff(None, pair_by="subject", column="expression", from_="neutral", to="happy")
+        e = one_warning(lambda: s.diff(None, key="subject", column="expression",
+                                       from_="neutral", to="happy"), "pair_by")
+        assert np.array_equal(d.mean, e.mean) and d.npairs == e.npairs > 0
+        with pytest.raises(TypeError, match="not both"):
+            s.pca(components=2, ncomp=3)
+        with pytest.raises(TypeError, match="not both"):
+            s.select(where="expression=happy", filter="expression=sad")
+
+
+def test_module_pca_components(store_path, ctx):
+    with es.Store(store_path, ctx=ctx) as s:
+        L = s.lengths()
+    a = es.pca(L, components=3, ctx=ctx)
+    b = one_warning(lambda: es.pca(L, ncomp=3, ctx=ctx), "components")
+    assert a.ncomp == b.ncomp == 3 and np.allclose(a.eigenvalues, b.eigenvalues)
