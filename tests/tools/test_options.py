@@ -162,6 +162,20 @@ def behaviour(d):
     r = run("point", st, "pc:all", ok=False)
     check(r.returncode == 1 and "pc:NAME:K" in r.stderr, f"pc:all: {r.stderr!r}")
 
+    # embed --init mean[FILTER] (the point syntax's filter) is mean:FILTER
+    meshes = []
+    for i, init in enumerate(["mean[group=a]", "mean:group=a"]):
+        out = f"{d}/init{i}.obj"
+        r = run("embed", st, "--point", "row:" + lines[1].split(",")[0].removesuffix(".obj"),
+                "--init", init, "-o", out, "--no-store", ok=False)
+        check(r.returncode == 0, f"embed --init {init}: {r.stderr!r}")
+        meshes.append(open(out, "rb").read() if r.returncode == 0 else b"")
+        check(r.returncode != 0 or "4 rows" in r.stdout, f"--init {init} uses group a: {r.stdout!r}")
+    check(meshes[0] == meshes[1], "embed --init mean[group=a] = mean:group=a")
+    r = run("embed", st, "--point", "mean", "--init", "mean[group=a", "-o", f"{d}/x.obj",
+            "--no-store", ok=False)
+    check(r.returncode == 1 and "]" in r.stderr, f"mean[ unclosed: {r.stderr!r}")
+
     # export --select / -s (old) and --where (new)
     run("export", st, "--select", "group=b", "--lengths", f"{d}/l_old.csv")
     run("export", st, "-s", "group=b", "--lengths", f"{d}/l_old2.csv")
