@@ -31,7 +31,7 @@ def cli_copy(store_path, tmp_path):
 
 
 def test_mean_by_group(store_path, cli_copy, tmp_path, cli, ctx):
-    cli("mean", cli_copy, "--by", "expression", "--csv", tmp_path / "m.csv")
+    cli("mean", cli_copy, "--by", "expression", "--output", tmp_path / "m.csv")
     head, M = columns(tmp_path / "m.csv", 3)
     with es.Store(store_path, write=True, ctx=ctx) as s:
         r = s.mean(by="expression", name="expression")
@@ -46,7 +46,7 @@ def test_mean_by_group(store_path, cli_copy, tmp_path, cli, ctx):
 
 
 def test_pca(store_path, cli_copy, tmp_path, cli, ctx):
-    cli("pca", cli_copy, "--name", "p", "--components", "4", "--csv", tmp_path / "p")
+    cli("pca", cli_copy, "--name", "p", "--components", "4", "--output", tmp_path / "p")
     _, comp = columns(tmp_path / "p_components.csv", 3)
     _, eig = columns(tmp_path / "p_eigenvalues.csv", 1)
     head, body = table(tmp_path / "p_scores.csv")
@@ -84,7 +84,7 @@ def test_pca(store_path, cli_copy, tmp_path, cli, ctx):
 
 def test_paired_difference(store_path, cli_copy, tmp_path, cli, ctx):
     cli("diff", cli_copy, "--pair-by", "subject", "--from", "neutral", "--to", "happy",
-        "--name", "smile", "--csv", tmp_path / "d.csv")
+        "--name", "smile", "--output", tmp_path / "d.csv")
     _, D = columns(tmp_path / "d.csv", 3)
     with es.Store(store_path, write=True, ctx=ctx) as s:
         d = s.diff("smile", pair_by="subject", column="expression", from_="neutral", to="happy")
@@ -101,7 +101,7 @@ def test_paired_difference(store_path, cli_copy, tmp_path, cli, ctx):
 
 def test_points_with_their_row_weights(store_path, cli_copy, tmp_path, cli, ctx):
     expr = "mean[expression=neutral] + 0.5*(row:face_s02_happy - row:face_s02_neutral)"
-    cli("point", cli_copy, expr, "--csv", tmp_path / "pt.csv")
+    cli("point", cli_copy, expr, "--output", tmp_path / "pt.csv")
     _, P = columns(tmp_path / "pt.csv", 3)
     with es.Store(store_path, write=True, ctx=ctx) as s:
         pt = s.point(expr, name="half_smile")
@@ -122,7 +122,7 @@ def test_points_with_their_row_weights(store_path, cli_copy, tmp_path, cli, ctx)
 
 def test_projection(store_path, cli_copy, tmp_path, cli, ctx):
     cli("pca", cli_copy, "--name", "p", "--components", "3")
-    cli("project", cli_copy, "--pca", "p", "--where", "expression=angry", "--csv",
+    cli("project", cli_copy, "--pca", "p", "--where", "expression=angry", "--output",
         tmp_path / "pr.csv", "face_s01_neutral")
     head, body = table(tmp_path / "pr.csv")
     with es.Store(store_path, write=True, ctx=ctx) as s:
@@ -175,7 +175,7 @@ def test_model(store_path, cli_copy, tmp_path, cli, ctx):
     numpy: the balanced expression SS, SS + RSS = TSS, and coefficients
     rebuilt from their row weights."""
     cli("model", cli_copy, "~ expression + subject", "--block", "subject", "--permutations", "99",
-        "--name", "m", "--csv", tmp_path / "anova.csv")
+        "--name", "m", "--output", tmp_path / "anova.csv")
     head, body = table(tmp_path / "anova.csv")
     with es.Store(store_path, write=True, ctx=ctx) as s:
         m = s.model("~ expression + subject", block="subject", permutations=99, name="m")
@@ -208,9 +208,9 @@ def test_model_pairwise_z(store_path, cli_copy, tmp_path, cli, ctx):
     """Z and the pairwise table as `edgespace model -o` writes them, bit for
     bit; the LS means from their row weights (numpy); the summary; the
     aliased copy left out with a warning; the comparison with a null model."""
-    cli("model", cli_copy, "~ expression + subject", "--block", "subject", "-p", "49",
+    cli("model", cli_copy, "~ expression + subject", "--block", "subject", "--permutations", "49",
         "--pairwise", "expression", "--reference", "neutral", "--no-store",
-        "--csv", tmp_path / "a.csv")
+        "--output", tmp_path / "a.csv")
     head, body = table(tmp_path / "a.csv")
     phead, pbody = table(tmp_path / "a.pairwise.csv")
     with es.Store(store_path, write=True, ctx=ctx) as s:

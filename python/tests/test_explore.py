@@ -314,7 +314,7 @@ def test_the_command_checks_its_options(study):
     r = subprocess.run([cli_path(), "explore", "--help"], capture_output=True, text=True)
     assert r.returncode == 0 and "127.0.0.1" in r.stdout and "--port" in r.stdout
     for args in ([], ["a.h5", "b.h5"], [str(study), "--port", "70000"],
-                 [str(study), "--port", "x"], [str(study), "--pcs", "-1"]):
+                 [str(study), "--port", "x"], [str(study), "--components", "-1"]):
         r = subprocess.run([cli_path(), "explore", *args], capture_output=True, text=True)
         assert r.returncode == 2, args
     r = subprocess.run([cli_path(), "explore", str(study) + ".missing"], capture_output=True,
