@@ -843,9 +843,8 @@ class Store:
         r = None if rows is None else A.indices(rows, (None,), "rows")
         rep = ffi.new("es_gpa_report *")
         with self._replacing(replace):
-            self._call(lib.es_study_gpa, _s(name), A.iptr(r),
-                       -1 if r is None else len(r), o, A.index(components, "components"), self._command("gpa"),
-                       rep)
+            self._call(lib.es_study_gpa, _s(name), A.iptr(r), -1 if r is None else len(r), o,
+                       A.index(components, "components"), self._command("gpa"), rep)
         self.commit()
         return self.load_gpa(name, A.struct_dict(rep, "es_gpa_report"))
 

@@ -52,3 +52,12 @@ def test_module_pca_components(store_path, ctx):
     a = es.pca(L, components=3, ctx=ctx)
     b = one_warning(lambda: es.pca(L, ncomp=3, ctx=ctx), "components")
     assert a.ncomp == b.ncomp == 3 and np.allclose(a.eigenvalues, b.eigenvalues)
+
+
+def test_gpa_components_beside_npc(store_path, ctx):
+    with es.Store(store_path, write=True, ctx=ctx) as s:
+        rows = s.select(where="expression=happy")
+        a = s.gpa("new", rows=rows, components=2)
+        b = one_warning(lambda: s.gpa("old", rows=rows, npc=2), "components")
+    assert np.array_equal(a.pc_sdev, b.pc_sdev) and len(a.pc_sdev) == 2
+    assert np.array_equal(a.pc_scores, b.pc_scores)
