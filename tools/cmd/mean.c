@@ -24,7 +24,7 @@ static const char usage[] =
     "  -w, --where FILTER only rows matching FILTER\n"
     "  -n, --name NAME    result name in the store\n"
     "      --no-store     compute and export only; leave the store unchanged\n"
-    "  -o, --output PATH     write edge,v0,v1,<group>... (one column per group; - for stdout)\n"
+    "  -o, --output PATH  write edge,v0,v1,<group>... (one column per group; - for stdout)\n"
     "      --replace      replace a stored result of that name (else refused)\n"
     "  -h, --help         show this help\n"
     "\n"

@@ -29,7 +29,7 @@ static const char usage[] =
     "      --oversample P     randomized: extra sample vectors (10)\n"
     "      --power-iters Q    randomized: subspace iterations (4)\n"
     "      --seed S           seed of the randomized method\n"
-    "  -o, --output PREFIX       write PREFIX_scores.csv (id, every label, PC1..PCK),\n"
+    "  -o, --output PREFIX    write PREFIX_scores.csv (id, every label, PC1..PCK),\n"
     "                         PREFIX_eigenvalues.csv and PREFIX_components.csv\n"
     "      --replace          replace a stored result of that name (else refused)\n"
     "  -h, --help             show this help\n"

@@ -20,7 +20,7 @@ static const char usage[] =
     "\n"
     "  -p, --pca NAME      the PCA (default: the only one, or \"default\")\n"
     "  -w, --where FILTER  also project the stored rows matching FILTER\n"
-    "  -o, --output PATH      write name,PC1..PCK,residual as CSV (- for stdout)\n"
+    "  -o, --output PATH   write name,PC1..PCK,residual as CSV (- for stdout)\n"
     "  -h, --help          show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
