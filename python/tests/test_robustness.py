@@ -221,7 +221,7 @@ def test_non_integer_indices_are_refused(store_path, ctx):
             s.positions(0.0)
         with pytest.raises(TypeError, match="row must be an integer"):
             s.source_path(2.9)
-        with pytest.raises(TypeError, match="ncomp must be an integer"):
+        with pytest.raises(TypeError, match="components must be an integer"):
             s.pca(components=2.5)
         with pytest.raises(TypeError, match="permutations must be an integer"):
             s.model("~ expression", permutations=99.9)
