@@ -991,10 +991,12 @@ class Store:
         self._call(lib.es_export_lengths_csv, A.iptr(r), -1 if r is None else len(r),
                       int(raw), _s(path))
 
-    def export_meshes(self, directory, rows=None, fmt="obj"):
-        """Rows' positions as mesh files DIR/<id>.<ext> (es_export_meshes)."""
+    def export_meshes(self, directory, rows=None, format=None, fmt=None):
+        """Rows' positions as mesh files DIR/<id>.<ext> (es_export_meshes) in
+        `format` (the CLI's --format: obj, the default, ply, ply-ascii, off)."""
+        format = renamed("Store.export_meshes", "format", format, "fmt", fmt) or "obj"
         r = None if rows is None else A.indices(rows, (None,), "rows")
-        f = getattr(lib, "ES_FORMAT_" + fmt.upper().replace("-", "_"))
+        f = getattr(lib, "ES_FORMAT_" + format.upper().replace("-", "_"))
         self._call(lib.es_export_meshes, A.iptr(r), -1 if r is None else len(r),
                       _s(directory), f)
 

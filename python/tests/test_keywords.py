@@ -61,3 +61,13 @@ def test_gpa_components_beside_npc(store_path, ctx):
         b = one_warning(lambda: s.gpa("old", rows=rows, npc=2), "components")
     assert np.array_equal(a.pc_sdev, b.pc_sdev) and len(a.pc_sdev) == 2
     assert np.array_equal(a.pc_scores, b.pc_scores)
+
+
+def test_export_meshes_format_beside_fmt(store_path, ctx, tmp_path):
+    with es.Store(store_path, ctx=ctx) as s:
+        rows = s.select(where="expression=happy")
+        s.export_meshes(tmp_path / "new", rows=rows, format="off")
+        one_warning(lambda: s.export_meshes(tmp_path / "old", rows=rows, fmt="off"), "format")
+    new, old = sorted((tmp_path / "new").iterdir()), sorted((tmp_path / "old").iterdir())
+    assert [p.name for p in new] == [p.name for p in old] and new[0].suffix == ".off"
+    assert all(a.read_bytes() == b.read_bytes() for a, b in zip(new, old))
