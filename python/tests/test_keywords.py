@@ -71,3 +71,22 @@ def test_export_meshes_format_beside_fmt(store_path, ctx, tmp_path):
     new, old = sorted((tmp_path / "new").iterdir()), sorted((tmp_path / "old").iterdir())
     assert [p.name for p in new] == [p.name for p in old] and new[0].suffix == ".off"
     assert all(a.read_bytes() == b.read_bytes() for a, b in zip(new, old))
+
+
+def test_explore_module_components_beside_pcs(tmp_path):
+    """python -m edgespace.explore takes --components as edgespace explore
+    does; --pcs still parses, says its new name, and is checked the same."""
+    import subprocess
+    import sys
+
+    def explore(*args):
+        return subprocess.run([sys.executable, "-m", "edgespace.explore",
+                               str(tmp_path / "none.h5"), *args],
+                              capture_output=True, text=True, timeout=60)
+    r = explore("--pcs", "-1")
+    assert r.returncode == 2 and "--pcs K is now --components K" in r.stderr, r.stderr
+    assert "--components wants 0 (all) or more" in r.stderr
+    r = explore("--components", "-1")
+    assert r.returncode == 2 and "is now" not in r.stderr and "--components wants" in r.stderr
+    r = explore("--components", "2", "--pcs", "2")
+    assert r.returncode == 2 and "not both" in r.stderr

@@ -141,7 +141,7 @@ int cmd_explore(int argc, char **argv)
     args[k++] = port;
     args[k++] = "--host";
     args[k++] = host;
-    args[k++] = "--pcs";
+    args[k++] = "--components";
     args[k++] = pcs;
     if (pca) {
         args[k++] = "--pca";
