@@ -88,7 +88,8 @@ void cli_deprecated(const char *verb, const char *old, const char *new_)
 static void warn_alias(const char *verb, const cli_alias *a)
 {
     static unsigned char said[N_ALIASES];
-    if (said[a - aliases]++) return;
+    if (said[a - aliases]) return;
+    said[a - aliases] = 1;
     char old[64], new_[64];
     const char *m = a->metavar ? a->metavar : "", *sp = a->metavar ? " " : "";
     snprintf(old, sizeof old, "%s%s%s", a->old, sp, m);
@@ -113,7 +114,8 @@ static int long_wants_next(const char *name, const struct option *lo)
 
 /* "--NEW" or "--NEW=VALUE" in memory that lives as long as the run (argv's
  * strings do): a static arena, so nothing is left for a leak checker to
- * report; NULL when a command line holds more old spellings than it fits. */
+ * report; NULL when the old spellings of one command line (values
+ * included) pass its 8 KiB. */
 static char *spelled(const char *new_, const char *value)
 {
     static char arena[8192];
@@ -179,8 +181,8 @@ int cli_getopt(int argc, char **argv, const char *shortopts, const struct option
     if (optind <= 1) {
         int rc = rewrite(argc, argv, shortopts, lo);
         if (rc == CLI_FAIL) {
-            fprintf(stderr, "edgespace %s: too many old option spellings in one command "
-                    "line; write them as README \"Options\" says\n", argv[0]);
+            fprintf(stderr, "edgespace %s: the old option spellings of this command line "
+                    "are too long to rewrite; write them as README \"Options\" says\n", argv[0]);
             return '?';
         }
         if (rc) return '?';
