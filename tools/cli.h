@@ -62,6 +62,17 @@ int cli_parse_size(const char *s, uint64_t *out);
     "                       Marquardt iterations (default 0.0025)\n"
 int cli_embed_option(const char *verb, int c, const char *arg, es_embed_opts *o);
 
+/* getopt_long for a subcommand (argv[0] is the verb), with the old option
+ * spellings of README "Options" rewritten in argv to their new ones and
+ * each one used said once on stderr ("edgespace gpa: --pcs N is now
+ * --components N; the old spelling will go"). tools/cli_options.c holds the
+ * table. Returns what getopt_long does; '?' after printing why. */
+struct option;
+/* "edgespace VERB: OLD is now NEW; the old spelling will go" on stderr, for
+ * an old form no option table can rewrite (plot STORE --pca). */
+void cli_deprecated(const char *verb, const char *old, const char *new_);
+int cli_getopt(int argc, char **argv, const char *shortopts, const struct option *longopts);
+
 /* Subcommand entry points: argv[0] is the verb. */
 typedef int (*cli_cmd_fn)(int argc, char **argv);
 

@@ -8,7 +8,7 @@
  *     unary   := ('-' | '+') unary | primary
  *     primary := NUMBER | '(' sum ')' | 'lerp' '(' sum ',' sum ',' sum ')'
  *              | 'mean' ['[' NAME '=' VALUE (',' NAME '=' VALUE)* ']']
- *              | 'row:' ID | 'file:' PATH | 'pc:' INTEGER | 'diff:' NAME
+ *              | 'row:' ID | 'file:' PATH | 'pc:' [NAME ':'] INTEGER | 'diff:' NAME
  *              | 'coef:' NAME ':' COEF
  * Numbers are constants, so each sub-expression is either a number or a
  * linear form sum c_i leaf_i; the parser checks the types as it goes (a
@@ -385,15 +385,28 @@ static es_status parse_primary(parser *p, form *f)
                             "found '%.*s'", (int)wl, w);
             return add_term(p, 1.0, ES_POINT_FILE, w, wl, 0, f);
         }
-        /* pc:K */
-        int64_t k = 0;
+        /* pc:K (the PCA of --pca) or pc:NAME:K (the PCA named inline, as
+         * coef:MODEL:COEF names its model). Digits not followed by ':' are
+         * K, so pc:1-row:a stays pc:1 minus row:a. */
         size_t j = p->pos;
+        while (isdigit((unsigned char)p->s[j])) j++;
+        if (j == p->pos || p->s[j] == ':') {
+            if ((rc = word(p, is_id_char, "a PCA name or a component number", &w, &wl)) != ES_OK)
+                return rc;
+            if (p->s[p->pos] != ':')
+                return perr(p, p->pos, "expected ':' and a component number after 'pc:%.*s' "
+                            "(pc:K or pc:NAME:K)", (int)wl, w);
+            wat = ++p->pos;
+        }
+        int64_t k = 0;
+        j = p->pos;
         while (isdigit((unsigned char)p->s[j]) && k < 1000000000) k = 10 * k + (p->s[j++] - '0');
         if (j == p->pos || k < 1 || isalnum((unsigned char)p->s[j]) || p->s[j] == '_' ||
             p->s[j] == '.')
-            return perr(p, wat, "expected a component number >= 1 after 'pc:'");
+            return perr(p, wat, "expected a component number >= 1 after 'pc:%.*s%s'",
+                        (int)wl, w ? w : "", w ? ":" : "");
         p->pos = j;
-        return add_term(p, 1.0, ES_POINT_PC, "", 0, k, f);
+        return add_term(p, 1.0, ES_POINT_PC, w ? w : "", wl, k, f);
     }
 #undef IS
     return perr(p, at, "unknown name '%.*s' (expected mean, row:, file:, pc:, diff:, coef: "
@@ -590,7 +603,8 @@ es_status es_point_eval_rows(es_ctx *ctx, const es_point_expr *x, int64_t E, int
             snprintf(msg, sizeof msg, "%s", es_ctx_errmsg(ctx));
             es__free(ctx, leaf);
             if (t->kind == ES_POINT_PC)
-                ES_FAIL(ctx, rc, "point: pc:%lld: %s", (long long)t->index, msg);
+                ES_FAIL(ctx, rc, "point: pc:%s%s%lld: %s", t->arg, *t->arg ? ":" : "",
+                        (long long)t->index, msg);
             if (t->kind == ES_POINT_MEAN)
                 ES_FAIL(ctx, rc, "point: mean%s%s%s: %s", *t->arg ? "[" : "", t->arg,
                         *t->arg ? "]" : "", msg);
@@ -605,8 +619,8 @@ es_status es_point_eval_rows(es_ctx *ctx, const es_point_expr *x, int64_t E, int
         if (t->kind == ES_POINT_PC) {
             if (!(s >= 0) || !isfinite(s)) {
                 es__free(ctx, leaf);
-                ES_FAIL(ctx, ES_ENUMERIC, "point: pc:%lld: standard deviation is %g",
-                        (long long)t->index, s);
+                ES_FAIL(ctx, ES_ENUMERIC, "point: pc:%s%s%lld: standard deviation is %g",
+                        t->arg, *t->arg ? ":" : "", (long long)t->index, s);
             }
             c *= s;
             in.ndirections++;

@@ -508,9 +508,18 @@ static es_status file_weights(es_ctx *ctx, es_study_resolver *r, const double *l
     return es_pca_row_weights(ctx, r->all_rows, len, ES_RIDGE_REL, w);
 }
 
-static es_status resolve_pc(es_ctx *ctx, es_study_resolver *r, int64_t index, double *vec,
-                            double *scale, double *w)
+/* Component `index` of the resolver's PCA (pc:K) or of the one named inline
+ * (pc:NAME:K, arg NAME): the resolver's is loaded once and kept, another
+ * one is loaded for this leaf alone (an expression rarely mixes PCAs). */
+static es_status resolve_pc(es_ctx *ctx, es_study_resolver *r, const char *arg, int64_t index,
+                            double *vec, double *scale, double *w)
 {
+    if (arg && *arg && !(r->pca_name && !strcmp(arg, r->pca_name))) {
+        es_study_resolver other = {r->store, NULL, arg, NULL, NULL, NULL, NULL};
+        es_status rc = resolve_pc(ctx, &other, NULL, index, vec, scale, w);
+        es_study_resolver_clear(ctx, &other);
+        return rc;
+    }
     const int64_t E = es_store_nedges(r->store);
     es_status rc;
     int64_t n;
@@ -625,7 +634,7 @@ es_status es_study_resolve(es_ctx *ctx, void *ud, es_point_leaf kind, const char
         if ((rc = es_lengths_from_file(ctx, r->mesh, arg, vec, scale)) != ES_OK) return rc;
         return w ? file_weights(ctx, r, vec, w) : ES_OK;
     case ES_POINT_PC:
-        return resolve_pc(ctx, r, index, vec, scale, w);
+        return resolve_pc(ctx, r, arg, index, vec, scale, w);
     case ES_POINT_DIFF:
         return resolve_diff(ctx, r, arg, vec, w);
     case ES_POINT_COEF: {

@@ -43,8 +43,17 @@ static es_status choose_start(es_ctx *ctx, es_store *s, const es_mesh *mesh, con
             ES_FAIL(ctx, ES_ENOTFOUND, "no row '%s' in the store%s", init + 4, hint);
         }
         snprintf(desc, ndesc, "row %s", init + 4);
-    } else if (!strncmp(init, "mean", 4) && (init[4] == 0 || init[4] == ':')) {
-        if ((rc = es_store_select(ctx, s, init[4] ? init + 5 : NULL, sel, nsel)) != ES_OK)
+    } else if (!strncmp(init, "mean", 4) && (init[4] == 0 || init[4] == ':' || init[4] == '[')) {
+        /* mean[FILTER] as in the point syntax, or the older mean:FILTER */
+        char filter[1024];
+        size_t n = strlen(init);
+        if (init[4] == '[' && init[n - 1] != ']')
+            ES_FAIL(ctx, ES_EINVAL, "--init %s: expected mean[FILTER] with the closing ']'",
+                    init);
+        if (n >= sizeof filter) ES_FAIL(ctx, ES_EINVAL, "--init: the filter is too long");
+        snprintf(filter, sizeof filter, "%.*s", init[4] == '[' ? (int)(n - 6) : (int)sizeof filter,
+                 init[4] ? init + 5 : "");
+        if ((rc = es_store_select(ctx, s, init[4] ? filter : NULL, sel, nsel)) != ES_OK)
             return rc;
         if (*nsel == 0) ES_FAIL(ctx, ES_ENOTFOUND, "--init %s selects no rows", init);
         if ((rc = es_study_mean_dihedrals(ctx, s, mesh, *sel, *nsel, alpha)) != ES_OK)
@@ -56,7 +65,7 @@ static es_status choose_start(es_ctx *ctx, es_store *s, const es_mesh *mesh, con
         if ((rc = es_mesh_read_positions(ctx, mesh, init + 5, init_xyz)) != ES_OK) return rc;
         snprintf(desc, ndesc, "mesh %s", init + 5);
     } else {
-        ES_FAIL(ctx, ES_EINVAL, "--init wants prior, nearest, row:ID, mean[:FILTER] or "
+        ES_FAIL(ctx, ES_EINVAL, "--init wants prior, nearest, row:ID, mean, mean[FILTER] or "
                 "mesh:FILE (got '%s')", init);
     }
     if (*init_row >= 0) return es_store_read_positions(ctx, s, *init_row, init_xyz);

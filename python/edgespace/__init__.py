@@ -10,8 +10,8 @@ computes; arrays cross the boundary without copies where the layouts agree
     es.ingest("faces.h5", manifest="faces/manifest.csv")
     with es.Store("faces.h5", write=True) as s:
         L = s.lengths()                         # (N, E) float64
-        pca = s.pca("faces", ncomp=10)          # stored as /analysis/pca/faces
-        s.diff("smile", key="subject", column="expression", from_="neutral", to="happy")
+        pca = s.pca("faces", components=10)     # stored as /analysis/pca/faces
+        s.diff("smile", pair_by="subject", column="expression", from_="neutral", to="happy")
         V, F, report = s.embed("mean[expression=neutral] + diff:smile")
     es.render((V, F))                            # PNG bytes, inline in Jupyter
 
@@ -27,6 +27,7 @@ from ._context import Context, EdgespaceWarning, default_context
 from ._errors import (CancelledError, ConvergenceError, Error, ExistsError, FormatError,
                       InvalidError, IOFailure, MismatchError, NoMemoryError, NotFoundError,
                       NumericError, RangeError, TopologyError)
+from ._names import renamed
 from ._native import INCLUDE_DIR, LIBRARY_PATH, LoadError, ffi, lib
 from .mesh import (Embedder, Embedding, Mesh, embed, embed_opts, normalize_lengths,
                    read_mesh)
@@ -63,7 +64,7 @@ def has_figures():
     return has("es_render")
 
 
-def pca(X, ncomp=0, method="auto", oversample=10, power_iters=4, ctx=None):
+def pca(X, components=None, method="auto", oversample=10, power_iters=4, ctx=None, ncomp=None):
     """PCA of the rows of an (N, E) array of length vectors (es_pca_fit on
     es_source_matrix: the array is the library's E x N matrix, not copied)."""
     from ._context import ctx_of
@@ -75,7 +76,8 @@ def pca(X, ncomp=0, method="auto", oversample=10, power_iters=4, ctx=None):
     srcp = ffi.new("es_source *", src)
     o = ffi.new("es_pca_opts *")
     lib.es_pca_opts_init(o)
-    o.ncomp, o.method = _A.index(ncomp, "ncomp"), _pca_method(method)
+    components = renamed("edgespace.pca", "components", components, "ncomp", ncomp) or 0
+    o.ncomp, o.method = _A.index(components, "components"), _pca_method(method)
     o.oversample = _A.index(oversample, "oversample")
     o.power_iters = _A.index(power_iters, "power_iters")
     out = ffi.new("es_pca **")

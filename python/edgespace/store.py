@@ -19,6 +19,7 @@ import numpy as np
 
 from . import _arrays as A
 from ._context import ctx_of
+from ._names import renamed
 from ._native import ffi, lib
 from .mesh import Embedding, Mesh, report_dict, set_embed_opts, study_embedding
 
@@ -390,10 +391,11 @@ class Store:
         """Row of an id, or -1."""
         return int(self._get(lib.es_store_find_row, _s(id)))
 
-    def select(self, filter=None):
+    def select(self, where=None, filter=None):
         """Rows matching "col=value[,col=value...]" (None: all), int64 array."""
+        where = renamed("Store.select", "where", where, "filter", filter)
         rows, n = ffi.new("int64_t **"), ffi.new("int64_t *")
-        self._call(lib.es_store_select, _s(filter) or ffi.NULL, rows, n)
+        self._call(lib.es_store_select, _s(where) or ffi.NULL, rows, n)
         return np.array(A.view(rows[0], (n[0],), A.Freed(self.ctx, rows[0]), "i8"))
 
     def source_path(self, row):
@@ -569,14 +571,15 @@ class Store:
     def _command(self, what):
         return _c(f"python: edgespace.Store.{what}")
 
-    def mean(self, by=None, filter=None, name=None, replace=False):
-        """Means of the rows matching filter, one per value of label column
+    def mean(self, by=None, where=None, name=None, replace=False, filter=None):
+        """Means of the rows matching `where`, one per value of label column
         `by` (es_study_mean); stored as mean/<name> when name is given
         (replace=True: over one of that name, as every storing call)."""
+        where = renamed("Store.mean", "where", where, "filter", filter)
         out = ffi.new("es_group_result **")
         with self._replacing(replace):
             self._call(lib.es_study_mean, _s(name) or ffi.NULL,
-                      _s(filter) or ffi.NULL, _s(by) or ffi.NULL, self._command("mean"), out)
+                      _s(where) or ffi.NULL, _s(by) or ffi.NULL, self._command("mean"), out)
         r = A.owned(self.ctx, out[0], lib.es_group_result_free)
         G, E = int(r.ngroups), int(r.nedges)
         res = MeanResult(groups=[A.string(r.names[g]) for g in range(G)],
@@ -586,18 +589,21 @@ class Store:
         self._committed(name)
         return res
 
-    def pca(self, name=None, filter=None, ncomp=0, method="auto", oversample=10,
-            power_iters=4, replace=False):
-        """Fit a PCA of the rows matching filter (es_study_pca); stored as
-        pca/<name> when name is given. Returns a PCA with .rows."""
+    def pca(self, name=None, where=None, components=None, method="auto", oversample=10,
+            power_iters=4, replace=False, filter=None, ncomp=None):
+        """Fit a PCA of the rows matching `where` (es_study_pca), keeping
+        `components` (None or 0: all); stored as pca/<name> when name is
+        given. Returns a PCA with .rows."""
+        where = renamed("Store.pca", "where", where, "filter", filter)
+        components = renamed("Store.pca", "components", components, "ncomp", ncomp) or 0
         o = ffi.new("es_pca_opts *")
         lib.es_pca_opts_init(o)
-        o.ncomp, o.method = A.index(ncomp, "ncomp"), _pca_method(method)
+        o.ncomp, o.method = A.index(components, "components"), _pca_method(method)
         o.oversample = A.index(oversample, "oversample")
         o.power_iters = A.index(power_iters, "power_iters")
         out, rows, n = ffi.new("es_pca **"), ffi.new("int64_t **"), ffi.new("int64_t *")
         with self._replacing(replace):
-            self._call(lib.es_study_pca, _s(name) or ffi.NULL, _s(filter) or ffi.NULL,
+            self._call(lib.es_study_pca, _s(name) or ffi.NULL, _s(where) or ffi.NULL,
                           o, self._command("pca"), out, rows, n)
         r = np.array(A.view(rows[0], (n[0],), A.Freed(self.ctx, rows[0]), "i8"))
         self._committed(name)
@@ -610,13 +616,17 @@ class Store:
         r = np.array(A.view(rows[0], (n[0],), A.Freed(self.ctx, rows[0]), "i8"))
         return PCA(self.ctx, out[0], r)
 
-    def diff(self, name, key, column, from_, to, filter=None, replace=False):
-        """Paired difference to - from, rows paired by label `key`
-        (es_study_diff); stored as diff/<name> when name is given."""
+    def diff(self, name, pair_by=None, column=None, from_=None, to=None, where=None,
+             replace=False, key=None, filter=None):
+        """Paired difference to - from of label `column`, rows paired by
+        label `pair_by` (es_study_diff; the CLI's --pair-by, --column,
+        --from, --to, --where); stored as diff/<name> when name is given."""
+        pair_by = renamed("Store.diff", "pair_by", pair_by, "key", key)
+        where = renamed("Store.diff", "where", where, "filter", filter)
         out = ffi.new("es_diff **")
         with self._replacing(replace):
-            self._call(lib.es_study_diff, _s(name) or ffi.NULL, _s(filter) or ffi.NULL,
-                          _s(key), _s(column), _s(from_), _s(to), self._command("diff"), out)
+            self._call(lib.es_study_diff, _s(name) or ffi.NULL, _s(where) or ffi.NULL,
+                          _s(pair_by), _s(column), _s(from_), _s(to), self._command("diff"), out)
         d = A.owned(self.ctx, out[0], lib.es_diff_free)
         E, P, U = int(d.nedges), int(d.npairs), int(d.nunpaired)
         res = Diff(mean=A.view(d.mean, (E,), d), sd=A.view(d.sd, (E,), d),
@@ -851,10 +861,11 @@ class Store:
                 "residuals": np.array(A.view(p.residuals, (n,), p))}
 
     def gpa(self, name, rows=None, scale=True, allow_reflection=False, tol=1e-10,
-            max_iter=1000, npc=0, replace=False):
+            max_iter=1000, components=None, replace=False, npc=None):
         """GPA of the rows' positions with the PCA of the tangent coordinates
         (es_study_gpa), stored as gpa/<name> and committed; the stored arrays
         come back in (specimen, landmark, dimension) order."""
+        components = renamed("Store.gpa", "components", components, "npc", npc) or 0
         o = ffi.new("es_gpa_opts *")
         lib.es_gpa_opts_init(o)
         o.scale, o.allow_reflection, o.tol, o.max_iter = int(scale), int(allow_reflection), \
@@ -862,9 +873,8 @@ class Store:
         r = None if rows is None else A.indices(rows, (None,), "rows")
         rep = ffi.new("es_gpa_report *")
         with self._replacing(replace):
-            self._call(lib.es_study_gpa, _s(name), A.iptr(r),
-                       -1 if r is None else len(r), o, A.index(npc, "npc"), self._command("gpa"),
-                       rep)
+            self._call(lib.es_study_gpa, _s(name), A.iptr(r), -1 if r is None else len(r), o,
+                       A.index(components, "components"), self._command("gpa"), rep)
         self.commit()
         return self.load_gpa(name, A.struct_dict(rep, "es_gpa_report"))
 
@@ -1011,15 +1021,17 @@ class Store:
         self._call(lib.es_export_lengths_csv, A.iptr(r), -1 if r is None else len(r),
                       int(raw), _s(path))
 
-    def export_meshes(self, directory, rows=None, fmt="obj"):
-        """Rows' positions as mesh files DIR/<id>.<ext> (es_export_meshes)."""
+    def export_meshes(self, directory, rows=None, format=None, fmt=None):
+        """Rows' positions as mesh files DIR/<id>.<ext> (es_export_meshes) in
+        `format` (the CLI's --format: obj, the default, ply, ply-ascii, off)."""
+        format = renamed("Store.export_meshes", "format", format, "fmt", fmt) or "obj"
         r = None if rows is None else A.indices(rows, (None,), "rows")
-        f = getattr(lib, "ES_FORMAT_" + fmt.upper().replace("-", "_"))
+        f = getattr(lib, "ES_FORMAT_" + format.upper().replace("-", "_"))
         self._call(lib.es_export_meshes, A.iptr(r), -1 if r is None else len(r),
                       _s(directory), f)
 
-    def export_statismo(self, path, pca=None, gpa=None, ncomp=0, sd=1.0, noise_variance=None,
-                        **opts):
+    def export_statismo(self, path, pca=None, gpa=None, components=None, sd=1.0,
+                        noise_variance=None, ncomp=None, **opts):
         """A statismo shape model of a stored PCA or GPA
         (es_study_export_statismo; datasets-spec/statismo.md; a landmark GPA
         as a POINT_SET model). Returns the report as a dict: kind, and for
@@ -1029,7 +1041,9 @@ class Store:
         lib.es_study_statismo_opts_init(o)
         keep = [_c(pca), _c(gpa), self._command("export_statismo")]
         o.pca_name, o.gpa_name, o.command = keep
-        o.ncomp, o.sd = A.index(ncomp, "ncomp"), float(sd)
+        components = renamed("Store.export_statismo", "components", components, "ncomp",
+                             ncomp) or 0
+        o.ncomp, o.sd = A.index(components, "components"), float(sd)
         if noise_variance is not None:
             o.noise_variance = float(noise_variance)
         set_embed_opts(o.embed, opts)

@@ -31,7 +31,7 @@ def cli_copy(store_path, tmp_path):
 
 
 def test_mean_by_group(store_path, cli_copy, tmp_path, cli, ctx):
-    cli("mean", cli_copy, "--by", "expression", "--csv", tmp_path / "m.csv")
+    cli("mean", cli_copy, "--by", "expression", "--output", tmp_path / "m.csv")
     head, M = columns(tmp_path / "m.csv", 3)
     with es.Store(store_path, write=True, ctx=ctx) as s:
         r = s.mean(by="expression", name="expression")
@@ -46,12 +46,12 @@ def test_mean_by_group(store_path, cli_copy, tmp_path, cli, ctx):
 
 
 def test_pca(store_path, cli_copy, tmp_path, cli, ctx):
-    cli("pca", cli_copy, "--name", "p", "--components", "4", "--csv", tmp_path / "p")
+    cli("pca", cli_copy, "--name", "p", "--components", "4", "--output", tmp_path / "p")
     _, comp = columns(tmp_path / "p_components.csv", 3)
     _, eig = columns(tmp_path / "p_eigenvalues.csv", 1)
     head, body = table(tmp_path / "p_scores.csv")
     with es.Store(store_path, write=True, ctx=ctx) as s:
-        p = s.pca("p", ncomp=4)
+        p = s.pca("p", components=4)
         assert np.array_equal(p.mean, comp[:, 0])
         assert np.array_equal(p.components, comp[:, 1:].T)
         assert np.array_equal(p.eigenvalues, eig[:, 0])
@@ -68,7 +68,7 @@ def test_pca(store_path, cli_copy, tmp_path, cli, ctx):
         for k in range(4):   # unit components, up to sign
             assert np.isclose(abs(p.components[k] @ Vt[k]), 1, atol=1e-8)
         # the same PCA on the array (es_pca_fit on the matrix, no store)
-        q = es.pca(L, ncomp=4, ctx=ctx)
+        q = es.pca(L, components=4, ctx=ctx)
         assert np.allclose(q.eigenvalues, p.eigenvalues, rtol=1e-12, atol=0)
         # load it back; project rows onto it
         r = s.load_pca("p")
@@ -84,10 +84,10 @@ def test_pca(store_path, cli_copy, tmp_path, cli, ctx):
 
 def test_paired_difference(store_path, cli_copy, tmp_path, cli, ctx):
     cli("diff", cli_copy, "--pair-by", "subject", "--from", "neutral", "--to", "happy",
-        "--name", "smile", "--csv", tmp_path / "d.csv")
+        "--name", "smile", "--output", tmp_path / "d.csv")
     _, D = columns(tmp_path / "d.csv", 3)
     with es.Store(store_path, write=True, ctx=ctx) as s:
-        d = s.diff("smile", key="subject", column="expression", from_="neutral", to="happy")
+        d = s.diff("smile", pair_by="subject", column="expression", from_="neutral", to="happy")
         for j, f in enumerate(("mean", "sd", "se", "t")):
             assert np.array_equal(getattr(d, f), D[:, j])
         L = s.lengths()
@@ -101,7 +101,7 @@ def test_paired_difference(store_path, cli_copy, tmp_path, cli, ctx):
 
 def test_points_with_their_row_weights(store_path, cli_copy, tmp_path, cli, ctx):
     expr = "mean[expression=neutral] + 0.5*(row:face_s02_happy - row:face_s02_neutral)"
-    cli("point", cli_copy, expr, "--csv", tmp_path / "pt.csv")
+    cli("point", cli_copy, expr, "--output", tmp_path / "pt.csv")
     _, P = columns(tmp_path / "pt.csv", 3)
     with es.Store(store_path, write=True, ctx=ctx) as s:
         pt = s.point(expr, name="half_smile")
@@ -122,11 +122,11 @@ def test_points_with_their_row_weights(store_path, cli_copy, tmp_path, cli, ctx)
 
 def test_projection(store_path, cli_copy, tmp_path, cli, ctx):
     cli("pca", cli_copy, "--name", "p", "--components", "3")
-    cli("project", cli_copy, "--pca", "p", "--where", "expression=angry", "--csv",
+    cli("project", cli_copy, "--pca", "p", "--where", "expression=angry", "--output",
         tmp_path / "pr.csv", "face_s01_neutral")
     head, body = table(tmp_path / "pr.csv")
     with es.Store(store_path, write=True, ctx=ctx) as s:
-        s.pca("p", ncomp=3)
+        s.pca("p", components=3)
         r = s.project(["face_s01_neutral"], where="expression=angry", pca="p")
         assert r["names"] == [b[0] for b in body]
         assert np.array_equal(r["scores"], np.array([[float(x) for x in b[1:4]] for b in body]))
@@ -175,7 +175,7 @@ def test_model(store_path, cli_copy, tmp_path, cli, ctx):
     numpy: the balanced expression SS, SS + RSS = TSS, and coefficients
     rebuilt from their row weights."""
     cli("model", cli_copy, "~ expression + subject", "--block", "subject", "--permutations", "99",
-        "--name", "m", "--csv", tmp_path / "anova.csv")
+        "--name", "m", "--output", tmp_path / "anova.csv")
     head, body = table(tmp_path / "anova.csv")
     with es.Store(store_path, write=True, ctx=ctx) as s:
         m = s.model("~ expression + subject", block="subject", permutations=99, name="m")
@@ -235,9 +235,9 @@ def test_model_pairwise_z(store_path, cli_copy, tmp_path, cli, ctx):
     """Z and the pairwise table as `edgespace model -o` writes them, bit for
     bit; the LS means from their row weights (numpy); the summary; the
     aliased copy left out with a warning; the comparison with a null model."""
-    cli("model", cli_copy, "~ expression + subject", "--block", "subject", "-p", "49",
+    cli("model", cli_copy, "~ expression + subject", "--block", "subject", "--permutations", "49",
         "--pairwise", "expression", "--reference", "neutral", "--no-store",
-        "--csv", tmp_path / "a.csv")
+        "--output", tmp_path / "a.csv")
     head, body = table(tmp_path / "a.csv")
     phead, pbody = table(tmp_path / "a.pairwise.csv")
     with es.Store(store_path, write=True, ctx=ctx) as s:

@@ -36,7 +36,7 @@ def test_results_are_views_of_the_librarys_memory(ctx):
     X = np.random.default_rng(4).random((12, 30))
     with pytest.raises(ValueError, match="one of auto, gram"):
         es.pca(X, method="exact", ctx=ctx)
-    p = es.pca(X, ncomp=3, method="gram", ctx=ctx)
+    p = es.pca(X, components=3, method="gram", ctx=ctx)
     assert p.components.__array_interface__["data"][0] == addr(p.ptr.components)
     assert p.mean.__array_interface__["data"][0] == addr(p.ptr.mean)
     assert p.scores.shape == (12, 3) and not p.components.flags.writeable
@@ -77,7 +77,7 @@ def test_library_memory_alive_at_exit_is_freed_quietly(store_path, tmp_path):
     import subprocess
     import sys
     with es.Store(store_path, write=True, ctx=es.Context(progress=None)) as s:
-        s.pca("p", ncomp=2)
+        s.pca("p", components=2)
     script = tmp_path / "exit.py"
     script.write_text(EXIT_SCRIPT)
     env = dict(os.environ, MALLOC_PERTURB_="17")

@@ -88,7 +88,7 @@ def test_progress_reaches_the_callback(store_path):
     seen = []
     ctx = es.Context(progress=lambda what, done, total: seen.append((what, done, total)))
     with es.Store(store_path, ctx=ctx) as s:
-        s.pca(ncomp=3)
+        s.pca(components=3)
     stages = {w for w, _, _ in seen}
     assert any(w.startswith("pca") for w in stages)
     for w in stages:   # every stage ends at done == total
@@ -106,9 +106,9 @@ def test_an_exception_in_a_callback_comes_out_of_the_call(store_path):
     ctx = es.Context(progress=boom)
     with es.Store(store_path, ctx=ctx) as s:
         with pytest.raises(Stop):
-            s.pca(ncomp=2)
+            s.pca(components=2)
         ctx.progress = None           # and the context is usable afterwards
-        assert s.pca(ncomp=2).ncomp == 2
+        assert s.pca(components=2).ncomp == 2
 
 
 def test_tqdm_progress_when_installed(store_path):
@@ -116,7 +116,7 @@ def test_tqdm_progress_when_installed(store_path):
     ctx = es.Context(progress=True)
     assert ctx.progress is not None
     with es.Store(store_path, ctx=ctx) as s:
-        assert s.pca(ncomp=2).ncomp == 2
+        assert s.pca(components=2).ncomp == 2
 
 
 def test_no_notebook_bars_outside_a_kernel_or_with_old_widgets(monkeypatch):

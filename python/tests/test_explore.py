@@ -40,8 +40,8 @@ def study(base_store, tmp_path_factory):
     path = tmp_path_factory.mktemp("explore") / "faces.h5"
     shutil.copyfile(base_store, path)
     with es.Store(path, write=True, ctx=es.Context(progress=None)) as s:
-        s.pca("p", ncomp=4)
-        s.diff("smile", key="subject", column="expression", from_="neutral", to="happy")
+        s.pca("p", components=4)
+        s.diff("smile", pair_by="subject", column="expression", from_="neutral", to="happy")
         s.model("~ expression", name="m", permutations=0)
     return path
 
@@ -314,7 +314,7 @@ def test_the_command_checks_its_options(study):
     r = subprocess.run([cli_path(), "explore", "--help"], capture_output=True, text=True)
     assert r.returncode == 0 and "127.0.0.1" in r.stdout and "--port" in r.stdout
     for args in ([], ["a.h5", "b.h5"], [str(study), "--port", "70000"],
-                 [str(study), "--port", "x"], [str(study), "--pcs", "-1"]):
+                 [str(study), "--port", "x"], [str(study), "--components", "-1"]):
         r = subprocess.run([cli_path(), "explore", *args], capture_output=True, text=True)
         assert r.returncode == 2, args
     r = subprocess.run([cli_path(), "explore", str(study) + ".missing"], capture_output=True,
@@ -672,8 +672,8 @@ def test_face_study_with_every_kind_of_slider(tmp_path):
     ctx = es.Context(progress=None)
     es.ingest(store, manifest=os.path.join(data, "manifest.csv"), ctx=ctx)
     with es.Store(store, write=True, ctx=ctx) as s:
-        s.pca("p", ncomp=5)
-        s.diff("smile", key="subject", column="expression", from_="neutral", to="happy")
+        s.pca("p", components=5)
+        s.diff("smile", pair_by="subject", column="expression", from_="neutral", to="happy")
         s.model("~ expression + subject", name="es", permutations=0)
     ex = Explorer(store, pca="p", warm=False)
     try:

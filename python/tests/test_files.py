@@ -18,7 +18,7 @@ import edgespace as es
 def test_lengths_csv_is_the_commands(store_path, tmp_path, cli, ctx):
     cli("export", store_path, "--lengths", tmp_path / "cli.csv")
     cli("export", store_path, "--lengths", tmp_path / "cli_raw.csv", "--raw",
-        "--select", "expression=happy")
+        "--where", "expression=happy")
     with es.Store(store_path, ctx=ctx) as s:
         s.export_lengths_csv(tmp_path / "py.csv")
         s.export_lengths_csv(tmp_path / "py_raw.csv", rows=s.select("expression=happy"), raw=True)
@@ -31,10 +31,10 @@ def test_lengths_csv_is_the_commands(store_path, tmp_path, cli, ctx):
 
 def test_meshes_are_the_commands(store_path, tmp_path, cli, ctx):
     cli("export", store_path, "--meshes", tmp_path / "cli", "--format", "ply",
-        "--select", "subject=s02")
+        "--where", "subject=s02")
     with es.Store(store_path, ctx=ctx) as s:
         rows = s.select("subject=s02")
-        s.export_meshes(tmp_path / "py", rows=rows, fmt="ply")
+        s.export_meshes(tmp_path / "py", rows=rows, format="ply")
         ids = [s.ids[r] for r in rows]
         P = s.positions(rows)
         mesh = s.mesh
@@ -46,7 +46,7 @@ def test_meshes_are_the_commands(store_path, tmp_path, cli, ctx):
         assert f.read_bytes() == (tmp_path / "cli" / f"{i}.ply").read_bytes()
         assert np.array_equal(mesh.read_positions(f), p)   # binary PLY: the same doubles
     with es.Store(store_path, ctx=ctx) as s, pytest.raises(AttributeError):
-        s.export_meshes(tmp_path / "x", fmt="stl")         # no such format
+        s.export_meshes(tmp_path / "x", format="stl")         # no such format
 
 
 def test_the_nearest_row_is_numpys(store_path, ctx):

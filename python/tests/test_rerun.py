@@ -17,14 +17,14 @@ import edgespace as es
 
 def test_a_stored_pca_is_refused_then_replaced(store_path, ctx):
     with es.Store(store_path, write=True, ctx=ctx) as s:
-        s.pca("faces", ncomp=3)
+        s.pca("faces", components=3)
         with pytest.raises(es.ExistsError, match=r"replace=True"):
-            s.pca("faces", ncomp=2)
-        p = s.pca("faces", ncomp=2, replace=True)
+            s.pca("faces", components=2)
+        p = s.pca("faces", components=2, replace=True)
         with pytest.raises(es.ExistsError):   # the handle's mode is back
-            s.pca("faces", ncomp=4)
+            s.pca("faces", components=4)
         s.mean(by="expression", name="m")
-        s.mean(by="expression", filter="expression=happy", name="m", replace=True)
+        s.mean(by="expression", where="expression=happy", name="m", replace=True)
     # each result a file beside the store (format 3), laid out as inside one
     with h5py.File(f"{store_path}.results/pca/faces.h5", "r") as f:
         g = f["analysis/pca/faces"]
@@ -36,8 +36,8 @@ def test_a_stored_pca_is_refused_then_replaced(store_path, ctx):
 
 def test_delete_result_and_what_is_left(store_path, ctx):
     with es.Store(store_path, write=True, ctx=ctx) as s:
-        s.pca("a", ncomp=2)
-        s.pca("b", ncomp=2)
+        s.pca("a", components=2)
+        s.pca("b", components=2)
         s.delete_result("pca/a")
         assert s.results("pca") == ["b"]
         with pytest.raises(es.NotFoundError):

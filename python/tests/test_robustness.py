@@ -100,9 +100,9 @@ def test_close_from_a_callback_of_a_call_on_it_is_refused(store_path):
             s.close()
         ctx.progress = close_it
         with pytest.raises(RuntimeError, match="cannot be closed from a callback"):
-            s.pca(ncomp=2)
+            s.pca(components=2)
         ctx.progress = None
-        assert s.nrows == 18 and s.pca(ncomp=2).ncomp == 2
+        assert s.nrows == 18 and s.pca(components=2).ncomp == 2
 
 
 def test_a_library_call_from_a_callback_is_refused(store_path):
@@ -110,7 +110,7 @@ def test_a_library_call_from_a_callback_is_refused(store_path):
     with es.Store(store_path, ctx=ctx) as s:
         ctx.progress = lambda what, d, t: s.lengths(0)
         with pytest.raises(RuntimeError, match="from a callback"):
-            s.pca(ncomp=2)
+            s.pca(components=2)
 
 
 # ---- a shared embedder ---------------------------------------------------------------
@@ -221,8 +221,8 @@ def test_non_integer_indices_are_refused(store_path, ctx):
             s.positions(0.0)
         with pytest.raises(TypeError, match="row must be an integer"):
             s.source_path(2.9)
-        with pytest.raises(TypeError, match="ncomp must be an integer"):
-            s.pca(ncomp=2.5)
+        with pytest.raises(TypeError, match="components must be an integer"):
+            s.pca(components=2.5)
         with pytest.raises(TypeError, match="permutations must be an integer"):
             s.model("~ expression", permutations=99.9)
 
@@ -244,7 +244,7 @@ def test_callback_exception_cancels_and_stores_nothing(store_path, call):
             if call == "model":
                 s.model("~ expression + subject", permutations=50000, name="m")
             elif call == "pca":
-                s.pca(name="p", ncomp=3)
+                s.pca(name="p", components=3)
             else:
                 s.mean(by="expression", name="x")
         assert len(reports) == 1          # not called again once it raised

@@ -12,7 +12,7 @@ EXPR = "mean + 1.5*pc:1 - 0.5*pc:2"
 
 def test_lengths_and_weights_embed_as_their_expression(store_path, tmp_path, cli, ctx):
     with es.Store(store_path, write=True, ctx=ctx) as s:
-        s.pca("p", ncomp=4)
+        s.pca("p", components=4)
     cli("embed", store_path, "--point", EXPR, "--pca", "p", "-o", tmp_path / "cli.ply",
         "--fast", "--no-store")
     with es.Store(store_path, ctx=ctx) as s:

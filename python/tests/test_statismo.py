@@ -83,8 +83,8 @@ def test_procrustes_model(store_path, tmp_path, cli, ctx):
 def test_edge_length_model_is_the_linearized_embeddings(store_path, tmp_path, ctx):
     K = 3
     with es.Store(store_path, write=True, ctx=ctx) as st:
-        p = st.pca("faces", ncomp=5)
-        rep = st.export_statismo(tmp_path / "p.h5", pca="faces", ncomp=K)
+        p = st.pca("faces", components=5)
+        rep = st.export_statismo(tmp_path / "p.h5", pca="faces", components=K)
         # the same embeddings made here (es_study_embed)
         X0 = st.embed("mean", pca="faces").V
         D = np.stack([(st.embed(f"mean + 1*pc:{k}", pca="faces").V -
@@ -111,7 +111,7 @@ def test_edge_length_model_is_the_linearized_embeddings(store_path, tmp_path, ct
 
 def test_export_errors(store_path, tmp_path, cli, ctx):
     with es.Store(store_path, write=True, ctx=ctx) as st:
-        st.pca("faces", ncomp=3)
+        st.pca("faces", components=3)
         with pytest.raises(es.NotFoundError, match="no PCA named 'nope'"):
             st.export_statismo(tmp_path / "x.h5", pca="nope")
         with pytest.raises(es.NotFoundError, match="no GPA result 'nope'"):
@@ -119,18 +119,18 @@ def test_export_errors(store_path, tmp_path, cli, ctx):
         with pytest.raises(es.InvalidError, match="not both"):
             st.export_statismo(tmp_path / "x.h5", pca="faces", gpa="g")
         with pytest.raises(es.InvalidError, match="4 modes asked"):
-            st.export_statismo(tmp_path / "x.h5", pca="faces", ncomp=4)
+            st.export_statismo(tmp_path / "x.h5", pca="faces", components=4)
         with pytest.raises(es.InvalidError, match="sd"):
             st.export_statismo(tmp_path / "x.h5", pca="faces", sd=0)
         # never over a store; over an earlier model, yes
         other = tmp_path / "other.h5"
         shutil.copyfile(store_path, other)
         with pytest.raises(es.ExistsError, match="not a statismo model"):
-            st.export_statismo(other, pca="faces", ncomp=1)
+            st.export_statismo(other, pca="faces", components=1)
         with pytest.raises(es.ExistsError, match="refusing to overwrite the store"):
-            st.export_statismo(store_path, pca="faces", ncomp=1)
-        st.export_statismo(tmp_path / "m.h5", pca="faces", ncomp=1)
-        st.export_statismo(tmp_path / "m.h5", pca="faces", ncomp=2)
+            st.export_statismo(store_path, pca="faces", components=1)
+        st.export_statismo(tmp_path / "m.h5", pca="faces", components=1)
+        st.export_statismo(tmp_path / "m.h5", pca="faces", components=2)
     with h5py.File(tmp_path / "m.h5", "r") as f:
         assert f["model/pcaBasis"].shape[1] == 2
     assert not list(tmp_path.glob("*.part"))

@@ -102,7 +102,7 @@ def test_a_landmark_gpa_is_a_point_set_model(landmark_store, tmp_path, ctx):
 def test_a_mesh_model_round_trips_and_its_instance_is_a_point(store_path, tmp_path, ctx):
     with es.Store(store_path, write=True, ctx=ctx) as s:
         s.gpa("g")
-        s.export_statismo(tmp_path / "model.h5", gpa="g", ncomp=3)
+        s.export_statismo(tmp_path / "model.h5", gpa="g", components=3)
         ref, cells, mean_def, var, basis = scalismo_read_pdm(tmp_path / "model.h5")
         m = es.read_statismo(tmp_path / "model.h5", ctx=ctx)
         assert m.dataset_type == "POLYGON_MESH" and np.array_equal(m.faces, cells)

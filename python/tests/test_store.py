@@ -158,7 +158,7 @@ def test_ingest_files_and_the_report(tmp_path, faces_dir, ctx):
 
 def test_stored_results_read_back(store_path, ctx):
     with es.Store(store_path, write=True, ctx=ctx) as s:
-        p = s.pca("faces", ncomp=3)
+        p = s.pca("faces", components=3)
         assert s.results() == ["pca"] and s.results("pca") == ["faces"]
         assert s.has("pca/faces/components")
         assert np.array_equal(s.get_matrix("pca/faces/components"), p.components)

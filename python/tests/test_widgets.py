@@ -30,8 +30,8 @@ def widget(store_path):
         pytest.skip("the widget's view needs a library with figures (cairo)")
     import edgespace.widgets as ew
     with es.Store(store_path, write=True, ctx=es.Context(progress=None)) as s:
-        s.pca("p", ncomp=3)
-        s.diff("smile", key="subject", column="expression", from_="neutral", to="happy")
+        s.pca("p", components=3)
+        s.diff("smile", pair_by="subject", column="expression", from_="neutral", to="happy")
     w = ew.explore(store_path, pca="p", warm=False)
     yield w
     w.close()
@@ -159,7 +159,7 @@ def test_the_widget_in_a_classic_notebook_in_chromium(store_path, tmp_path):
     from selenium.webdriver.common.keys import Keys
     import nbformat
     with es.Store(store_path, write=True, ctx=es.Context(progress=None)) as s:
-        s.pca("p", ncomp=3)
+        s.pca("p", components=3)
     nb = nbformat.v4.new_notebook()
     nb.cells.append(nbformat.v4.new_code_cell(
         f"import edgespace.widgets as ew\nw = ew.explore({str(store_path)!r}, pca='p', warm=False)\nw"))

@@ -55,8 +55,8 @@ int es_test_landmark_gpa(const char *dir, const char *set, const char *specimens
     if (r.status) return 0;
     ES_RUN(&r, dir, "gpa", store, "--name", "g");
     if (r.status) return 0;
-    ES_RUN(&r, dir, "export", store, "--result", "gpa/g", "--table", "aligned", "--csv", aligned);
+    ES_RUN(&r, dir, "export", store, "--result", "gpa/g", "--table", "aligned", "--output", aligned);
     if (r.status) return 0;
-    ES_RUN(&r, dir, "export", store, "--result", "gpa/g", "--csv", spec);
+    ES_RUN(&r, dir, "export", store, "--result", "gpa/g", "--output", spec);
     return r.status == 0;
 }

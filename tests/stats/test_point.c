@@ -128,6 +128,28 @@ static void test_eval(es_ctx *ctx)
         ES_CHECK(k == ES_POINT_DIFF && c == -2 && !strcmp(arg, "smile"));
         es_point_expr_free(x);
     }
+    /* pc:NAME:K names its PCA as coef:MODEL:COEF names its model (issue
+     * 29); digits then ':' are a name, digits alone K (pc:1-row:a is pc:1
+     * minus row:a, as before) */
+    x = NULL;
+    ES_CHECK_OK(ctx, es_point_parse(ctx, "pc:faces:2 - 0.5*pc:\"my pca\":1 + pc:2019:3 + "
+                                         "pc:1-row:a", &x));
+    if (x) {
+        static const struct { const char *arg; int64_t k; double c; } want[] = {
+            {"faces", 2, 1}, {"my pca", 1, -0.5}, {"2019", 3, 1}, {"", 1, 1}};
+        ES_CHECK(es_point_expr_nterms(x) == 5);
+        for (int i = 0; i < 4; i++) {
+            double c;
+            es_point_leaf k;
+            const char *arg;
+            int64_t idx;
+            es_point_expr_term(x, i, &c, &k, &arg, &idx);
+            ES_CHECK_MSG(k == ES_POINT_PC && idx == want[i].k && c == want[i].c &&
+                         !strcmp(arg, want[i].arg), "term %d: '%s' %lld %g", i, arg,
+                         (long long)idx, c);
+        }
+        es_point_expr_free(x);
+    }
     /* a value holding ',' reaches the store quoted (es_store_select's
      * col="v"), others as written */
     static const struct { const char *text, *filter; } filters[] = {
@@ -217,7 +239,11 @@ static void test_errors(es_ctx *ctx)
         {"row:\"\"", "column 5: expected a row id, found an empty string"},
         {"file:face.stl", "column 6: expected a mesh file path ending in .obj, .ply or .off"},
         {"pc:0", "column 4: expected a component number >= 1"},
-        {"mean + pc:x", "column 11: expected a component number >= 1"},
+        {"mean + pc:x", "column 12: expected ':' and a component number after 'pc:x' "
+                        "(pc:K or pc:NAME:K)"},
+        {"mean + pc:faces:", "column 17: expected a component number >= 1 after 'pc:faces:'"},
+        {"mean + pc:faces:0", "column 17: expected a component number >= 1 after 'pc:faces:'"},
+        {"pc:faces:1x", "column 10: expected a component number >= 1 after 'pc:faces:'"},
         {"mean + pc:2b", "column 11: expected a component number >= 1"},
         {"diff:", "column 6: expected a difference name"},
         {"2pc:1 + mean", "column 2: expected an operator after the number"},

@@ -3,7 +3,7 @@
  *   - a result name that is taken is refused (the store unchanged) unless
  *     --replace is given, for mean, pca, diff and point (gpa, embed and
  *     interp in their own tests);
- *   - a --csv table that cannot be written leaves the store unchanged (the
+ *   - an --output table that cannot be written leaves the store unchanged (the
  *     tables are written before the commit);
  *   - writes that fail part way, injected with RLIMIT_FSIZE (every write past
  *     the limit fails with EFBIG), and a full disk (a small tmpfs, where the
@@ -131,11 +131,11 @@ static void test_replace_and_tables(const char *base, size_t nbase)
         /* a table that cannot be written: exit 1 and the store unchanged
          * (it was: the result committed first, then the failure) */
         args[n] = "--replace";
-        args[n + 1] = "--csv";
+        args[n + 1] = "--output";
         args[n + 2] = csv;
         args[n + 3] = NULL;
         ES_CHECK_MSG(run(args, 0, err, sizeof err) == 1 && strstr(err, "no/such/dir"),
-                     "%s --csv: %s", cmds[c][0], err);
+                     "%s --output: %s", cmds[c][0], err);
         ES_CHECK_MSG(before && unchanged(store, before, nb), "%s with an unwritable table "
                      "changed the store", cmds[c][0]);
         /* --replace replaces */
@@ -345,7 +345,7 @@ static void test_full_disk_frames(const char *base, size_t nbase)
     put_bytes(src, base, nbase);
     snprintf(ref, sizeof ref, "%s/ref_%%02d.obj", dir);
     {
-        const char *args[] = {"interp", src, "--from", "row:m00", "--to", "row:m01", "-k", "9",
+        const char *args[] = {"interp", src, "--from", "row:m00", "--to", "row:m01", "--steps", "9",
                               "-o", ref, "--no-store", NULL};
         ES_CHECK_MSG(run(args, 0, err, sizeof err) == 0, "interp: %s", err);
     }
@@ -381,7 +381,7 @@ static void test_full_disk_frames(const char *base, size_t nbase)
                     break;
             if (f) fclose(f);
         }
-        const char *args[] = {"interp", src, "--from", "row:m00", "--to", "row:m01", "-k", "9",
+        const char *args[] = {"interp", src, "--from", "row:m00", "--to", "row:m01", "--steps", "9",
                               "-o", pat, "--no-store", NULL};
         int rc = run(args, 0, err, sizeof err);
         ES_CHECK_MSG(rc == 1 && strstr(err, "No space left on device"), "interp on a full "
@@ -502,8 +502,8 @@ static void test_hostile_inputs(const char *base, size_t nbase)
                                          "term,df,ss,ms,r2,f,z,p,error\n"};
     const char *const cmds[3][10] = {
         {"mean", store, "--by", "grp", "--no-store", "-o", "-", NULL},
-        {"point", store, "mean", "--csv", "-", NULL},
-        {"model", store, "~ grp", "-p", "9", "--no-store", "-o", "-", NULL}};
+        {"point", store, "mean", "--output", "-", NULL},
+        {"model", store, "~ grp", "--permutations", "9", "--no-store", "-o", "-", NULL}};
     for (int c = 0; c < 3; c++) {
         char out[256] = "";
         int rc = run(cmds[c], 0, err, sizeof err);

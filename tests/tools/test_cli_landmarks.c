@@ -78,7 +78,7 @@ int main(void)
     ES_RUN(&r, dir, "mean", truss, "--by", "group");
     ES_CHECK_MSG(r.status == 0, "%s%s", r.out, r.err);
     ES_RUN(&r, dir, "diff", truss, "--pair-by", "pair", "--column", "group", "--from", "a",
-           "--to", "b", "--csv", "-");
+           "--to", "b", "--output", "-");
     /* stdout is the CSV alone; the summary goes to stderr */
     ES_CHECK_MSG(r.status == 0 && strstr(r.err, "3 pairs") &&
                  !strncmp(r.out, "edge,v0,v1,mean", 15), "%s%s", r.out, r.err);
@@ -90,7 +90,7 @@ int main(void)
                  strstr(r.out, "validity: not checked"), "%s%s", r.out, r.err);
     ES_RUN(&r, dir, "gpa", truss, "--name", "g");
     ES_CHECK_MSG(r.status == 0, "%s%s", r.out, r.err);
-    ES_RUN(&r, dir, "compare", truss, "--gpa", "g", "--by", "group", "-p", "5", "--no-figures");
+    ES_RUN(&r, dir, "compare", truss, "--gpa", "g", "--by", "group", "--permutations", "5", "--no-figures");
     ES_CHECK_MSG(r.status == 0 && strstr(r.out, "6 shapes"), "%s%s", r.out, r.err);
 
     /* triangles: a mesh store as before */

@@ -115,12 +115,12 @@ int main(void)
     ES_RUN(&r, dir, "model", store, "~ a", "--figure", fig);
     ES_CHECK(r.status == 2 && strstr(r.err, "--figure needs --edges TERM"));
     ES_RUN(&r, dir, "export", store, "--result", "model/m");
-    ES_CHECK(r.status == 2 && strstr(r.err, "--result needs --csv PATH"));
-    ES_RUN(&r, dir, "export", store, "--table", "anova", "--csv", "-");
+    ES_CHECK(r.status == 2 && strstr(r.err, "--result needs --output PATH"));
+    ES_RUN(&r, dir, "export", store, "--table", "anova", "--output", "-");
     ES_CHECK(r.status == 2 && strstr(r.err, "go with --result"));
 
     /* the faces, their lengths, and failures on the store */
-    ES_RUN(&r, dir, "synth", "face", "-n", "6", "--noise", "0.002", "-o", faces, "--replace");
+    ES_RUN(&r, dir, "synth", "face", "--count", "6", "--noise", "0.002", "-o", faces, "--replace");
     ES_CHECK(r.status == 0);
     ES_RUN(&r, dir, "ingest", store, "--manifest", manifest, "-q");
     ES_CHECK(r.status == 0);
@@ -160,7 +160,7 @@ int main(void)
         ES_CHECK_MSG(r.status == 1 && strstr(r.err, "formula: column 3: no label column 'v1'"),
                      "%s", r.err);
         /* (expression x subject with one face each leaves no residual) */
-        ES_RUN(&r, dir, "model", store, known, "-p", "9", "--no-store");
+        ES_RUN(&r, dir, "model", store, known, "--permutations", "9", "--no-store");
         ES_CHECK_MSG(r.status == 1 && strstr(r.err, "no residual degrees of freedom"), "%s",
                      r.err);
         clock_gettime(CLOCK_MONOTONIC, &t1);
@@ -171,16 +171,16 @@ int main(void)
      * compare -p took 2^40) */
     ES_RUN(&r, dir, "model", store, "~ expression", "--edge-permutations", "1099511627776");
     ES_CHECK_MSG(r.status == 2 && strstr(r.err, "from 0 to 100000000"), "%s", r.err);
-    ES_RUN(&r, dir, "model", store, "~ expression", "-p", "100000001");
+    ES_RUN(&r, dir, "model", store, "~ expression", "--permutations", "100000001");
     ES_CHECK_MSG(r.status == 2 && strstr(r.err, "from 0 to 100000000"), "%s", r.err);
     ES_RUN(&r, dir, "model", store, "~ expression", "--block", "subjct");
     ES_CHECK_MSG(r.status == 1 && strstr(r.err, "'subjct'") && strstr(r.err, "did you mean") &&
                  strstr(r.err, "subject"), "%s", r.err);
-    ES_RUN(&r, dir, "export", store, "--result", "model/m", "--csv", "-");
+    ES_RUN(&r, dir, "export", store, "--result", "model/m", "--output", "-");
     ES_CHECK(r.status == 1 && strstr(r.err, "the store has no result model/m"));
 
     /* subject as term and block: the ANOVA against the closed form */
-    ES_RUN(&r, dir, "model", store, "~ expression + subject", "--block", "subject", "-p", "99",
+    ES_RUN(&r, dir, "model", store, "~ expression + subject", "--block", "subject", "--permutations", "99",
            "--pairwise", "expression", "--edges", "expression", "-n", "m", "-o", anova,
            ES_HAVE_FIGURES ? "--figure" : "--seed", ES_HAVE_FIGURES ? fig : "7");
     ES_CHECK_MSG(r.status == 0 && strstr(r.out, "(block)") &&
@@ -212,20 +212,20 @@ int main(void)
     char *want = NULL;
     size_t wn = 0;
     ES_CHECK_OK(ctx, es__read_file(ctx, anova, ES__READ_TEXT, &want, &wn));
-    ES_RUN(&r, dir, "export", store, "--result", "model/m", "--csv", "-");
+    ES_RUN(&r, dir, "export", store, "--result", "model/m", "--output", "-");
     ES_CHECK_MSG(r.status == 0 && want && !strcmp(r.out, want), "%s%s", r.out, r.err);
     es__free(ctx, want);
-    ES_RUN(&r, dir, "export", store, "--result", "model/m", "--table", "pairwise", "--csv", "-");
+    ES_RUN(&r, dir, "export", store, "--result", "model/m", "--table", "pairwise", "--output", "-");
     ES_CHECK_MSG(r.status == 0 && strstr(r.out, "level_a,level_b,d,ucl,z,p\n") &&
                  strstr(r.out, "happy,neutral,"), "%s%s", r.out, r.err);
     /* ... and equals the pairwise table -o wrote beside the ANOVA table */
     ES_CHECK_OK(ctx, es__read_file(ctx, pairwise_csv, ES__READ_TEXT, &want, &wn));
     ES_CHECK_MSG(want && !strcmp(r.out, want), "%s", r.out);
     es__free(ctx, want);
-    ES_RUN(&r, dir, "export", store, "--result", "model/m", "--table", "attributes", "--csv", "-");
+    ES_RUN(&r, dir, "export", store, "--result", "model/m", "--table", "attributes", "--output", "-");
     ES_CHECK(r.status == 0 && strstr(r.out, "formula,~ expression + subject\n") &&
              strstr(r.out, "block,subject\n"));
-    ES_RUN(&r, dir, "export", store, "--result", "model/m", "--table", "nope", "--csv", "-");
+    ES_RUN(&r, dir, "export", store, "--result", "model/m", "--table", "nope", "--output", "-");
     ES_CHECK_MSG(r.status == 1 && strstr(r.err, "(tables: anova, coefficients,"), "%s", r.err);
     ES_RUN(&r, dir, "info", store);
     ES_CHECK(r.status == 0 && strstr(r.out, "model"));
@@ -233,11 +233,11 @@ int main(void)
     /* a GPA result's tables carry the rows' ids and labels */
     ES_RUN(&r, dir, "gpa", store, "--name", "g");
     ES_CHECK(r.status == 0);
-    ES_RUN(&r, dir, "export", store, "--result", "gpa/g", "--csv", "-");
+    ES_RUN(&r, dir, "export", store, "--result", "gpa/g", "--output", "-");
     ES_CHECK_MSG(r.status == 0 && !strncmp(r.out, "id,file,subject,expression,centroid_size", 40)
                  && strstr(r.out, "\nface_s01_neutral,face_s01_neutral.obj,s01,neutral,"),
                  "%s%s", r.out, r.err);
-    ES_RUN(&r2, dir, "model", store, "~ expression", "--gpa", "g", "--no-store", "-p", "0");
+    ES_RUN(&r2, dir, "model", store, "~ expression", "--gpa", "g", "--no-store", "--permutations", "0");
     ES_CHECK_MSG(r2.status == 0 && strstr(r2.out, "expression") && !strstr(r2.out, "stored"),
                  "%s%s", r2.out, r2.err);
     /* a nested formula: R's term labels in the table, its error term in the
@@ -264,7 +264,7 @@ int main(void)
     ES_CHECK_MSG(r.status == 1 && strstr(r.err, "no PCA named 'nope' (pca results: default)"),
                  "%s", r.err);
     unlink(var);
-    ES_RUN(&r, dir, "variation", store, "--coef", "m:expression=happy", "-k", "1", "-o", var);
+    ES_RUN(&r, dir, "variation", store, "--coef", "m:expression=happy", "--sd", "1", "-o", var);
     ES_CHECK_MSG(r.status == 0 && is_png(var), "%s%s", r.out, r.err);
     ES_RUN(&r, dir, "variation", store, "--coef", "m:expression=sad", "-o", var);
     ES_CHECK_MSG(r.status == 1 && strstr(r.err, "sad"), "%s", r.err);

@@ -59,14 +59,14 @@ int main(void)
     ES_RUN(&r, dir, "compare", store, "--gpa", "g");
     ES_CHECK_MSG(r.status == 1 && strstr(r.err, "at least 3"), "%s", r.err);
     /* a result is never written over silently: refused, then --replace */
-    ES_RUN(&r, dir, "gpa", store, "--name", "g", "--no-scale", "--allow-reflection", "--pcs", "2");
+    ES_RUN(&r, dir, "gpa", store, "--name", "g", "--no-scale", "--allow-reflection", "--components", "2");
     ES_CHECK_MSG(r.status == 1 && strstr(r.err, "result gpa/g exists already") &&
                  strstr(r.err, "--replace"), "%s", r.err);
-    ES_RUN(&r, dir, "gpa", store, "--name", "g", "--no-scale", "--allow-reflection", "--pcs", "2",
+    ES_RUN(&r, dir, "gpa", store, "--name", "g", "--no-scale", "--allow-reflection", "--components", "2",
            "--replace");
     ES_CHECK_MSG(r.status == 0 && strstr(r.out, "4 rows, 3D, partial GPA with reflection") &&
                  strstr(r.out, "PC variance"), "%s%s", r.out, r.err);
-    ES_RUN(&r, dir, "compare", store, "--gpa", "g", "-p", "1099511627776");
+    ES_RUN(&r, dir, "compare", store, "--gpa", "g", "--permutations", "1099511627776");
     ES_CHECK_MSG(r.status == 2 && strstr(r.err, "(0 to 100000000)"), "%s", r.err);
     ES_RUN(&r, dir, "compare", store, "--gpa", "nope");
     ES_CHECK(r.status == 1 && strstr(r.err, "no GPA result 'nope'"));
@@ -111,7 +111,7 @@ int main(void)
                  "%s%s", r.out, r.err);
     ES_RUN(&r, dir, "gpa", lstore, "--name", "lg");
     ES_CHECK_MSG(r.status == 0 && strstr(r.out, "4 rows, 2D"), "%s%s", r.out, r.err);
-    ES_RUN(&r, dir, "compare", lstore, "--gpa", "lg", "--by", "group", "-p", "5", "--no-figures");
+    ES_RUN(&r, dir, "compare", lstore, "--gpa", "lg", "--by", "group", "--permutations", "5", "--no-figures");
     ES_CHECK_MSG(r.status == 0 && strstr(r.out, "4 shapes"), "%s%s", r.out, r.err);
     ES_RUN(&r, dir, "ingest-landmarks", lstore, "--csv", lm, "--triangles", tri);
     ES_CHECK(r.status == 1 && strstr(r.err, "edgespace ingest-landmarks: "));

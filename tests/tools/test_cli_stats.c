@@ -115,14 +115,14 @@ int main(void)
     ES_CHECK(run(out, sizeof out, "pca study.h5 --method randomized") == 2);
 
     /* mean per expression */
-    ES_CHECK(run(out, sizeof out, "mean study.h5 --by expression --csv means.csv") == 0);
+    ES_CHECK(run(out, sizeof out, "mean study.h5 --by expression --output means.csv") == 0);
     ES_CHECK(strstr(out, "neutral") && strstr(out, "stored as /analysis/mean/expression"));
     char line[4096];
     first_line("means.csv", line, sizeof line);
     ES_CHECK(!strcmp(line, "edge,v0,v1,neutral,happy"));
 
     /* pca: stored result equals a direct fit */
-    ES_CHECK(run(out, sizeof out, "pca study.h5 --name p --csv p") == 0);
+    ES_CHECK(run(out, sizeof out, "pca study.h5 --name p --output p") == 0);
     ES_CHECK_MSG(strstr(out, "13 rows") != NULL, "%s", out);
     ES_CHECK(count_lines("p_scores.csv") == 14);
     first_line("p_scores.csv", line, sizeof line);
@@ -186,7 +186,7 @@ int main(void)
 
     /* diff: 6 pairs, s7 unpaired and named */
     ES_CHECK(run(out, sizeof out, "diff study.h5 --pair-by subject --from neutral --to happy "
-                 "--name smile --csv smile.csv") == 0);
+                 "--name smile --output smile.csv") == 0);
     ES_CHECK_MSG(strstr(out, "6 pairs") && strstr(out, "1 unpaired rows: s7_neutral"), "%s", out);
     first_line("smile.csv", line, sizeof line);
     ES_CHECK(!strcmp(line, "edge,v0,v1,mean,sd,se,t"));
@@ -309,11 +309,11 @@ int main(void)
     snprintf(path, sizeof path, "%s/study.h5", dir);
 
     /* project a new file and a stored row */
-    ES_CHECK(run(out, sizeof out, "project study.h5 --pca p new.obj s2_happy --csv proj.csv") == 0);
+    ES_CHECK(run(out, sizeof out, "project study.h5 --pca p new.obj s2_happy --output proj.csv") == 0);
     ES_CHECK(count_lines("proj.csv") == 3);
     ES_CHECK(run(out, sizeof out, "project study.h5 --pca p nothing_here") == 1);
     /* a failure part way leaves no partial table */
-    ES_CHECK(run(out, sizeof out, "project study.h5 --pca p s2_happy nothing_here --csv part.csv")
+    ES_CHECK(run(out, sizeof out, "project study.h5 --pca p s2_happy nothing_here --output part.csv")
              == 1);
     snprintf(path, sizeof path, "%s/part.csv", dir);
     ES_CHECK_MSG(access(path, F_OK) != 0, "project left %s behind", path);

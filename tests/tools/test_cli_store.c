@@ -114,7 +114,7 @@ int main(void)
 
     /* export lengths (all, selected) and meshes */
     snprintf(csv, sizeof csv, "%s/l.csv", dir);
-    ES_RUN(&r, dir, "export", store, "--lengths", csv, "--select", "group=a");
+    ES_RUN(&r, dir, "export", store, "--lengths", csv, "--where", "group=a");
     ES_CHECK(r.status == 0);
     {
         size_t n;
@@ -128,7 +128,7 @@ int main(void)
         ES_CHECK(text && strstr(text, "\nmesh-0,") && strstr(text, "\nmesh-2,"));
         free(text);
     }
-    ES_RUN(&r, dir, "export", store, "--lengths", csv, "--select", "colour=red");
+    ES_RUN(&r, dir, "export", store, "--lengths", csv, "--where", "colour=red");
     ES_CHECK(r.status == 1 && strstr(r.err, "colour"));
     /* the store given as the output (by mistake) is refused and left as it was,
      * and so for a stats command's --csv */
@@ -138,8 +138,8 @@ int main(void)
         ES_RUN(&r, dir, "export", store, "--lengths", store);
         ES_CHECK_MSG(r.status == 1 && strstr(r.err, "store itself"), "export onto the store: %d %s",
                      r.status, r.err);
-        ES_RUN(&r, dir, "mean", store, "--no-store", "--csv", store);
-        ES_CHECK_MSG(r.status == 1 && strstr(r.err, "HDF5"), "mean --csv onto the store: %d %s",
+        ES_RUN(&r, dir, "mean", store, "--no-store", "--output", store);
+        ES_CHECK_MSG(r.status == 1 && strstr(r.err, "HDF5"), "mean --output onto the store: %d %s",
                      r.status, r.err);
         ES_CHECK(before && es_test_same_bytes(store, before, n0));
         free(before);

@@ -91,7 +91,7 @@ static void run_case(const char *what, const char *store, const char *formula, c
     snprintf(ours, sizeof ours, "%s/%s.ours.csv", dir, what);
     snprintf(theirs, sizeof theirs, "%s/%s.adonis2.csv", dir, what);
     snprintf(perms, sizeof perms, "%lld", (long long)B);
-    const char *args[32] = {"model", store, formula, "--permute", "raw", "-p", perms, "--type",
+    const char *args[32] = {"model", store, formula, "--permute", "raw", "--permutations", perms, "--type",
                             type, "--no-store", "--seed", "11", "-o", ours};
     int n = 14;
     if (gpa) args[n++] = "--gpa", args[n++] = gpa;
@@ -144,9 +144,9 @@ int main(int argc, char **argv)
         ES_CHECK(r.status == 0);
         ES_RUN(&r, dir, "export", store, "--lengths", lengths);
         ES_CHECK(r.status == 0);
-        ES_RUN(&r, dir, "export", store, "--result", "gpa/g", "--csv", spec);
+        ES_RUN(&r, dir, "export", store, "--result", "gpa/g", "--output", spec);
         ES_CHECK(r.status == 0);
-        ES_RUN(&r, dir, "export", store, "--result", "gpa/g", "--table", "aligned", "--csv",
+        ES_RUN(&r, dir, "export", store, "--result", "gpa/g", "--table", "aligned", "--output",
                aligned);
         ES_CHECK(r.status == 0);
         run_case("face_lengths", store, "~ expression + subject", NULL, "subject", "I", lengths,

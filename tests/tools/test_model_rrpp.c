@@ -181,7 +181,7 @@ static void run_case(const char *what, const char *store, const char *formula,
     char anova[700], pw[700], path[800];
     snprintf(anova, sizeof anova, "%s/%s.csv", dir, what);
     snprintf(pw, sizeof pw, "%s/%s.pairwise.csv", dir, what);
-    const char *args[40] = {"model", store, formula, "-p", "199", "--seed", SEED, "-n", what,
+    const char *args[40] = {"model", store, formula, "--permutations", "199", "--seed", SEED, "-n", what,
                             "--replace", "-o", anova};
     int n = 12;
     for (int k = 0; ours_args && ours_args[k]; k++) args[n++] = ours_args[k];
@@ -210,7 +210,7 @@ static void cac_scores(const char *store, const char *name, char *path, size_t l
     char res[100];
     snprintf(path, len, "%s/%s.scores.csv", dir, name);
     snprintf(res, sizeof res, "model/%s", name);
-    ES_RUN(&r, dir, "export", store, "--result", res, "--table", "scores", "--csv", path);
+    ES_RUN(&r, dir, "export", store, "--result", res, "--table", "scores", "--output", path);
     ES_CHECK_MSG(r.status == 0, "%s", r.err);
 }
 
@@ -312,7 +312,7 @@ static void apes(void)
     static const char *const lm_cols[] = {"f", "p"};
     static const double lm_tol[] = {1e-10, 1e-12};
     ES_RUN(&r, dir, "export", store, "--result", "model/apes_additive", "--table", "edges",
-           "--csv", s1);
+           "--output", s1);
     ES_CHECK_MSG(r.status == 0, "%s", r.err);
     snprintf(path, sizeof path, "%s/apes_additive.ref/landmarks.csv", dir);
     compare("apes_landmark", "reference", s1, path, "landmark", NULL, lm_cols, lm_tol, 2);
@@ -325,7 +325,7 @@ static void apes(void)
 
     /* a copy of sex: left out by name; type III keeps sex; requests refused */
     ES_RUN(&r, dir, "model", store, "~ sex + sexcopy", "--gpa", "g", "--type", "III",
-           "--no-store", "-p", "99", "--pairwise", "sex");
+           "--no-store", "--permutations", "99", "--pairwise", "sex");
     ES_CHECK_MSG(r.status == 0 && strstr(r.err, "term 'sexcopy' duplicates 'sex'") &&
                  strstr(r.out, "left out: sexcopy duplicates 'sex'") && !strstr(r.out, "nan") &&
                  !strstr(r.out, "(block)") && strstr(r.out, "\nsex "), "%s%s", r.out, r.err);
@@ -335,13 +335,13 @@ static void apes(void)
         double dist = d ? strtod(d + 20, NULL) : 0;
         ES_CHECK_MSG(d && dist > 1, "%s", r.out);
     }
-    ES_RUN(&r, dir, "model", store, "~ sex + sexcopy", "--gpa", "g", "--no-store", "-p", "9",
+    ES_RUN(&r, dir, "model", store, "~ sex + sexcopy", "--gpa", "g", "--no-store", "--permutations", "9",
            "--pairwise", "sexcopy");
     ES_CHECK_MSG(r.status == 1 && strstr(r.err, "'sexcopy' duplicates 'sex'"), "%s", r.err);
-    ES_RUN(&r, dir, "model", store, "~ sex + sexcopy", "--gpa", "g", "--no-store", "-p", "9",
+    ES_RUN(&r, dir, "model", store, "~ sex + sexcopy", "--gpa", "g", "--no-store", "--permutations", "9",
            "--edges", "sexcopy");
     ES_CHECK_MSG(r.status == 1 && strstr(r.err, "duplicates 'sex'"), "%s", r.err);
-    ES_RUN(&r, dir, "model", store, "~ species", "--gpa", "g", "--no-store", "-p", "0",
+    ES_RUN(&r, dir, "model", store, "~ species", "--gpa", "g", "--no-store", "--permutations", "0",
            "--edges", "species");
     ES_CHECK_MSG(r.status == 0 && !strstr(r.out, "0 of") && strstr(r.out, "no p or q values"),
                  "%s", r.out);
@@ -377,7 +377,7 @@ static void faces(void)
     ES_CHECK(r.status == 0);
     /* the rows' labels (a row table of a stored model) and their scale, the
      * size of edge-length space (the lengths table's second column) */
-    ES_RUN(&r, dir, "model", store, "~ log(size) + expression", "-p", "0", "-n", "face_cac_plus",
+    ES_RUN(&r, dir, "model", store, "~ log(size) + expression", "--permutations", "0", "-n", "face_cac_plus",
            "--replace");
     ES_CHECK(r.status == 0);
     cac_scores(store, "face_cac_plus", s2, sizeof s2);

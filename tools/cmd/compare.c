@@ -21,7 +21,7 @@ static const char usage[] =
     "\n"
     "  -g, --gpa NAME          GPA result to use (required)\n"
     "  -b, --by COLUMN         label column defining groups\n"
-    "  -p, --permutations N    permutations of the tests (default 999)\n"
+    "      --permutations N    permutations of the tests (default 999)\n"
     "  -o, --output DIR        write CSV files and figures to DIR\n"
     "      --name NAME         result name (default: the GPA name)\n"
     "      --top N             disagreeing pairs reported (default 20)\n"
@@ -51,7 +51,7 @@ int cmd_compare(int argc, char **argv)
     int64_t seed = 0;
     es_compare_opts_init(&o);
     optind = 1;
-    while ((c = getopt_long(argc, argv, "g:b:p:o:qh", longopts, NULL)) != -1) {
+    while ((c = cli_getopt(argc, argv, "g:b:o:qh", longopts)) != -1) {
         switch (c) {
         case 'g': gpa = optarg; break;
         case 'b': by = optarg; break;

@@ -13,7 +13,7 @@
 
 static const char usage[] =
     "usage: edgespace diff STORE --pair-by KEY --from VALUE --to VALUE [--column COLUMN]\n"
-    "                      [--name NAME] [--where FILTER] [--csv PATH]\n"
+    "                      [--name NAME] [--where FILTER] [--output PATH]\n"
     "\n"
     "Pair the rows whose label COLUMN is VALUE(from) with those whose COLUMN is\n"
     "VALUE(to) by their label KEY (e.g. subject), take to - from per pair and\n"
@@ -21,15 +21,15 @@ static const char usage[] =
     "'from' (or two 'to') rows is an error. Stores mean, sd, se and t per edge\n"
     "as /analysis/diff/NAME (default NAME: TO-minus-FROM).\n"
     "\n"
-    "  -p, --pair-by KEY    label column that pairs rows\n"
-    "  -f, --from VALUE     value of COLUMN of the rows subtracted\n"
-    "  -t, --to VALUE       value of COLUMN of the rows subtracted from\n"
-    "  -c, --column COLUMN  label column holding VALUE (default: the one column\n"
+    "      --pair-by KEY    label column that pairs rows\n"
+    "      --from VALUE     value of COLUMN of the rows subtracted\n"
+    "      --to VALUE       value of COLUMN of the rows subtracted from\n"
+    "      --column COLUMN  label column holding VALUE (default: the one column\n"
     "                       other than KEY in which both values occur)\n"
     "  -n, --name NAME      result name\n"
     "  -w, --where FILTER   only rows matching \"col=value[,...]\"\n"
     "                       (quote a value holding ',': col=\"a,b\")\n"
-    "  -o, --csv PATH       write edge,v0,v1,mean,sd,se,t (- for stdout)\n"
+    "  -o, --output PATH    write edge,v0,v1,mean,sd,se,t (- for stdout)\n"
     "      --replace        replace a stored result of that name (else refused)\n"
     "  -h, --help           show this help\n"
     "\n"
@@ -48,7 +48,7 @@ int cmd_diff(int argc, char **argv)
         {"pair-by", required_argument, NULL, 'p'}, {"from", required_argument, NULL, 'f'},
         {"to", required_argument, NULL, 't'}, {"column", required_argument, NULL, 'c'},
         {"name", required_argument, NULL, 'n'}, {"where", required_argument, NULL, 'w'},
-        {"csv", required_argument, NULL, 'o'}, {"replace", no_argument, NULL, 'R'},
+        {"output", required_argument, NULL, 'o'}, {"replace", no_argument, NULL, 'R'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
     const char *key = NULL, *from = NULL, *to = NULL, *column = NULL, *name = NULL,
@@ -56,7 +56,7 @@ int cmd_diff(int argc, char **argv)
     es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
     int c;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "p:f:t:c:n:w:o:h", lo, NULL)) != -1) {
+    while ((c = cli_getopt(argc, argv, "n:w:o:h", lo)) != -1) {
         switch (c) {
         case 'p': key = optarg; break;
         case 'f': from = optarg; break;

@@ -20,17 +20,19 @@ static const char usage[] =
     "lengths leave it free (open meshes), and puts the output in the store's\n"
     "frame (the first row's pose), so outputs of nearby points overlay.\n"
     "\n"
-    "  -p, --point SPEC     row:ID (a stored row's lengths), NAME (a stored point,\n"
+    "      --point SPEC     row:ID (a stored row's lengths), NAME (a stored point,\n"
     "                       /analysis/point/NAME), or an expression such as\n"
     "                       \"mean[expression=neutral] + diff:smile\" (see\n"
     "                       datasets-spec/point-syntax.md)\n"
     "  -o, --output OUT     mesh file (.obj, .ply, .off)\n"
     "      --pca NAME       the PCA whose components pc:K in SPEC means (needed when\n"
-    "                       several are stored and none is named 'default')\n"
+    "                       several are stored and none is named 'default'); or\n"
+    "                       name it in SPEC: pc:NAME:K\n"
     "  -i, --init HOW       prior (default, see above); or an explicit start without\n"
     "                       the prior: nearest (the stored row nearest in edge-length\n"
-    "                       distance), row:ID, mean[:FILTER] (circular mean of the\n"
-    "                       dihedrals of the selected rows), or mesh:FILE (a mesh with\n"
+    "                       distance), row:ID, mean or mean[FILTER] as in a point\n"
+    "                       (circular mean of the dihedrals of the selected rows;\n"
+    "                       mean:FILTER is the old spelling), or mesh:FILE (a mesh with\n"
     "                       the store's face list: its dihedrals, and the output is\n"
     "                       aligned to it)\n"
     "  -s, --scale S        sum of edge lengths of the output (default: the point's\n"
@@ -79,7 +81,7 @@ int cmd_embed(int argc, char **argv)
     es_status rc;
     es_study_embed_opts_init(&o);
     optind = 1;
-    while ((c = getopt_long(argc, argv, "p:o:i:s:n:m:h", longopts, NULL)) != -1) {
+    while ((c = cli_getopt(argc, argv, "o:i:s:n:m:h", longopts)) != -1) {
         switch (c) {
         case 'p': o.point = optarg; break;
         case 'o': o.output = optarg; break;
@@ -117,8 +119,8 @@ int cmd_embed(int argc, char **argv)
     if (!o.point || !o.output) return cli_usage_error("embed", "--point and --output are required");
     if (strcmp(o.init, "prior") && strcmp(o.init, "nearest") && strncmp(o.init, "row:", 4) &&
         strncmp(o.init, "mesh:", 5) &&
-        !(!strncmp(o.init, "mean", 4) && (o.init[4] == 0 || o.init[4] == ':')))
-        return cli_usage_error("embed", "--init wants prior, nearest, row:ID, mean[:FILTER] or "
+        !(!strncmp(o.init, "mean", 4) && (o.init[4] == 0 || o.init[4] == ':' || o.init[4] == '[')))
+        return cli_usage_error("embed", "--init wants prior, nearest, row:ID, mean[FILTER] or "
                                "mesh:FILE");
     if (!o.name) {
         es_id_from_path(o.output, namebuf, sizeof namebuf);   /* its base name */

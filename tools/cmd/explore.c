@@ -25,7 +25,7 @@
 #endif
 
 static const char usage[] =
-    "usage: edgespace explore STORE [--port N] [--pca NAME] [--pcs K] [options]\n"
+    "usage: edgespace explore STORE [--port N] [--pca NAME] [--components K] [options]\n"
     "\n"
     "Serve a page to explore the store's shape space by hand, and print its URL.\n"
     "The page has the PCA scatter of the rows coloured by a label column (hover:\n"
@@ -45,7 +45,7 @@ static const char usage[] =
     "      --port N       TCP port (default 0: any free one)\n"
     "      --pca NAME     the PCA of the sliders and the scatter (needed when several\n"
     "                     are stored and none is named 'default')\n"
-    "      --pcs K        a slider for each of the first K components (default 20;\n"
+    "  -k, --components K     a slider for each of the first K components (default 20;\n"
     "                     0: all)\n"
     "      --host ADDR    listen on ADDR instead of 127.0.0.1 (anyone who reaches it\n"
     "                     with the URL can read the store)\n"
@@ -95,13 +95,13 @@ int cmd_explore(int argc, char **argv)
         {"port", required_argument, NULL, 'p'}, {"pca", required_argument, NULL, 'c'},
         {"host", required_argument, NULL, 'H'}, {"cold", no_argument, NULL, 'C'},
         {"accurate", no_argument, NULL, 'A'},   {"no-cache", no_argument, NULL, 'N'},
-        {"pcs", required_argument, NULL, 'k'},  {"help", no_argument, NULL, 'h'},
+        {"components", required_argument, NULL, 'k'},  {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
     const char *pca = NULL, *host = "127.0.0.1", *port = "0", *pcs = "20";
     int c, cold = 0, accurate = 0, no_cache = 0;
     int64_t n;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
+    while ((c = cli_getopt(argc, argv, "k:h", longopts)) != -1) {
         switch (c) {
         case 'p':
             if (cli_parse_i64(optarg, &n) || n < 0 || n > 65535)
@@ -111,7 +111,7 @@ int cmd_explore(int argc, char **argv)
         case 'c': pca = optarg; break;
         case 'k':
             if (cli_parse_i64(optarg, &n) || n < 0)
-                return cli_usage_error("explore", "--pcs wants 0 (all) or a count");
+                return cli_usage_error("explore", "--components wants 0 (all) or a count");
             pcs = optarg;
             break;
         case 'H':
@@ -141,7 +141,7 @@ int cmd_explore(int argc, char **argv)
     args[k++] = port;
     args[k++] = "--host";
     args[k++] = host;
-    args[k++] = "--pcs";
+    args[k++] = "--components";
     args[k++] = pcs;
     if (pca) {
         args[k++] = "--pca";

@@ -14,7 +14,7 @@ static const char usage[] =
     "usage: edgespace export STORE (--lengths CSV | --meshes DIR) [options]\n"
     "       edgespace export STORE --statismo MODEL.h5 [--pca NAME | --gpa NAME]\n"
     "                        [--components K] [--sd C] [--noise-variance V]\n"
-    "       edgespace export STORE --result KIND/NAME [--table TABLE] --csv PATH\n"
+    "       edgespace export STORE --result KIND/NAME [--table TABLE] --output PATH\n"
     "\n"
     "Write rows of a store: their edge lengths as CSV (id, scale, then one column\n"
     "per edge named by its 0-based vertex pair 'a-b'), or their positions as they\n"
@@ -24,7 +24,7 @@ static const char usage[] =
     "      --raw             with --lengths: write scale x length instead\n"
     "  -M, --meshes DIR      write meshes into DIR (created if absent)\n"
     "  -f, --format FMT      mesh format: obj (default), ply, ply-ascii, off\n"
-    "  -s, --select FILTER   only rows matching col=value[,col=value...]\n"
+    "  -w, --where FILTER    only rows matching col=value[,col=value...]\n"
     "                        (--where FILTER, as in the other commands)\n"
     "                        (quote a value holding ',': col=\"a,b\")\n"
     "      --statismo FILE   write a statismo shape model (datasets-spec/statismo.md)\n"
@@ -34,15 +34,15 @@ static const char usage[] =
     "      --gpa NAME        Procrustes PCA of a GPA result (its tangent modes; of a\n"
     "                        landmark store, a POINT_SET model). FILE must end in\n"
     "                        .h5: scalismo opens no other name\n"
-    "      --components K    modes to export (default: 10 of a PCA, every PC the GPA\n"
+    "  -k, --components K    modes to export (default: 10 of a PCA, every PC the GPA\n"
     "                        stored)\n"
     "      --sd C            the step along each PC, in sd (default 1)\n"
     "      --noise-variance V  the model's noise variance (default: 0 for a PCA,\n"
     "                        the PPCA estimate for a GPA)\n"
     "  -r, --result KIND/NAME  a stored result (gpa/all, model/m, ...) as a table\n"
-    "  -t, --table TABLE     which of its tables (default: the kind's first;\n"
+    "      --table TABLE     which of its tables (default: the kind's first;\n"
     "                        'attributes' for any result; a wrong name lists them)\n"
-    "  -o, --csv PATH        where the result's table goes (- for stdout)\n"
+    "  -o, --output PATH     where the result's table goes (- for stdout)\n"
     "  -h, --help            show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -57,7 +57,7 @@ static int export_statismo(const char *store, const char *path, es_study_statism
     es_status rc;
     char *cmd;
     if (other) return cli_usage_error("export", "--statismo goes alone (no --lengths, "
-                                      "--meshes or --select)");
+                                      "--meshes or --where)");
     if (so->pca_name && so->gpa_name) return cli_usage_error("export", "give --pca or --gpa");
     if (!(ctx = cli_ctx_new("export"))) return CLI_FAIL;
     so->command = cmd = cli_command_line(argc, argv);
@@ -86,12 +86,12 @@ int cmd_export(int argc, char **argv)
     static const struct option longopts[] = {
         {"lengths", required_argument, NULL, 'l'}, {"raw", no_argument, NULL, 'R'},
         {"meshes", required_argument, NULL, 'M'},  {"format", required_argument, NULL, 'f'},
-        {"select", required_argument, NULL, 's'},  {"help", no_argument, NULL, 'h'},
+        {"help", no_argument, NULL, 'h'},
         {"statismo", required_argument, NULL, 'S'}, {"pca", required_argument, NULL, 'P'},
         {"gpa", required_argument, NULL, 'G'},      {"components", required_argument, NULL, 'k'},
         {"sd", required_argument, NULL, 'c'}, {"noise-variance", required_argument, NULL, 'n'},
         {"result", required_argument, NULL, 'r'},  {"table", required_argument, NULL, 't'},
-        {"csv", required_argument, NULL, 'o'},    {"where", required_argument, NULL, 's'},
+        {"output", required_argument, NULL, 'o'},    {"where", required_argument, NULL, 'w'},
         {NULL, 0, NULL, 0}};
     const char *lengths = NULL, *meshes = NULL, *filter = NULL, *statismo = NULL;
     const char *result = NULL, *table = NULL, *csv = NULL;
@@ -104,12 +104,12 @@ int cmd_export(int argc, char **argv)
     int c, raw = 0;
     es_study_statismo_opts_init(&so);
     optind = 1;
-    while ((c = getopt_long(argc, argv, "l:M:f:s:r:t:o:h", longopts, NULL)) != -1) {
+    while ((c = cli_getopt(argc, argv, "l:M:f:w:r:o:k:h", longopts)) != -1) {
         switch (c) {
         case 'l': lengths = optarg; break;
         case 'R': raw = 1; break;
         case 'M': meshes = optarg; break;
-        case 's': filter = optarg; break;
+        case 'w': filter = optarg; break;
         case 'r': result = optarg; break;
         case 't': table = optarg; break;
         case 'o': csv = optarg; break;
@@ -146,10 +146,10 @@ int cmd_export(int argc, char **argv)
         return cli_usage_error("export", "--pca and --gpa go with --statismo");
     if (result) {
         if (lengths || meshes || filter)
-            return cli_usage_error("export", "--result goes alone (with --table and --csv)");
-        if (!csv) return cli_usage_error("export", "--result needs --csv PATH (- for stdout)");
+            return cli_usage_error("export", "--result goes alone (with --table and --output)");
+        if (!csv) return cli_usage_error("export", "--result needs --output PATH (- for stdout)");
     } else if (table || csv) {
-        return cli_usage_error("export", "--table and --csv go with --result KIND/NAME");
+        return cli_usage_error("export", "--table and --output go with --result KIND/NAME");
     } else if (!lengths == !meshes)
         return cli_usage_error("export", "give one of --lengths CSV or --meshes DIR");
     if (raw && !lengths) return cli_usage_error("export", "--raw goes with --lengths");

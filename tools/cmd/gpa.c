@@ -24,7 +24,7 @@ static const char usage[] =
     "                          (quote a value holding ',': col=\"a,b\")\n"
     "      --tol T             convergence tolerance (default 1e-10)\n"
     "      --max-iter N        iteration limit (default 1000)\n"
-    "      --pcs N             principal components stored (default min(10, n-1))\n"
+    "  -k, --components N      principal components stored (default min(10, n-1))\n"
     "  -q, --quiet             print nothing on success\n"
     "      --replace           replace a stored result of that name (else refused)\n"
     "  -h, --help              show this help\n"
@@ -33,13 +33,13 @@ static const char usage[] =
 
 int cmd_gpa(int argc, char **argv)
 {
-    enum { O_NOSCALE = 256, O_REFLECT, O_TOL, O_MAXIT, O_PCS };
+    enum { O_NOSCALE = 256, O_REFLECT, O_TOL, O_MAXIT };
     static const struct option longopts[] = {
         {"name", required_argument, NULL, 'n'},   {"no-scale", no_argument, NULL, O_NOSCALE},
         {"allow-reflection", no_argument, NULL, O_REFLECT},
         {"where", required_argument, NULL, 'w'},  {"tol", required_argument, NULL, O_TOL},
         {"max-iter", required_argument, NULL, O_MAXIT},
-        {"pcs", required_argument, NULL, O_PCS},  {"quiet", no_argument, NULL, 'q'},
+        {"components", required_argument, NULL, 'k'},  {"quiet", no_argument, NULL, 'q'},
         {"replace", no_argument, NULL, 'R'}, {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
     const char *name = NULL, *where = NULL;
@@ -49,7 +49,7 @@ int cmd_gpa(int argc, char **argv)
     int c, quiet = 0;
     es_gpa_opts_init(&o);
     optind = 1;
-    while ((c = getopt_long(argc, argv, "n:w:qh", longopts, NULL)) != -1) {
+    while ((c = cli_getopt(argc, argv, "n:w:k:qh", longopts)) != -1) {
         switch (c) {
         case 'n': name = optarg; break;
         case 'w': where = optarg; break;
@@ -63,9 +63,9 @@ int cmd_gpa(int argc, char **argv)
             if (cli_parse_i64(optarg, &o.max_iter) || o.max_iter < 1)
                 return cli_usage_error("gpa", "bad --max-iter '%s'", optarg);
             break;
-        case O_PCS:
+        case 'k':
             if (cli_parse_i64(optarg, &npc) || npc < 1)
-                return cli_usage_error("gpa", "bad --pcs '%s'", optarg);
+                return cli_usage_error("gpa", "bad --components '%s'", optarg);
             break;
         case 'q': quiet = 1; break;
         case 'R': wmode = ES_STORE_REPLACE; break;

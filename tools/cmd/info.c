@@ -15,7 +15,7 @@ static const char usage[] =
     "fingerprint), rows, label columns with their distinct values, and the\n"
     "analysis results it holds.\n"
     "\n"
-    "  -r, --rows   also list every row: id, scale and labels (tab-separated)\n"
+    "      --rows   also list every row: id, scale and labels (tab-separated)\n"
     "  -h, --help   show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -61,7 +61,7 @@ int cmd_info(int argc, char **argv)
     char **kinds = NULL;
     int64_t nkinds = 0;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "rh", longopts, NULL)) != -1) {
+    while ((c = cli_getopt(argc, argv, "h", longopts)) != -1) {
         switch (c) {
         case 'r': rows = 1; break;
         case 'h': fputs(usage, stdout); return CLI_OK;

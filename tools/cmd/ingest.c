@@ -17,7 +17,7 @@ static const char usage[] =
     "in: on any error (or if killed) the store is left exactly as it was.\n"
     "Inputs whose id and content are in the store already are skipped.\n"
     "\n"
-    "  -m, --manifest CSV  CSV with a 'file' column (paths relative to the CSV),\n"
+    "      --manifest CSV  CSV with a 'file' column (paths relative to the CSV),\n"
     "                      an optional 'id' column and any label columns\n"
     "  -f, --format FMT    obj, ply or off (default: from each file's extension)\n"
     "      --no-create     fail if STORE does not exist\n"
@@ -44,7 +44,7 @@ int cmd_ingest(int argc, char **argv)
     int c, quiet = 0;
     es_ingest_opts_init(&opts);
     optind = 1;
-    while ((c = getopt_long(argc, argv, "m:f:qh", longopts, NULL)) != -1) {
+    while ((c = cli_getopt(argc, argv, "f:qh", longopts)) != -1) {
         switch (c) {
         case 'm': manifest = optarg; break;
         case 'f':

@@ -22,9 +22,9 @@ static const char usage[] =
     "  neither      landmark configurations only: gpa, info and export of\n"
     "               positions; length statistics refuse\n"
     "\n"
-    "  -t, --tps FILE        tpsDig file (LM=, LM3=, ID=, IMAGE=, SCALE=; CURVES ignored)\n"
-    "  -c, --csv FILE        long CSV: specimen, landmark, x, y[, z]\n"
-    "  -s, --specimens FILE  CSV of labels: specimen id, then label columns\n"
+    "      --tps FILE        tpsDig file (LM=, LM3=, ID=, IMAGE=, SCALE=; CURVES ignored)\n"
+    "      --csv FILE        long CSV: specimen, landmark, x, y[, z]\n"
+    "      --specimens FILE  CSV of labels: specimen id, then label columns\n"
     "  -T, --triangles FILE  triangles of 1-based landmark numbers, 3 per line\n"
     "  -e, --edges FILE      landmark pairs, 1-based, 2 per line (truss lengths)\n"
     "      --no-tps-scale    keep TPS coordinates unscaled (SCALE= is recorded)\n"
@@ -45,7 +45,7 @@ int cmd_ingest_landmarks(int argc, char **argv)
     const char *tps = NULL, *csv = NULL, *spec = NULL, *tri = NULL, *edges = NULL;
     int c, quiet = 0, tps_scale = 1;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "t:c:s:T:e:qh", longopts, NULL)) != -1) {
+    while ((c = cli_getopt(argc, argv, "T:e:qh", longopts)) != -1) {
         switch (c) {
         case 't': tps = optarg; break;
         case 'c': csv = optarg; break;

@@ -25,14 +25,15 @@ static const char usage[] =
     "prior (--cold: from its own prior). Reports are printed\n"
     "and stored under /analysis/embed/NAME_<i> (per-vertex residuals included).\n"
     "\n"
-    "  -f, --from A          first shape (t = 0): row:ID, a stored point's name, or\n"
+    "      --from A          first shape (t = 0): row:ID, a stored point's name, or\n"
     "                        an expression such as \"mean[expression=neutral]\"\n"
-    "  -t, --to B            second shape (t = 1), the same kinds\n"
+    "      --to B            second shape (t = 1), the same kinds\n"
     "      --pca NAME        the PCA whose components pc:K in A or B means (needed\n"
-    "                        when several are stored and none is named 'default')\n"
-    "  -k, --steps N         frames from t0 to t1 inclusive (default 9)\n"
+    "                        when several are stored and none is named 'default');\n"
+    "                        or name it in A or B: pc:NAME:K\n"
+    "      --steps N         frames from t0 to t1 inclusive (default 9)\n"
     "      --t0 T, --t1 T    range of t (default 0 and 1)\n"
-    "  -w, --weights EXPR    w1*row:a + w2*row:b + ... (two or more rows)\n"
+    "      --weights EXPR    w1*row:a + w2*row:b + ... (two or more rows)\n"
     "  -o, --output PATTERN  mesh file; with several frames a printf pattern with\n"
     "                        one integer conversion, e.g. 'cat_%02d.obj' (%% for %)\n"
     "  -n, --name NAME       result name in the store (default: output base name)\n"
@@ -127,7 +128,7 @@ int cmd_interp(int argc, char **argv)
     const char *method = NULL;
     es_study_interp_opts_init(&o);
     optind = 1;
-    while ((c = getopt_long(argc, argv, "f:t:k:w:o:n:m:h", longopts, NULL)) != -1) {
+    while ((c = cli_getopt(argc, argv, "o:n:m:h", longopts)) != -1) {
         switch (c) {
         case 'f': o.from = optarg; break;
         case 't': o.to = optarg; break;

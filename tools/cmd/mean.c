@@ -10,7 +10,7 @@
 #include <string.h>
 
 static const char usage[] =
-    "usage: edgespace mean STORE [--by COLUMN] [--where FILTER] [--name NAME] [--csv PATH]\n"
+    "usage: edgespace mean STORE [--by COLUMN] [--where FILTER] [--name NAME] [--output PATH]\n"
     "                            [--no-store]\n"
     "\n"
     "Mean scale-normalized edge lengths of the rows of STORE: of all rows, of\n"
@@ -24,7 +24,7 @@ static const char usage[] =
     "  -w, --where FILTER only rows matching FILTER\n"
     "  -n, --name NAME    result name in the store\n"
     "      --no-store     compute and export only; leave the store unchanged\n"
-    "  -o, --csv PATH     write edge,v0,v1,<group>... (one column per group; - for stdout)\n"
+    "  -o, --output PATH  write edge,v0,v1,<group>... (one column per group; - for stdout)\n"
     "      --replace      replace a stored result of that name (else refused)\n"
     "  -h, --help         show this help\n"
     "\n"
@@ -34,7 +34,7 @@ int cmd_mean(int argc, char **argv)
 {
     static const struct option lo[] = {
         {"by", required_argument, NULL, 'b'}, {"where", required_argument, NULL, 'w'},
-        {"name", required_argument, NULL, 'n'}, {"csv", required_argument, NULL, 'o'},
+        {"name", required_argument, NULL, 'n'}, {"output", required_argument, NULL, 'o'},
         {"no-store", no_argument, NULL, 'N'}, {"replace", no_argument, NULL, 'R'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
@@ -42,7 +42,7 @@ int cmd_mean(int argc, char **argv)
     es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
     int c, nostore = 0;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "b:w:n:o:h", lo, NULL)) != -1) {
+    while ((c = cli_getopt(argc, argv, "b:w:n:o:h", lo)) != -1) {
         switch (c) {
         case 'b': by = optarg; break;
         case 'w': where = optarg; break;

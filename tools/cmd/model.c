@@ -26,13 +26,13 @@ static const char usage[] =
     "  -g, --gpa NAME         model the coordinates of GPA result NAME (Procrustes\n"
     "                         space) instead of the normalized edge lengths\n"
     "  -w, --where FILTER     only rows matching col=value[,col=value...]\n"
-    "  -b, --block COLUMN     permute only within the values of COLUMN (repeated\n"
+    "      --block COLUMN     permute only within the values of COLUMN (repeated\n"
     "                         measures: the subject)\n"
-    "  -t, --type I|II|III    sums of squares: sequential (I, default), each term\n"
+    "      --type I|II|III    sums of squares: sequential (I, default), each term\n"
     "                         after those not containing it (II), after all (III)\n"
     "      --permute rrpp|raw residuals of each term's reduced model (rrpp, default:\n"
     "                         geomorph, RRPP) or the rows themselves (raw: adonis2)\n"
-    "  -p, --permutations N   permutations (999; 0: no p-values)\n"
+    "      --permutations N   permutations (999; 0: no p-values)\n"
     "      --contrasts treatment|sum   factor coding (treatment)\n"
     "      --reference LEVELS the baseline level: LEVEL or FACTOR=LEVEL, comma-separated\n"
     "                         (default: the first level in byte order)\n"
@@ -53,10 +53,10 @@ static const char usage[] =
     "  -n, --name NAME        result name (default: model)\n"
     "      --no-store         leave the store unchanged\n"
     "      --replace          replace a stored result of that name (else refused)\n"
-    "  -o, --csv PATH         write the ANOVA table as CSV (- for stdout); with\n"
+    "  -o, --output PATH      write the ANOVA table as CSV (- for stdout); with\n"
     "                         --pairwise the pairwise table goes to PATH's stem +\n"
     "                         .pairwise.csv (after a blank line for -)\n"
-    "  -f, --figure PATH      with --edges: -log10 q of every edge on the mean mesh\n"
+    "      --figure PATH      with --edges: -log10 q of every edge on the mean mesh\n"
     "  -h, --help             show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -76,7 +76,7 @@ int cmd_model(int argc, char **argv)
         {"edges", required_argument, NULL, O_EDGES},
         {"edge-permutations", required_argument, NULL, O_EDGE_PERM},
         {"seed", required_argument, NULL, O_SEED}, {"name", required_argument, NULL, 'n'},
-        {"no-store", no_argument, NULL, O_NOSTORE}, {"csv", required_argument, NULL, 'o'},
+        {"no-store", no_argument, NULL, O_NOSTORE}, {"output", required_argument, NULL, 'o'},
         {"figure", required_argument, NULL, 'f'}, {"help", no_argument, NULL, 'h'},
         {"replace", no_argument, NULL, 'R'}, {"reference", required_argument, NULL, O_REFERENCE},
         {"error", required_argument, NULL, O_ERROR}, {"null", required_argument, NULL, O_NULL},
@@ -90,7 +90,7 @@ int cmd_model(int argc, char **argv)
     int c, nostore = 0;
     es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
     optind = 1;
-    while ((c = getopt_long(argc, argv, "g:w:b:t:p:n:o:f:h", lo, NULL)) != -1) {
+    while ((c = cli_getopt(argc, argv, "g:w:n:o:h", lo)) != -1) {
         switch (c) {
         case 'g': o.gpa = optarg; break;
         case 'w': o.where = optarg; break;

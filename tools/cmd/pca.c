@@ -12,7 +12,7 @@
 
 static const char usage[] =
     "usage: edgespace pca STORE [--name NAME] [--where FILTER] [--components K]\n"
-    "                     [--method auto|gram|covariance|randomized] [--csv PREFIX]\n"
+    "                     [--method auto|gram|covariance|randomized] [--output PREFIX]\n"
     "\n"
     "PCA of the scale-normalized edge lengths of the rows of STORE (or of the\n"
     "rows matching FILTER). Eigenvalues use the divisor N-1; each component is\n"
@@ -29,7 +29,7 @@ static const char usage[] =
     "      --oversample P     randomized: extra sample vectors (10)\n"
     "      --power-iters Q    randomized: subspace iterations (4)\n"
     "      --seed S           seed of the randomized method\n"
-    "  -o, --csv PREFIX       write PREFIX_scores.csv (id, every label, PC1..PCK),\n"
+    "  -o, --output PREFIX    write PREFIX_scores.csv (id, every label, PC1..PCK),\n"
     "                         PREFIX_eigenvalues.csv and PREFIX_components.csv\n"
     "      --replace          replace a stored result of that name (else refused)\n"
     "  -h, --help             show this help\n"
@@ -42,7 +42,7 @@ int cmd_pca(int argc, char **argv)
         {"name", required_argument, NULL, 'n'}, {"where", required_argument, NULL, 'w'},
         {"components", required_argument, NULL, 'k'}, {"method", required_argument, NULL, 'm'},
         {"oversample", required_argument, NULL, 'p'}, {"power-iters", required_argument, NULL, 'q'},
-        {"seed", required_argument, NULL, 's'}, {"csv", required_argument, NULL, 'o'},
+        {"seed", required_argument, NULL, 's'}, {"output", required_argument, NULL, 'o'},
         {"replace", no_argument, NULL, 'R'}, {"help", no_argument, NULL, 'h'}, {NULL, 0, NULL, 0}};
     const char *name = "default", *where = NULL, *csv = NULL;
     es_pca_opts o;
@@ -51,7 +51,7 @@ int cmd_pca(int argc, char **argv)
     es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
     int c;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "n:w:k:m:o:h", lo, NULL)) != -1) {
+    while ((c = cli_getopt(argc, argv, "n:w:k:m:o:h", lo)) != -1) {
         switch (c) {
         case 'n': name = optarg; break;
         case 'w': where = optarg; break;

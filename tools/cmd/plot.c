@@ -13,8 +13,7 @@
 static void usage(FILE *f)
 {
     fputs("usage: edgespace plot KIND TABLE.csv -o OUT.png|.svg|.pdf [options]\n"
-          "       edgespace plot STORE.h5 --pca NAME [--pcs A,B] [--color COL | --scree] -o OUT\n"
-          "               (the PCA figures; see 'edgespace plot-pca --help')\n\n"
+          "(the PCA figures are 'edgespace plot-pca'; 'plot STORE --pca' is its old spelling)\n\n"
           "KIND is one of:\n"
           "  scatter    points (--x, --y), coloured by the category in --label\n"
           "  lines      one curve per --y column against --x (legend: column names)\n"
@@ -54,7 +53,14 @@ static int wants_pca_figure(int argc, char **argv)
 
 int cmd_plot(int argc, char **argv)
 {
-    if (wants_pca_figure(argc, argv)) return cmd_plot_pca(argc, argv);
+    if (wants_pca_figure(argc, argv)) {
+        /* One command per figure kind (README "Options"): the old form
+         * still draws, as plot-pca with plot-pca's own messages. */
+        cli_deprecated(VERB, "plot STORE --pca ...", "plot-pca STORE ...");
+        static char verb_pca[] = "plot-pca";
+        argv[0] = verb_pca;
+        return cmd_plot_pca(argc, argv);
+    }
 
     static const struct option opts[] = {
         {"output", required_argument, NULL, 'o'}, {"x", required_argument, NULL, 'x'},
@@ -73,7 +79,7 @@ int cmd_plot(int argc, char **argv)
 
     es_figure_table_spec_init(&spec);
     optind = 1;
-    while ((c = getopt_long(argc, argv, "o:h", opts, NULL)) != -1) {
+    while ((c = cli_getopt(argc, argv, "o:h", opts)) != -1) {
         switch (c) {
         case 'o': out = optarg; break;
         case 'x': spec.x = optarg; break;

@@ -17,9 +17,9 @@ static const char usage[] =
     "component and cumulative). OUT ends in .png, .svg or .pdf.\n"
     "\n"
     "  -p, --pca NAME      the PCA (default: the only one, or \"default\")\n"
-    "  -c, --pcs A,B       components on the x and y axes (1-based)\n"
-    "  -l, --color COLUMN  colour points by this label column\n"
-    "  -s, --scree         draw the scree plot instead\n"
+    "      --pcs A,B       components on the x and y axes (1-based)\n"
+    "      --color COLUMN  colour points by this label column\n"
+    "      --scree         draw the scree plot instead\n"
     "      --title TEXT    figure title\n"
     "  -o, --output OUT    the figure file (required)\n"
     "  -h, --help          show this help\n"
@@ -38,7 +38,7 @@ int cmd_plot_pca(int argc, char **argv)
     long long a = 1, b = 2;
     int c, scree = 0;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "p:c:l:so:h", lo, NULL)) != -1) {
+    while ((c = cli_getopt(argc, argv, "p:o:h", lo)) != -1) {
         switch (c) {
         case 'p': pca_name = optarg; break;
         case 'l': color = optarg; break;

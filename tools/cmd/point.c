@@ -12,7 +12,7 @@
 
 static const char usage[] =
     "usage: edgespace point STORE EXPRESSION [--name NAME] [--pca NAME] [--scale S]\n"
-    "                       [--csv PATH]\n"
+    "                       [--output PATH]\n"
     "\n"
     "Evaluate a point of edge-length space, e.g.\n"
     "    \"mean[expression=neutral] + diff:smile\"   \"mean + 2*pc:1\"\n"
@@ -23,9 +23,10 @@ static const char usage[] =
     "--name the point is stored as /analysis/point/NAME.\n"
     "\n"
     "  -n, --name NAME   store the point under this name\n"
-    "  -p, --pca NAME    the PCA of pc:K (default: the only one, or \"default\")\n"
+    "  -p, --pca NAME    the PCA of pc:K (default: the only one, or \"default\");\n"
+    "                    pc:NAME:K names it in the expression\n"
     "  -s, --scale S     embed at scale S instead of the rule\n"
-    "  -o, --csv PATH    write edge,v0,v1,length (normalized) as CSV (- for stdout)\n"
+    "  -o, --output PATH write edge,v0,v1,length (normalized) as CSV (- for stdout)\n"
     "      --replace     replace a stored result of that name (else refused)\n"
     "  -h, --help        show this help\n"
     "\n"
@@ -35,14 +36,14 @@ int cmd_point(int argc, char **argv)
 {
     static const struct option lo[] = {
         {"name", required_argument, NULL, 'n'}, {"pca", required_argument, NULL, 'p'},
-        {"scale", required_argument, NULL, 's'}, {"csv", required_argument, NULL, 'o'},
+        {"scale", required_argument, NULL, 's'}, {"output", required_argument, NULL, 'o'},
         {"replace", no_argument, NULL, 'R'}, {"help", no_argument, NULL, 'h'}, {NULL, 0, NULL, 0}};
     const char *name = NULL, *pca = NULL, *csv = NULL;
     double scale = 0;
     es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
     int c;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "n:p:s:o:h", lo, NULL)) != -1) {
+    while ((c = cli_getopt(argc, argv, "n:p:s:o:h", lo)) != -1) {
         switch (c) {
         case 'n': name = optarg; break;
         case 'p': pca = optarg; break;

@@ -11,7 +11,7 @@
 #include <strings.h>
 
 static const char usage[] =
-    "usage: edgespace project STORE [--pca NAME] [--where FILTER] [--csv PATH] [INPUT...]\n"
+    "usage: edgespace project STORE [--pca NAME] [--where FILTER] [--output PATH] [INPUT...]\n"
     "\n"
     "Project shapes onto a stored PCA: each INPUT is a mesh file (.obj, .ply,\n"
     ".off; the store's face list) or a stored row id; --where adds the rows\n"
@@ -20,7 +20,7 @@ static const char usage[] =
     "\n"
     "  -p, --pca NAME      the PCA (default: the only one, or \"default\")\n"
     "  -w, --where FILTER  also project the stored rows matching FILTER\n"
-    "  -o, --csv PATH      write name,PC1..PCK,residual as CSV (- for stdout)\n"
+    "  -o, --output PATH   write name,PC1..PCK,residual as CSV (- for stdout)\n"
     "  -h, --help          show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
@@ -29,12 +29,12 @@ int cmd_project(int argc, char **argv)
 {
     static const struct option lo[] = {
         {"pca", required_argument, NULL, 'p'}, {"where", required_argument, NULL, 'w'},
-        {"csv", required_argument, NULL, 'o'}, {"help", no_argument, NULL, 'h'},
+        {"output", required_argument, NULL, 'o'}, {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
     const char *pca_name = NULL, *where = NULL, *csv = NULL;
     int c;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "p:w:o:h", lo, NULL)) != -1) {
+    while ((c = cli_getopt(argc, argv, "p:w:o:h", lo)) != -1) {
         switch (c) {
         case 'p': pca_name = optarg; break;
         case 'w': where = optarg; break;

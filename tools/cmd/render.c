@@ -90,7 +90,7 @@ int cmd_render(int argc, char **argv)
 
     es_render_spec_init(&spec);
     optind = 1;
-    while ((c = getopt_long(argc, argv, "o:h", opts, NULL)) != -1) {
+    while ((c = cli_getopt(argc, argv, "o:h", opts)) != -1) {
         switch (c) {
         case 'o': out = optarg; break;
         case 'v':

@@ -24,7 +24,7 @@ static const char usage[] =
     "keeps them inside, and each stored result copies it, until --upgrade moves\n"
     "them out (one copy of the store).\n"
     "\n"
-    "  -k, --kind KIND        list only results of KIND (mean, pca, gpa, model, ...)\n"
+    "      --kind KIND        list only results of KIND (mean, pca, gpa, model, ...)\n"
     "  -d, --delete KIND/NAME delete this result (repeat for several)\n"
     "  -u, --upgrade          upgrade a store of format 1 or 2 to format 3\n"
     "  -h, --help             show this help\n"
@@ -67,7 +67,7 @@ int cmd_results(int argc, char **argv)
     const char *kind = NULL, *del[MAX_DELETE];
     int ndel = 0, c, upgrade = 0;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "k:d:uh", lo, NULL)) != -1) {
+    while ((c = cli_getopt(argc, argv, "d:uh", lo)) != -1) {
         switch (c) {
         case 'k': kind = optarg; break;
         case 'u': upgrade = 1; break;

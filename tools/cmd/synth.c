@@ -26,9 +26,9 @@ static const char usage[] =
     "\n"
     "options:\n"
     "  -o, --output DIR       output folder (created if missing)\n"
-    "  -n, --n N              family size (barbell 2, tube 7, face 10, strip 2)\n"
-    "  -s, --seed S           random seed (default 0x5eed)\n"
-    "  -r, --resolution R     mesh density 1..64 (default 8)\n"
+    "      --count N          family size (barbell 2, tube 7, face 10, strip 2)\n"
+    "      --seed S           random seed (default 0x5eed)\n"
+    "      --resolution R     mesh density 1..64 (default 8)\n"
     "      --noise X          per-vertex noise sd relative to size\n"
     "      --subdivide K      apply 1-to-4 subdivision K times\n"
     "      --replace          overwrite DIR/manifest.csv and meshes of the same names\n"
@@ -59,7 +59,7 @@ int cmd_synth(int argc, char **argv)
 {
     static const struct option longopts[] = {
         {"output", required_argument, NULL, 'o'},
-        {"n", required_argument, NULL, 'n'},
+        {"count", required_argument, NULL, 'n'},
         {"seed", required_argument, NULL, 's'},
         {"resolution", required_argument, NULL, 'r'},
         {"noise", required_argument, NULL, 'N'},
@@ -73,7 +73,7 @@ int cmd_synth(int argc, char **argv)
     int c, replace = 0;
     es_synth_opts_init(&o);
     optind = 1;
-    while ((c = getopt_long(argc, argv, "o:n:s:r:h", longopts, NULL)) != -1) {
+    while ((c = cli_getopt(argc, argv, "o:h", longopts)) != -1) {
         switch (c) {
         case 'o': dir = optarg; break;
         case 'n':

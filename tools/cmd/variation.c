@@ -21,11 +21,11 @@ static const char usage[] =
     "vertex's displacement from the minus to the plus shape.\n"
     "\n"
     "  -o, --output PATH      the figure; the extension picks the format\n"
-    "  -P, --pca NAME         the PCA of the components (default: the only one)\n"
-    "  -c, --pcs LIST         components, e.g. 1,2,3 (default: 1; at most 8)\n"
+    "  -p, --pca NAME         the PCA of the components (default: the only one)\n"
+    "      --pcs LIST         components, e.g. 1,2,3 (default: 1; at most 8)\n"
     "      --coef MODEL:COEF  instead of components: a coefficient of a stored\n"
     "                         model in edge-length space (k in its units)\n"
-    "  -k, --k K              how far (2)\n"
+    "      --sd K             how far, in standard deviations (2)\n"
     "      --panel PIXELS     panel width and height (360)\n"
     "      --title TEXT       title (default: automatic)\n"
 CLI_EMBED_HELP
@@ -50,9 +50,9 @@ int cmd_variation(int argc, char **argv)
 {
     enum { O_COEF = 256, O_PANEL, O_TITLE };
     static const struct option lo[] = {
-        {"output", required_argument, NULL, 'o'}, {"pca", required_argument, NULL, 'P'},
+        {"output", required_argument, NULL, 'o'}, {"pca", required_argument, NULL, 'p'},
         {"pcs", required_argument, NULL, 'c'}, {"coef", required_argument, NULL, O_COEF},
-        {"k", required_argument, NULL, 'k'}, {"panel", required_argument, NULL, O_PANEL},
+        {"sd", required_argument, NULL, 'k'}, {"panel", required_argument, NULL, O_PANEL},
         {"title", required_argument, NULL, O_TITLE}, {"help", no_argument, NULL, 'h'},
         CLI_EMBED_LONGOPTS, {NULL, 0, NULL, 0}};
     es_figure_variation_opts o;
@@ -61,10 +61,10 @@ int cmd_variation(int argc, char **argv)
     const char *out = NULL;
     int c, e;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "o:P:c:k:h", lo, NULL)) != -1) {
+    while ((c = cli_getopt(argc, argv, "o:p:h", lo)) != -1) {
         switch (c) {
         case 'o': out = optarg; break;
-        case 'P': o.pca_name = optarg; break;
+        case 'p': o.pca_name = optarg; break;
         case 'c':
             if (parse_pcs(optarg, pcs, &o.npcs))
                 return cli_usage_error(VERB, "--pcs wants 1 to %d component numbers like 1,2",
@@ -74,7 +74,7 @@ int cmd_variation(int argc, char **argv)
         case O_COEF: o.coef = optarg; break;
         case 'k':
             if (cli_parse_double(optarg, &o.k) || !(o.k > 0))
-                return cli_usage_error(VERB, "--k needs a number > 0");
+                return cli_usage_error(VERB, "--sd needs a number > 0");
             break;
         case O_PANEL:
             if (cli_parse_i64(optarg, &panel) || panel < 64 || panel > 4096)

@@ -44,7 +44,7 @@ typedef enum es_point_leaf {
                            a value holding ',' is quoted, as es_store_select reads) */
     ES_POINT_ROW,       /* arg: the row id */
     ES_POINT_FILE,      /* arg: the path */
-    ES_POINT_PC,        /* index: K (1-based), arg "" */
+    ES_POINT_PC,        /* index: K (1-based), arg the PCA named inline (pc:NAME:K) or "" */
     ES_POINT_DIFF,      /* arg: the difference's name */
     ES_POINT_COEF       /* arg: "MODEL/COEF", the model's name and the coefficient's */
 } es_point_leaf;

@@ -1,4 +1,4 @@
-"""python3 -m edgespace.explore STORE [--port N] [--pca NAME] [--pcs K]
+"""python3 -m edgespace.explore STORE [--port N] [--pca NAME] [--components K]
 [--host ADDR] [--cold] [--accurate] [--no-cache]: the program `edgespace explore`
 (tools/cmd/explore.c) runs. Prints the URL (with its token) on a line of
 its own on standard output once the server listens; progress and requests
@@ -52,7 +52,8 @@ def main(argv=None):
     ap.add_argument("store")
     ap.add_argument("--port", type=int, default=0)
     ap.add_argument("--pca", default=None)
-    ap.add_argument("--pcs", type=int, default=20)
+    ap.add_argument("--components", "-k", type=int, default=None)
+    ap.add_argument("--pcs", type=int, default=None, help=argparse.SUPPRESS)   # the old spelling
     ap.add_argument("--host", default="127.0.0.1")
     ap.add_argument("--cold", action="store_true")
     ap.add_argument("--accurate", action="store_true")
@@ -60,8 +61,16 @@ def main(argv=None):
     a = ap.parse_args(argv)
     if not 0 <= a.port <= 65535:
         ap.error("--port wants 0 (any free port) to 65535")
-    if a.pcs < 0:
-        ap.error("--pcs wants 0 (all) or more")
+    if a.pcs is not None:
+        # README "Options": one name per concept, as edgespace explore
+        if a.components is not None:
+            ap.error("give --components (the new spelling of --pcs), not both")
+        _log("--pcs K is now --components K; the old spelling will go")
+        a.components = a.pcs
+    if a.components is None:
+        a.components = 20
+    if a.components < 0:
+        ap.error("--components wants 0 (all) or more")
 
     def ready(url):
         from .server import LOOPBACK
@@ -72,7 +81,7 @@ def main(argv=None):
 
     try:
         return run(a.store, pca=a.pca, host=a.host, port=a.port, warm=not a.cold,
-                   fast=not a.accurate, cache=not a.no_cache, pcs=a.pcs, ready=ready)
+                   fast=not a.accurate, cache=not a.no_cache, pcs=a.components, ready=ready)
     except KeyboardInterrupt:       # Ctrl-C before the server listened
         return 130
     except OSError as e:
