@@ -187,7 +187,7 @@ def test_interp_takes_the_commands_methods(store_path, tmp_path, cli, ctx, metho
     frame (written by the same library; each run alone)."""
     a, b = "row:face_s01_neutral", "row:face_s01_happy"
     pat = str(tmp_path / "c_%02d.obj")
-    cli("interp", store_path, "--from", a, "--to", b, "-k", "3", "--method", method,
+    cli("interp", store_path, "--from", a, "--to", b, "--steps", "3", "--method", method,
         *cli_extra, "-o", pat, "--no-store")
     with es.Store(store_path, ctx=ctx) as s:
         frames = s.interp(a, b, steps=3, method=method, **extra)
