@@ -95,9 +95,18 @@ static void add_diag(es_embedder *emb, int64_t v, double w)
  * each (face-study: 14 % of a fast frame's CPU). */
 static int factor_still_fits(const es_embedder *emb, double reuse)
 {
+    /* all but 1 % of the weights within `reuse`, and none doubled or
+     * halved: a walk along face-study's PC 1 in 20 frames moves the median
+     * weight 0.5 % a frame but a few short edges' by 12-35 %, and a test of
+     * every weight refactored every frame */
+    int64_t off = 0, allowed = emb->ne / 100;
     if (!(reuse > 0) || !emb->lg_have_factor) return 0;
-    for (int64_t e = 0; e < emb->ne; e++)
-        if (fabs(emb->lg_w[e] - emb->lg_wf[e]) > reuse * emb->lg_wf[e]) return 0;
+    for (int64_t e = 0; e < emb->ne; e++) {
+        double d = fabs(emb->lg_w[e] - emb->lg_wf[e]);
+        if (d > reuse * emb->lg_wf[e] && (++off > allowed || d > emb->lg_wf[e] ||
+                                          2 * emb->lg_w[e] < emb->lg_wf[e]))
+            return 0;
+    }
     return 1;
 }
 
