@@ -49,7 +49,7 @@ int cli_parse_size(const char *s, uint64_t *out);
     {"iters", required_argument, NULL, 0x103}, {"fast", no_argument, NULL, 0x104}, \
     {"solver", required_argument, NULL, 0x105}
 #define CLI_EMBED_HELP \
-    "      --iters N        local-global iterations at most (default 100; the solver:\n" \
+    "      --iters N        local-global iterations at most (default 40; the solver:\n" \
     "                       lib/embed/local_global.c)\n" \
     "      --refine-iters N Levenberg-Marquardt iterations that finish where the\n" \
     "                       local-global ones did not reach RMS 0.05 % / max 1 %\n" \

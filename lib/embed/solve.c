@@ -46,13 +46,16 @@ void es_embed_opts_init(es_embed_opts *o)
     o->prior_bend_closed = 0;
     /* the local-global solve: measured on face-study (local_global.c) */
     o->solver = ES_EMBED_SOLVER_AUTO;
-    /* 100: face-study's points (mean, mean +- 2 sd on PCs 1-3, a held-out
-     * face) meet the accuracy stop in 47-76 iterations (0.19-0.29 s); with
-     * 40 they stopped short and the Levenberg-Marquardt polish took 2-4
-     * iterations of a 3V x 3V factorization each (0.31-0.64 s), for 0.1-3 %
-     * less bending (mean 1.064 x the prior's against 1.076; mean + 2 sd on
-     * PC 1 1.013 against 1.044) */
-    o->lg_max_iter = 100;
+    /* 40, then the Levenberg-Marquardt polish: measured against 100
+     * iterations and no polish (tools/bench/bench_points, quiet machine),
+     * 100 was 13 % faster on face-study's points (0.34 s against 0.40 s a
+     * point: most met the accuracy stop in 47-91 iterations) but bent them
+     * more (mean 1.077 x the prior's against 1.065, mean + 2 sd on PC 2
+     * 1.112 against 1.082), and on sfm_surrey subdivided to 13.6K and 54K
+     * vertices mean + 2 sd on PC 2 bent 1.385 and 1.673 against 1.329 and
+     * 1.626 in as much time: the polish fixes the last length error with
+     * less bending than more local-global iterations */
+    o->lg_max_iter = 40;
     o->lg_history = 6;
     o->lg_rms_tol = 5e-4;
     o->lg_max_tol = 1e-2;

@@ -148,7 +148,7 @@ typedef struct es_embed_opts {
      * iterations would. Measured on face-study in tools/bench/bench_walk.c
      * and tests/study/test_prior_faces.c. */
     es_embed_solver solver;   /* default AUTO (local-global, then the polish) */
-    int lg_max_iter;          /* local-global iterations at most (default 100; exact
+    int lg_max_iter;          /* local-global iterations at most (default 40; exact
                                  targets, prior_exact, twice as many) */
     double lg_rms_tol;        /* the accuracy asked for: RMS ratio <= lg_rms_tol and max
                                  relative error <= lg_max_tol (defaults 5e-4, 1e-2; a
