@@ -42,6 +42,11 @@ es_status es__canvas_close(es_ctx *ctx, es__canvas *cv);
  * NULL members: no-op. */
 void es__canvas_discard(es__canvas *cv);
 
+/* A plot frame's defaults (640 x 480, font 12, no title or labels), and its
+ * check (font size in (0, 200)) naming the plot `what` (plot.c). */
+void es__frame_init(es_plot_frame *f);
+es_status es__frame_check(es_ctx *ctx, const char *what, const es_plot_frame *f);
+
 /* Text anchored at (x, y): ha 0 left, 0.5 centre, 1 right; va 0 top,
  * 0.5 middle, 1 bottom (of the font's ascent..descent box); rotated by
  * `angle` radians about the anchor. */

@@ -61,6 +61,7 @@ es_status es_compare_study(es_ctx *ctx, es_mat lengths, es_mat aligned, const in
     if (!r) return ES_ENOMEM;
     r->ctx = ctx;
     r->n = n;
+    r->normalized_lengths = o.normalize_lengths != 0;
     int64_t m = n * (n - 1) / 2;
     r->ntop = o.top_pairs < m ? (o.top_pairs > 0 ? o.top_pairs : 0) : m;
     r->d_len = es__alloc_array(ctx, 2 * n * n, sizeof *r->d_len);

@@ -283,7 +283,7 @@ static void test_study(es_ctx *ctx)
     const char *gn[2] = {"one", "two"};
     ES_CHECK_OK(ctx, es_study_compare_write(ctx, r, ids, group, gn, dir));
 #if ES_HAVE_FIGURES
-    ES_CHECK_OK(ctx, es_figure_compare_write(ctx, r, ids, group, gn, dir));
+    ES_CHECK_OK(ctx, es_figure_compare_write(ctx, r, ids, group, gn, dir, NULL));
 #endif
     char path[512];
     static const struct { const char *f; int64_t lines; } files[] = {

@@ -98,6 +98,7 @@ typedef struct es_compare_result {
     double *mean_len, *mean_proc;  /* ngroups x ngroups distances of group means */
     double *p_len, *p_proc;        /* their permutation p-values */
     es_group_stats groups_len, groups_proc;
+    int normalized_lengths;        /* d_len is between unit-sum length vectors (opts) */
     /* Filled by the study on a store (es_study_compare), NULL otherwise: the
      * row ids (n), each row's group (n) and the group names (ngroups). */
     char **ids;

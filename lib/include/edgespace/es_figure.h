@@ -21,20 +21,36 @@
 extern "C" {
 #endif
 
-/* The comparison study's figures in dir (made if missing): heatmap_lengths.svg,
- * heatmap_procrustes.svg (the two distance matrices) and pairs_scatter.svg
- * (distance pairs, coloured by group pair when group is given). ids: n names
- * (NULL: 1-based numbers); group_names: ngroups names (NULL: numbers). */
+/* The comparison study's figures in dir (made if missing), format "png",
+ * "pdf" or "svg" (NULL: svg) as the files' extension: heatmap_lengths,
+ * heatmap_procrustes (the two distance matrices, es_figure_compare_heatmap)
+ * and pairs_scatter (distance pairs, coloured by group pair when group is
+ * given). ids: n names (NULL: 1-based numbers); group_names: ngroups names
+ * (NULL: numbers). */
 ES_API es_status es_figure_compare_write(es_ctx *ctx, const es_compare_result *res,
                                          const char *const *ids, const int64_t *group,
-                                         const char *const *group_names, const char *dir);
+                                         const char *const *group_names, const char *dir,
+                                         const char *format);
 
-/* es_study_compare (es_study.h) and, with out_dir, its figures beside its
- * tables. */
+/* One distance matrix of the study (which 0: edge lengths, 1: Procrustes)
+ * as a heat map at path (format by extension): rows and columns ordered by
+ * group (group may be NULL), then by id, then by row; white lines between
+ * groups and their names beside them; ids as row and column labels up to
+ * 60 rows (group names only above that); the colour bar names the distance
+ * and its units (between unit-sum length vectors when the study normalized
+ * the lengths; data units of the GPA-aligned configurations). info (may be
+ * NULL) receives es_plot_heatmap's plot area. */
+ES_API es_status es_figure_compare_heatmap(es_ctx *ctx, const es_compare_result *res, int which,
+                                           const char *const *ids, const int64_t *group,
+                                           const char *const *group_names, const char *path,
+                                           es_plot_info *info);
+
+/* es_study_compare (es_study.h) and, with out_dir, its figures (in format,
+ * as es_figure_compare_write) beside its tables. */
 ES_API es_status es_figure_compare(es_ctx *ctx, es_store *store, const char *gpa_name,
                                    const char *by, const es_compare_opts *opts,
                                    const char *name, const char *out_dir, const char *command,
-                                   es_compare_result **res);
+                                   const char *format, es_compare_result **res);
 
 /* ---- a figure of a CSV table (edgespace plot) -------------------------------
  *
