@@ -88,13 +88,15 @@ double es__legend_width(cairo_t *cr, const char *title, const char *const *names
                         int64_t n, double size);
 
 /* Vertical colour bar, vmax at the top; the top device row has exactly the
- * map's colour at 1, the bottom row at 0. Ticks and label on the right. */
+ * map's colour at 1, the bottom row at 0. Ticks and label on the right.
+ * logscale: the values are log10 of the quantity; ticks at 1, 2, 5 x 10^k of
+ * the quantity, labelled with it. */
 void es__draw_colorbar(cairo_t *cr, double x, double y, double w, double h,
                        es_colormap cmap, double vmin, double vmax, const char *label,
-                       double size);
+                       double size, int logscale);
 /* Width taken by a colour bar of bar width w (bar, ticks, label). */
 double es__colorbar_width(cairo_t *cr, double w, double vmin, double vmax,
-                          const char *label, double size);
+                          const char *label, double size, int logscale);
 
 /* Resolve a colour range: vmin == vmax means the finite range of data
  * (symmetric about 0 for diverging maps); a degenerate range is widened. */

@@ -226,7 +226,7 @@ es_status es_plot_heatmap(es_ctx *ctx, const es_heatmap_spec *spec, const char *
                      ? max_group_width(cr, spec, spec->row_groups, rows, lsize) + 0.8 * lsize
                      : 0;
     double band = spec->col_groups ? 1.4 * lsize : 0;   /* column group names */
-    double cbw = es__colorbar_width(cr, fs, vmin, vmax, spec->colorbar_label, fs) + fs;
+    double cbw = es__colorbar_width(cr, fs, vmin, vmax, spec->colorbar_label, fs, 0) + fs;
     es_plot_frame g = *f;
     g.height = f->height - (int)(spec->col_labels ? clw : 0) - (int)band;
     es__plot_area(&g, cbw, rlw + rgw, &info);
@@ -280,7 +280,7 @@ es_status es_plot_heatmap(es_ctx *ctx, const es_heatmap_spec *spec, const char *
     labels_only.height = f->height;
     es__draw_axes(cr, &labels_only, &info, NULL, NULL, 0);
     es__draw_colorbar(cr, info.right + fs, info.top, fs, h, spec->cmap, vmin, vmax,
-                      spec->colorbar_label, fs);
+                      spec->colorbar_label, fs, 0);
     rc = es__canvas_close(ctx, &cv);
     if (info_out) *info_out = info;
     return rc;

@@ -636,7 +636,8 @@ es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
         cairo_select_font_face(tcr, "sans-serif", CAIRO_FONT_SLANT_NORMAL,
                                CAIRO_FONT_WEIGHT_NORMAL);
         cb_w = (int)ceil(2 * fs + es__colorbar_width(tcr, fs, rep.vmin, rep.vmax,
-                                                     spec->colorbar_label, fs));
+                                                     spec->colorbar_label, fs,
+                                                     spec->colorbar_log10));
         cairo_destroy(tcr);
         cairo_surface_destroy(tmp);
     }
@@ -744,7 +745,7 @@ es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
         double x = round((double)(W * ncols) + fs), y = round(title_h + 0.1 * span),
                w = round(fs), h = round(0.8 * span);
         es__draw_colorbar(cr, x, y, w, h, spec->cmap, rep.vmin, rep.vmax, spec->colorbar_label,
-                          fs);
+                          fs, spec->colorbar_log10);
         rep.colorbar[0] = x, rep.colorbar[1] = y, rep.colorbar[2] = w, rep.colorbar[3] = h;
         if (rep.n_nan_scalars > 0) {
             /* a key for the grey of missing values, under the bar */
@@ -753,7 +754,8 @@ es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
             cairo_rectangle(cr, x, ky, w, w);
             cairo_fill(cr);
             cairo_set_source_rgb(cr, 0, 0, 0);
-            es__text(cr, x + w + 6, ky + 0.5 * w, "n/a", 0.85 * fs, 0, 0.5, 0);
+            es__text(cr, x + w + 6, ky + 0.5 * w, spec->nan_label ? spec->nan_label : "n/a",
+                     0.85 * fs, 0, 0.5, 0);
         }
     }
     rc = es__canvas_close(ctx, &cv);

@@ -18,8 +18,11 @@ def _streams(data):
 
 
 def _cmap(text):
-    """code -> unicode string of one ToUnicode CMap (bfchar and bfrange)."""
+    """code -> unicode string of one ToUnicode CMap (bfchar and bfrange),
+    and the bytes per code (its codespacerange)."""
     table = {}
+    space = re.search(rb"begincodespacerange\s*<([0-9a-fA-F]+)>", text)
+    width = len(space.group(1)) // 2 if space else 1
     for block in re.findall(rb"beginbfchar(.*?)endbfchar", text, re.S):
         for src, dst in re.findall(rb"<([0-9a-fA-F]+)>\s*<([0-9a-fA-F]+)>", block):
             table[int(src, 16)] = bytes.fromhex(dst.decode()).decode("utf-16-be")
@@ -29,7 +32,7 @@ def _cmap(text):
             base = bytes.fromhex(dst.decode()).decode("utf-16-be")
             for k, code in enumerate(range(int(lo, 16), int(hi, 16) + 1)):
                 table[code] = base[:-1] + chr(ord(base[-1]) + k)
-    return table
+    return table, width
 
 
 def _literal(s):
@@ -54,14 +57,23 @@ def _literal(s):
     return bytes(out)
 
 
-_TOKENS = re.compile(rb"/([\w.+-]+)\s+[\d.]+\s+Tf|\((?:\\.|[^\\)])*\)|<[0-9a-fA-F]*>|(T[jJ])")
+_TOKENS = re.compile(rb"/([\w.+-]+)\s+[\d.]+\s+Tf|\((?:\\.|[^\\)])*\)|<[0-9a-fA-F]*>|"
+                     rb"\b(Tj|TJ|Tm|Td|TD|T\*|ET)\b")
+
+
+def _decode(codes, cmap):
+    table, width = cmap
+    return "".join(table.get(int.from_bytes(codes[i:i + width], "big"), "\ufffd")
+                   for i in range(0, len(codes), width))
 
 
 def pdf_strings(path):
-    """Every string the PDF shows, decoded, in content-stream order."""
+    """Every run of text the PDF shows, decoded, in content-stream order: the
+    strings shown one after another without a move between them (cairo
+    switches fonts inside a word for a character like "≥") are one run."""
     data = open(path, "rb").read()
     streams = _streams(data)
-    fonts = {}   # resource name -> cmap
+    fonts = {}   # resource name -> (cmap, bytes per code)
     for name, obj in re.findall(rb"/([\w.+-]+)\s+(\d+)\s+0\s+R", data):
         m = re.search(rb"\b" + obj + rb" 0 obj\s*<<(.*?)>>\s*endobj", data, re.S)
         if m and b"/ToUnicode" in m.group(1):
@@ -72,20 +84,24 @@ def pdf_strings(path):
     for text in streams.values():
         if b"BT" not in text:
             continue
-        cmap, pending = {}, []
+        cmap, pending, run = ({}, 1), [], ""
         for m in _TOKENS.finditer(text):
-            tok = m.group(0)
+            tok, op = m.group(0), m.group(2)
             if m.group(1):
-                cmap = fonts.get(m.group(1).decode(), {})
+                cmap = fonts.get(m.group(1).decode(), ({}, 1))
             elif tok.startswith(b"("):
                 pending.append(_literal(tok[1:-1]))
             elif tok.startswith(b"<"):
                 pending.append(bytes.fromhex(tok[1:-1].decode()))
-            elif m.group(2):   # Tj or TJ shows what was read since the last
-                s = "".join(cmap.get(b, "\ufffd") for p in pending for b in p)
-                if s:
-                    out.append(s)
+            elif op in (b"Tj", b"TJ"):
+                run += "".join(_decode(p, cmap) for p in pending)
                 pending = []
+            elif op:   # a move or the end of the text object ends the run
+                if run:
+                    out.append(run)
+                run = ""
+        if run:
+            out.append(run)
     return out
 
 
@@ -95,5 +111,5 @@ def pdf_codepoints(path):
     chars = set()
     for text in _streams(data).values():
         if b"beginbfchar" in text or b"beginbfrange" in text:
-            chars.update("".join(_cmap(text).values()))
+            chars.update("".join(_cmap(text)[0].values()))
     return chars

@@ -161,9 +161,11 @@ ES_API es_status es_figure_render_files(es_ctx *ctx, const es_render_spec *spec,
 
 /* The per-edge tests of a model (es_study_model with opts.edge_term) drawn
  * on the mean mesh of its rows (the Procrustes mean of their positions, in
- * the store's frame): each edge coloured by -log10 of its FDR q-value
- * (faces show the mean of their three edges), the number of edges with
- * q < 0.05 in the title. ES_EINVAL when r has no per-edge tests. */
+ * the store's frame): each edge with FDR q < 0.05 coloured by its F on a
+ * log scale (colour bar "per-edge F (log)", range the 2nd to 98th
+ * percentile of the coloured edges), the others grey (ES_NAN_GREY); faces
+ * show the mean of their three edges (grey when one of them is). The number
+ * of edges with q < 0.05 is in the title. ES_EINVAL when r has no per-edge tests. */
 ES_API es_status es_figure_edge_tests(es_ctx *ctx, es_store *store,
                                       const es_study_model_result *r, const char *out_path);
 
