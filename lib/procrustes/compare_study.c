@@ -31,6 +31,7 @@ void es_compare_result_free(es_compare_result *res)
     if (!res) return;
     es_ctx *ctx = res->ctx;
     es__free(ctx, res->d_len);
+    es__free(ctx, res->d_rho);
     es__free(ctx, res->nn_len);
     es__free(ctx, res->top_pairs);
     es__free(ctx, res->top_diff);

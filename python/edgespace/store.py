@@ -887,6 +887,8 @@ class Store:
             if r.group_names != ffi.NULL else [],
             groups_len=A.struct_dict(r.groups_len, "es_group_stats"),
             groups_proc=A.struct_dict(r.groups_proc, "es_group_stats"))
+        # Kendall's rho (unit centroid size) beside the data-unit d_proc
+        res.d_rho = A.view(r.d_rho, (n, n), r).T if r.d_rho != ffi.NULL else None
         if G:
             res.mean_len = A.view(r.mean_len, (G, G), r).T
             res.mean_proc = A.view(r.mean_proc, (G, G), r).T

@@ -4,6 +4,7 @@
 #include "commands.h"
 
 #include <getopt.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -34,6 +35,27 @@ static const char usage[] =
     "  -h, --help              show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Median of the upper triangle of an n x n matrix (NaN when n < 2 or out
+ * of memory: a figure of the report, not of the study). */
+static double upper_median(int64_t n, const double *d)
+{
+    int64_t m = n * (n - 1) / 2, t = 0;
+    double *v = m > 0 ? malloc((size_t)m * sizeof *v) : NULL, med = NAN;
+    if (!v) return med;
+    for (int64_t j = 1; j < n; j++)
+        for (int64_t i = 0; i < j; i++) v[t++] = d[i + j * n];
+    qsort(v, (size_t)m, sizeof *v, cmp_double);
+    med = m % 2 ? v[m / 2] : 0.5 * (v[m / 2 - 1] + v[m / 2]);
+    free(v);
+    return med;
+}
 
 int cmd_compare(int argc, char **argv)
 {
@@ -119,6 +141,10 @@ int cmd_compare(int argc, char **argv)
                 printf("groups by '%s': edge lengths F %.4g (p %.4g, R2 %.3f); Procrustes F "
                        "%.4g (p %.4g, R2 %.3f)\n", by, r->groups_len.f, r->groups_len.p,
                        r->groups_len.r2, r->groups_proc.f, r->groups_proc.p, r->groups_proc.r2);
+            if (r->d_rho)   /* the data-unit figures beside Kendall's rho (unit size) */
+                printf("Procrustes distances: median %.4g data units, median rho %.4g rad "
+                       "(Riemannian, unit centroid size)\n", upper_median(r->n, r->d_proc),
+                       upper_median(r->n, r->d_rho));
             if (out) printf("outputs in %s\n", out);
         }
         es_store_close(s);
