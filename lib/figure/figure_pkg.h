@@ -13,7 +13,9 @@
 #endif
 
 #include "core/core_private.h"
+#include "edgespace/es_io.h"
 #include "edgespace/es_plot.h"
+#include "edgespace/es_render.h"
 
 #include <cairo.h>
 
@@ -102,6 +104,22 @@ double es__colorbar_width(cairo_t *cr, double w, double vmin, double vmax,
  * (symmetric about 0 for diverging maps); a degenerate range is widened. */
 void es__color_range(es_colormap cmap, const double *v, int64_t n, double *vmin,
                      double *vmax);
+
+/* The colour range of a render spec's scalars into rep->vmin, vmax (given,
+ * percentiles, or the finite range; es__color_range), and the non-finite
+ * count into rep->n_nan_scalars (render.c; es_render and the coloured mesh
+ * files share it). */
+es_status es__render_range(es_ctx *ctx, const es_render_spec *spec, es_render_report *rep);
+
+/* A scalar file's column `want` (NULL: the first; render_files.c): *n values,
+ * one per line after an optional header (its text into head[hn]), NaN for
+ * blanks; and what they colour on a mesh read from mesh_path: its vertices,
+ * faces or (through a topology made into *mesh_out) edges, set in it. */
+es_status es__read_scalars(es_ctx *ctx, const char *path, const char *want, double **out,
+                           int64_t *n, char *head, size_t hn);
+es_status es__match_scalars(es_ctx *ctx, const char *mesh_path, const es_meshdata *md,
+                            const char *sf, int64_t n, es_mesh **mesh_out,
+                            es_render_mesh *it);
 
 /* A CSV cell as a number for the figures: blanks around it are ignored; an
  * empty cell, "nan" or "na" (any case) is a missing value, NaN; anything

@@ -558,6 +558,36 @@ static es_status percentile_range(es_ctx *ctx, const es_render_spec *spec, doubl
     return ES_OK;
 }
 
+es_status es__render_range(es_ctx *ctx, const es_render_spec *spec, es_render_report *rep)
+{
+    double lo = INFINITY, hi = -INFINITY;
+    es_status rc;
+    rep->n_nan_scalars = 0;
+    for (int64_t i = 0; i < spec->nmeshes; i++) {
+        const es_render_mesh *m = &spec->meshes[i];
+        for (int64_t k = 0; k < nscalars(m); k++) {
+            double v = m->scalars[k];
+            if (!isfinite(v)) rep->n_nan_scalars++;
+            else lo = fmin(lo, v), hi = fmax(hi, v);
+        }
+    }
+    rep->vmin = spec->vmin;
+    rep->vmax = spec->vmax;
+    if ((rep->vmin == rep->vmax || !isfinite(rep->vmin) || !isfinite(rep->vmax)) && lo < hi &&
+        (spec->range_percentiles[0] > 0 || (spec->range_percentiles[1] > 0 &&
+                                           spec->range_percentiles[1] < 100)) &&
+        (rc = percentile_range(ctx, spec, &lo, &hi)) != ES_OK)
+        return rc;
+    if (rep->vmin == rep->vmax || !isfinite(rep->vmin) || !isfinite(rep->vmax)) {
+        double pair[2] = {lo, hi};
+        rep->vmin = rep->vmax = 0;
+        es__color_range(spec->cmap, pair, lo <= hi ? 2 : 0, &rep->vmin, &rep->vmax);
+    } else {
+        es__color_range(spec->cmap, NULL, 0, &rep->vmin, &rep->vmax);
+    }
+    return ES_OK;
+}
+
 es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
                     es_render_report *rep_out)
 {
@@ -574,33 +604,14 @@ es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
     if ((rc = check_spec(ctx, spec)) != ES_OK) return rc;
     int64_t n = spec->nmeshes, maxv = 0, maxf = 0;
     bool any_scalars = false;
-    double lo = INFINITY, hi = -INFINITY;
     for (int64_t i = 0; i < n; i++) {
         const es_render_mesh *m = &spec->meshes[i];
         if ((rc = check_mesh(ctx, i, m)) != ES_OK) return rc;
         maxv = m->nverts > maxv ? m->nverts : maxv;
         maxf = m->nfaces > maxf ? m->nfaces : maxf;
         any_scalars |= m->scalar_kind != ES_SCALARS_NONE;
-        for (int64_t k = 0; k < nscalars(m); k++) {
-            double v = m->scalars[k];
-            if (!isfinite(v)) rep.n_nan_scalars++;
-            else lo = fmin(lo, v), hi = fmax(hi, v);
-        }
     }
-    rep.vmin = spec->vmin;
-    rep.vmax = spec->vmax;
-    if ((rep.vmin == rep.vmax || !isfinite(rep.vmin) || !isfinite(rep.vmax)) && lo < hi &&
-        (spec->range_percentiles[0] > 0 || (spec->range_percentiles[1] > 0 &&
-                                           spec->range_percentiles[1] < 100)) &&
-        (rc = percentile_range(ctx, spec, &lo, &hi)) != ES_OK)
-        return rc;
-    if (rep.vmin == rep.vmax || !isfinite(rep.vmin) || !isfinite(rep.vmax)) {
-        double pair[2] = {lo, hi};
-        rep.vmin = rep.vmax = 0;
-        es__color_range(spec->cmap, pair, lo <= hi ? 2 : 0, &rep.vmin, &rep.vmax);
-    } else {
-        es__color_range(spec->cmap, NULL, 0, &rep.vmin, &rep.vmax);
-    }
+    if ((rc = es__render_range(ctx, spec, &rep)) != ES_OK) return rc;
 
     /* cameras, and one scale for all panels: the coarsest that fits them all */
     int ss = spec->supersample, W = spec->width, H = spec->height;

@@ -157,6 +157,20 @@ ES_API es_status es_figure_render_files(es_ctx *ctx, const es_render_spec *spec,
                                         const char *const *labels, const char *out_path,
                                         es_render_report *rep);
 
+/* One mesh file coloured by one scalar file, as es_figure_render_files
+ * would draw it (spec: cmap, vmin/vmax, range_percentiles, scalar_column;
+ * the rest ignored), written to out_path by its extension: .ply (binary,
+ * vertex colours), .glb (COLOR_0) or .vtp (VTK XML PolyData for ParaView:
+ * the values per point, per cell too for face values, and the colours as
+ * UInt8 "colors"). Face and edge values colour each vertex by the mean of
+ * the finite values around it, on the colour range of the values given (the
+ * one es_figure_render_files' colour bar shows); NaN is ES_NAN_GREY. rep (may be NULL) gets
+ * the colour range and the non-finite count. Errors: those of
+ * es_figure_render_files; ES_EINVAL for another extension. */
+ES_API es_status es_figure_color_file(es_ctx *ctx, const es_render_spec *spec,
+                                      const char *mesh_path, const char *scalar_path,
+                                      const char *out_path, es_render_report *rep);
+
 /* ---- models and shape variation ---------------------------------------------- */
 
 /* The per-edge tests of a model (es_study_model with opts.edge_term) drawn
