@@ -1,6 +1,8 @@
 /* lib/figure/compare_figures.c — the comparison study's figures: the two
- * distance heat maps and the scatter of distance pairs coloured by group
- * pair; and the study on a store with its tables and figures in one call.
+ * distance heat maps (rows ordered by group, labelled with ids or group
+ * names, the colour bar in the distance's units) and the scatter of
+ * distance pairs coloured by group pair; and the study on a store with its
+ * tables and figures in one call.
  */
 #include "figure/figure_pkg.h"
 #include "core/files.h"
@@ -9,6 +11,7 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 typedef struct names {
     const char *const *s;
@@ -23,29 +26,97 @@ static const char *name_of(names *nm, int64_t i)
     return nm->buf;
 }
 
+/* A row of the heat maps, sorted by group, then by id, then by row number
+ * (the key carries all three, so the order is total and qsort stable). */
+typedef struct order_key {
+    int64_t row, group;
+    const char *id;
+} order_key;
+
+static int cmp_order(const void *pa, const void *pb)
+{
+    const order_key *a = pa, *b = pb;
+    if (a->group != b->group) return a->group < b->group ? -1 : 1;
+    int c = a->id && b->id ? strcmp(a->id, b->id) : 0;
+    if (c) return c;
+    return (a->row > b->row) - (a->row < b->row);
+}
+
+es_status es_figure_compare_heatmap(es_ctx *ctx, const es_compare_result *r, int which,
+                                    const char *const *ids, const int64_t *group,
+                                    const char *const *gnames, const char *path,
+                                    es_plot_info *info)
+{
+    if (!r || (which != 0 && which != 1) || !path)
+        ES_FAIL(ctx, ES_EINVAL, "compare heatmap: no result, no path or a matrix %d "
+                "that is neither 0 (edge lengths) nor 1 (Procrustes)", which);
+    const int64_t n = r->n;
+    const double *d = which ? r->d_proc : r->d_len;
+    order_key *key = es__alloc_array(ctx, n, sizeof *key);
+    double *sorted = es__alloc_array(ctx, n * n, sizeof *sorted);
+    int64_t *sgroup = es__alloc_array(ctx, n, sizeof *sgroup);
+    const char **sids = es__alloc_array(ctx, n, sizeof *sids);
+    es_status rc = key && sorted && sgroup && sids ? ES_OK : ES_ENOMEM;
+    if (rc == ES_OK) {
+        for (int64_t i = 0; i < n; i++)
+            key[i] = (order_key){i, group ? group[i] : 0, ids ? ids[i] : NULL};
+        qsort(key, (size_t)n, sizeof *key, cmp_order);
+        for (int64_t j = 0; j < n; j++) {
+            sgroup[j] = key[j].group;
+            sids[j] = key[j].id;
+            for (int64_t i = 0; i < n; i++) sorted[i + j * n] = d[key[i].row + key[j].row * n];
+        }
+        es_heatmap_spec h;
+        es_heatmap_spec_init(&h);
+        h.frame.width = 720;
+        h.frame.height = 660;   /* square cells beside the colour bar */
+        h.frame.title = which ? "Procrustes distances (GPA-aligned)"
+                              : "edge-length distances (scale-normalized)";
+        h.values = (es_mat){sorted, n, n, n};
+        /* ids while they can be read (two per line of text at most); the
+         * group names carry a larger matrix */
+        h.row_labels = h.col_labels = ids && n <= 60 ? sids : NULL;
+        h.row_groups = h.col_groups = group ? sgroup : NULL;
+        h.group_names = gnames;
+        h.colorbar_label = which ? "Procrustes distance (data units, GPA-aligned)"
+                           : r->normalized_lengths
+                               ? "distance between unit-sum length vectors"
+                               : "edge-length distance (data units)";
+        rc = es_plot_heatmap(ctx, &h, path, info);
+    }
+    es__free(ctx, key);
+    es__free(ctx, sorted);
+    es__free(ctx, sgroup);
+    es__free(ctx, sids);
+    return rc;
+}
+
+/* "png", "pdf" or "svg" (NULL: svg). */
+static es_status check_format(es_ctx *ctx, const char *format)
+{
+    static const char *const known[] = {"png", "pdf", "svg"};
+    for (size_t i = 0; i < sizeof known / sizeof *known; i++)
+        if (!strcmp(format, known[i])) return ES_OK;
+    ES_FAIL(ctx, ES_EINVAL, "compare: unknown figure format '%s' (png, pdf, svg)", format);
+}
+
 es_status es_figure_compare_write(es_ctx *ctx, const es_compare_result *r,
                                   const char *const *ids, const int64_t *group,
-                                  const char *const *gnames, const char *dir)
+                                  const char *const *gnames, const char *dir,
+                                  const char *format)
 {
     char path[4096];
     es_status rc;
     int64_t n = r->n, m = n * (n - 1) / 2;
+    if (!format) format = "svg";
+    if ((rc = check_format(ctx, format)) != ES_OK) return rc;
     if ((rc = es__mkdir_p(ctx, dir)) != ES_OK)
         return es__fail(ctx, rc, "compare: %s", es_ctx_errmsg(ctx));
-    const char *files[2] = {"heatmap_lengths.svg", "heatmap_procrustes.svg"};
-    const char *titles[2] = {"edge-length distances (scale-normalized)",
-                             "Procrustes distances (GPA-aligned)"};
-    double *mats[2] = {r->d_len, r->d_proc};
+    const char *files[2] = {"heatmap_lengths", "heatmap_procrustes"};
     for (int s = 0; s < 2; s++) {
-        es_heatmap_spec h;
-        es_heatmap_spec_init(&h);
-        h.frame.title = titles[s];
-        h.values = (es_mat){mats[s], n, n, n};
-        h.row_labels = n <= 60 ? ids : NULL;
-        h.col_labels = n <= 60 ? ids : NULL;
-        h.colorbar_label = "distance";
-        snprintf(path, sizeof path, "%s/%s", dir, files[s]);
-        if ((rc = es_plot_heatmap(ctx, &h, path, NULL)) != ES_OK) return rc;
+        snprintf(path, sizeof path, "%s/%s.%s", dir, files[s], format);
+        if ((rc = es_figure_compare_heatmap(ctx, r, s, ids, group, gnames, path, NULL)) != ES_OK)
+            return rc;
     }
     double *x = es__alloc_array(ctx, 2 * m, sizeof *x);
     char **lab = group ? es__calloc(ctx, (size_t)m, sizeof *lab) : NULL;
@@ -82,7 +153,7 @@ es_status es_figure_compare_write(es_ctx *ctx, const es_compare_result *r,
         sc.labels = (const char *const *)lab;
         sc.legend_title = group ? "group pair" : NULL;
         sc.marker_radius = m > 2000 ? 2 : 4;
-        snprintf(path, sizeof path, "%s/pairs_scatter.svg", dir);
+        snprintf(path, sizeof path, "%s/pairs_scatter.%s", dir, format);
         rc = es_plot_scatter(ctx, &sc, path, NULL);
     }
     if (lab)
@@ -95,13 +166,14 @@ es_status es_figure_compare_write(es_ctx *ctx, const es_compare_result *r,
 
 es_status es_figure_compare(es_ctx *ctx, es_store *store, const char *gpa_name, const char *by,
                             const es_compare_opts *opts, const char *name, const char *out_dir,
-                            const char *command, es_compare_result **res)
+                            const char *command, const char *format,
+                            es_compare_result **res)
 {
     es_compare_result *r = NULL;
     es_status rc = es_study_compare(ctx, store, gpa_name, by, opts, name, out_dir, command, &r);
     if (rc == ES_OK && out_dir)
         rc = es_figure_compare_write(ctx, r, (const char *const *)r->ids, r->group,
-                                     (const char *const *)r->group_names, out_dir);
+                                     (const char *const *)r->group_names, out_dir, format);
     if (rc == ES_OK && res) {
         *res = r;
         r = NULL;

@@ -13,7 +13,9 @@
 #endif
 
 #include "core/core_private.h"
+#include "edgespace/es_io.h"
 #include "edgespace/es_plot.h"
+#include "edgespace/es_render.h"
 
 #include <cairo.h>
 
@@ -41,6 +43,11 @@ es_status es__canvas_close(es_ctx *ctx, es__canvas *cv);
 /* Release without reporting (on an error path; the part file is removed).
  * NULL members: no-op. */
 void es__canvas_discard(es__canvas *cv);
+
+/* A plot frame's defaults (640 x 480, font 12, no title or labels), and its
+ * check (font size in (0, 200)) naming the plot `what` (plot.c). */
+void es__frame_init(es_plot_frame *f);
+es_status es__frame_check(es_ctx *ctx, const char *what, const es_plot_frame *f);
 
 /* Text anchored at (x, y): ha 0 left, 0.5 centre, 1 right; va 0 top,
  * 0.5 middle, 1 bottom (of the font's ascent..descent box); rotated by
@@ -83,18 +90,36 @@ double es__legend_width(cairo_t *cr, const char *title, const char *const *names
                         int64_t n, double size);
 
 /* Vertical colour bar, vmax at the top; the top device row has exactly the
- * map's colour at 1, the bottom row at 0. Ticks and label on the right. */
+ * map's colour at 1, the bottom row at 0. Ticks and label on the right.
+ * logscale: the values are log10 of the quantity; ticks at 1, 2, 5 x 10^k of
+ * the quantity, labelled with it. */
 void es__draw_colorbar(cairo_t *cr, double x, double y, double w, double h,
                        es_colormap cmap, double vmin, double vmax, const char *label,
-                       double size);
+                       double size, int logscale);
 /* Width taken by a colour bar of bar width w (bar, ticks, label). */
 double es__colorbar_width(cairo_t *cr, double w, double vmin, double vmax,
-                          const char *label, double size);
+                          const char *label, double size, int logscale);
 
 /* Resolve a colour range: vmin == vmax means the finite range of data
  * (symmetric about 0 for diverging maps); a degenerate range is widened. */
 void es__color_range(es_colormap cmap, const double *v, int64_t n, double *vmin,
                      double *vmax);
+
+/* The colour range of a render spec's scalars into rep->vmin, vmax (given,
+ * percentiles, or the finite range; es__color_range), and the non-finite
+ * count into rep->n_nan_scalars (render.c; es_render and the coloured mesh
+ * files share it). */
+es_status es__render_range(es_ctx *ctx, const es_render_spec *spec, es_render_report *rep);
+
+/* A scalar file's column `want` (NULL: the first; render_files.c): *n values,
+ * one per line after an optional header (its text into head[hn]), NaN for
+ * blanks; and what they colour on a mesh read from mesh_path: its vertices,
+ * faces or (through a topology made into *mesh_out) edges, set in it. */
+es_status es__read_scalars(es_ctx *ctx, const char *path, const char *want, double **out,
+                           int64_t *n, char *head, size_t hn);
+es_status es__match_scalars(es_ctx *ctx, const char *mesh_path, const es_meshdata *md,
+                            const char *sf, int64_t n, es_mesh **mesh_out,
+                            es_render_mesh *it);
 
 /* A CSV cell as a number for the figures: blanks around it are ignored; an
  * empty cell, "nan" or "na" (any case) is a missing value, NaN; anything

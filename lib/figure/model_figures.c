@@ -1,6 +1,6 @@
 /* lib/figure/model_figures.c — figures of models and of shape variation:
  * the per-edge tests of a model as a heat map on the mean mesh
- * (es_figure_edge_tests), and mean +- k sd along principal components or
+ * (es_figure_edge_tests: each significant edge's F, log scale), and mean +- k sd along principal components or
  * along a model coefficient, embedded near the data and drawn in one frame
  * beside the per-vertex displacement (es_figure_variation).
  *
@@ -17,6 +17,7 @@
 #include "edgespace/es_study.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -51,17 +52,20 @@ es_status es_figure_edge_tests(es_ctx *ctx, es_store *store, const es_study_mode
     if (r->model->p != E)
         ES_FAIL(ctx, ES_EINVAL, "edge figure: the model is not per edge");
     es_mesh *mesh = NULL;
-    double *xyz = NULL, *v = es__alloc_array(ctx, E, sizeof *v), vmax = 2;
+    double *xyz = NULL, *v = es__alloc_array(ctx, E, sizeof *v);
     es_status rc = v ? mean_mesh(ctx, store, r->rows, r->nrows, &mesh, &xyz) : ES_ENOMEM;
     int64_t nsig = 0;
     if (rc == ES_OK) {
-        /* -log10 q, capped where q reaches its floor 1/(B+1) */
+        /* The F of each edge, not its q: with most edges significant, q sits
+         * at its floor 1/(B+1) almost everywhere and shows nothing, while F
+         * still ranks the edges. Log scale since F spans decades; the edges
+         * not significant (q >= 0.05, or untested) are NaN, drawn grey. */
         for (int64_t e = 0; e < E; e++) {
-            v[e] = isnan(r->edge_q[e]) ? NAN : -log10(r->edge_q[e]);
-            nsig += r->edge_q[e] < 0.05;
-            if (isfinite(v[e]) && v[e] > vmax) vmax = v[e];
+            bool sig = r->edge_q[e] < 0.05 && r->edge_f[e] > 0;
+            v[e] = sig ? log10(r->edge_f[e]) : NAN;
+            nsig += sig;
         }
-        char title[256], bar[64];
+        char title[256];
         es_render_mesh m;
         es_render_spec spec;
         es_render_mesh_from(&m, mesh, xyz);
@@ -70,14 +74,16 @@ es_status es_figure_edge_tests(es_ctx *ctx, es_store *store, const es_study_mode
         es_render_spec_init(&spec);
         spec.nmeshes = 1;
         spec.meshes = &m;
-        spec.vmin = 0;
-        spec.vmax = vmax;
         spec.cmap = ES_CMAP_VIRIDIS;
-        snprintf(title, sizeof title, "per-edge tests: %lld of %lld edges with FDR q < 0.05",
+        /* a few extreme edges do not set the range of all (render --percentiles) */
+        spec.range_percentiles[0] = 2;
+        spec.range_percentiles[1] = 98;
+        spec.colorbar_log10 = 1;
+        snprintf(title, sizeof title, "%lld of %lld edges with FDR q < 0.05",
                  (long long)nsig, (long long)E);
-        snprintf(bar, sizeof bar, "-log10 q (0.05: %.2f)", -log10(0.05));
+        spec.nan_label = "q \u2265 0.05";
         spec.title = title;
-        spec.colorbar_label = bar;
+        spec.colorbar_label = "per-edge F (log)";
         rc = es_render(ctx, &spec, out_path, NULL);
     }
     es_mesh_free(mesh);

@@ -18,7 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static void frame_init(es_plot_frame *f)
+void es__frame_init(es_plot_frame *f)
 {
     memset(f, 0, sizeof *f);
     f->width = 640;
@@ -26,7 +26,7 @@ static void frame_init(es_plot_frame *f)
     f->font_size = 12;
 }
 
-static es_status check_frame(es_ctx *ctx, const char *what, const es_plot_frame *f)
+es_status es__frame_check(es_ctx *ctx, const char *what, const es_plot_frame *f)
 {
     if (!(f->font_size > 0 && f->font_size < 200))
         ES_FAIL(ctx, ES_EINVAL, "%s: font size %g is outside (0, 200)", what, f->font_size);
@@ -43,7 +43,7 @@ static void info_clear(es_plot_info *info)
 void es_scatter_spec_init(es_scatter_spec *spec)
 {
     memset(spec, 0, sizeof *spec);
-    frame_init(&spec->frame);
+    es__frame_init(&spec->frame);
     spec->marker_radius = 4;
 }
 
@@ -85,7 +85,7 @@ es_status es_plot_scatter(es_ctx *ctx, const es_scatter_spec *spec, const char *
     double fs = f->font_size;
 
     info_clear(&info);
-    if ((rc = check_frame(ctx, "scatter", f)) != ES_OK) return rc;
+    if ((rc = es__frame_check(ctx, "scatter", f)) != ES_OK) return rc;
     if (spec->n < 0 || (spec->n > 0 && (!spec->x || !spec->y)))
         ES_FAIL(ctx, ES_EINVAL, "scatter: %lld points but no coordinates", (long long)spec->n);
     if (!(spec->marker_radius > 0))
@@ -175,7 +175,7 @@ done:
 void es_scree_spec_init(es_scree_spec *spec)
 {
     memset(spec, 0, sizeof *spec);
-    frame_init(&spec->frame);
+    es__frame_init(&spec->frame);
     spec->frame.xlabel = "component";
     spec->frame.ylabel = "explained variance (%)";
 }
@@ -191,7 +191,7 @@ es_status es_plot_scree(es_ctx *ctx, const es_scree_spec *spec, const char *path
 
     info_clear(&info);
     if (info_out) *info_out = info;
-    if ((rc = check_frame(ctx, "scree", f)) != ES_OK) return rc;
+    if ((rc = es__frame_check(ctx, "scree", f)) != ES_OK) return rc;
     if (spec->n <= 0 || !spec->variance)
         ES_FAIL(ctx, ES_EINVAL, "scree: need at least one variance (n = %lld)",
                 (long long)spec->n);
@@ -265,7 +265,7 @@ es_status es_plot_scree(es_ctx *ctx, const es_scree_spec *spec, const char *path
 void es_lines_spec_init(es_lines_spec *spec)
 {
     memset(spec, 0, sizeof *spec);
-    frame_init(&spec->frame);
+    es__frame_init(&spec->frame);
 }
 
 es_status es_plot_lines(es_ctx *ctx, const es_lines_spec *spec, const char *path,
@@ -281,7 +281,7 @@ es_status es_plot_lines(es_ctx *ctx, const es_lines_spec *spec, const char *path
 
     info_clear(&info);
     if (info_out) *info_out = info;
-    if ((rc = check_frame(ctx, "lines", f)) != ES_OK) return rc;
+    if ((rc = es__frame_check(ctx, "lines", f)) != ES_OK) return rc;
     if (spec->nseries < 0 || (spec->nseries > 0 && !spec->series))
         ES_FAIL(ctx, ES_EINVAL, "lines: %lld series but no array", (long long)spec->nseries);
     double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
@@ -397,142 +397,12 @@ done:
     return rc;
 }
 
-/* ---- heat map -------------------------------------------------------------- */
-
-void es_heatmap_spec_init(es_heatmap_spec *spec)
-{
-    memset(spec, 0, sizeof *spec);
-    frame_init(&spec->frame);
-    spec->cmap = ES_CMAP_VIRIDIS;
-}
-
-static double max_label_width(cairo_t *cr, const char *const *labels, int64_t n, double size)
-{
-    double w = 0;
-    for (int64_t i = 0; labels && i < n; i++) w = fmax(w, es__text_width(cr, labels[i], size));
-    return w;
-}
-
-es_status es_plot_heatmap(es_ctx *ctx, const es_heatmap_spec *spec, const char *path,
-                          es_plot_info *info_out)
-{
-    es_status rc;
-    es_plot_info info;
-    es__canvas cv;
-    const es_plot_frame *f = &spec->frame;
-    const es_mat *m = &spec->values;
-    double fs = f->font_size, vmin = spec->vmin, vmax = spec->vmax;
-    cairo_surface_t *img = NULL;
-
-    info_clear(&info);
-    if (info_out) *info_out = info;
-    if ((rc = check_frame(ctx, "heatmap", f)) != ES_OK) return rc;
-    if (m->rows <= 0 || m->cols <= 0 || !m->data || m->ld < m->rows)
-        ES_FAIL(ctx, ES_EINVAL, "heatmap: bad matrix %lld x %lld (ld %lld)",
-                (long long)m->rows, (long long)m->cols, (long long)m->ld);
-    if (m->rows > 16384 || m->cols > 16384)
-        ES_FAIL(ctx, ES_ERANGE, "heatmap: matrix %lld x %lld is larger than 16384 x 16384",
-                (long long)m->rows, (long long)m->cols);
-    int rows = (int)m->rows, cols = (int)m->cols;
-    if (vmin == vmax || !isfinite(vmin) || !isfinite(vmax)) {
-        double lo = INFINITY, hi = -INFINITY;
-        for (int j = 0; j < cols; j++)
-            for (int i = 0; i < rows; i++) {
-                double v = ES_AT(*m, i, j);
-                if (isfinite(v)) lo = fmin(lo, v), hi = fmax(hi, v);
-            }
-        double pair[2] = {lo, hi};
-        vmin = vmax = 0;
-        es__color_range(spec->cmap, pair, lo <= hi ? 2 : 0, &vmin, &vmax);
-    } else {
-        es__color_range(spec->cmap, NULL, 0, &vmin, &vmax);
-    }
-
-    /* one pixel per cell, scaled up with nearest-neighbour filtering: one
-     * image instead of rows x cols rectangles, also in SVG and PDF */
-    img = cairo_image_surface_create(CAIRO_FORMAT_RGB24, cols, rows);
-    if (cairo_surface_status(img) != CAIRO_STATUS_SUCCESS) {
-        cairo_surface_destroy(img);
-        ES_FAIL(ctx, ES_ENOMEM, "heatmap: cannot allocate a %d x %d image", cols, rows);
-    }
-    unsigned char *px = cairo_image_surface_get_data(img);
-    int stride = cairo_image_surface_get_stride(img);
-    for (int i = 0; i < rows; i++) {
-        uint32_t *row = (uint32_t *)(void *)(px + (size_t)i * (size_t)stride);
-        for (int j = 0; j < cols; j++) {
-            double v = ES_AT(*m, i, j), rgb[3];
-            if (!isfinite(v)) info.n_skipped++;
-            es_colormap_rgb(spec->cmap, isfinite(v) ? (v - vmin) / (vmax - vmin) : NAN, rgb);
-            row[j] = (uint32_t)lrint(rgb[0] * 255) << 16 | (uint32_t)lrint(rgb[1] * 255) << 8 |
-                     (uint32_t)lrint(rgb[2] * 255);
-        }
-    }
-    cairo_surface_mark_dirty(img);
-
-    if ((rc = es__canvas_open(ctx, path, f->width, f->height, &cv)) != ES_OK) {
-        cairo_surface_destroy(img);
-        return rc;
-    }
-    cairo_t *cr = cv.cr;
-    double lsize = 0.8 * fs;
-    double rlw = max_label_width(cr, spec->row_labels, rows, lsize);
-    double clw = max_label_width(cr, spec->col_labels, cols, lsize);
-    double cbw = es__colorbar_width(cr, fs, vmin, vmax, spec->colorbar_label, fs) + fs;
-    es_plot_frame g = *f;
-    g.height = f->height - (int)(spec->col_labels ? clw : 0);
-    es__plot_area(&g, cbw, spec->row_labels ? rlw : 0, &info);
-    info.xmin = 0;
-    info.xmax = cols;
-    info.ymin = 0;
-    info.ymax = rows;
-    double w = info.right - info.left, h = info.bottom - info.top;
-    /* square cells unless the matrix is very elongated */
-    if ((double)rows / cols >= 0.25 && (double)rows / cols <= 4) {
-        double cell = fmin(w / cols, h / rows);
-        w = cell * cols;
-        h = cell * rows;
-        info.right = info.left + w;
-        info.bottom = info.top + h;
-    }
-
-    cairo_save(cr);
-    cairo_translate(cr, info.left, info.top);
-    cairo_scale(cr, w / cols, h / rows);
-    cairo_set_source_surface(cr, img, 0, 0);
-    cairo_pattern_set_filter(cairo_get_source(cr), CAIRO_FILTER_NEAREST);
-    cairo_rectangle(cr, 0, 0, cols, rows);
-    cairo_fill(cr);
-    cairo_restore(cr);
-
-    /* labels: every k-th so that they never overlap */
-    cairo_set_source_rgb(cr, 0, 0, 0);
-    int kr = (int)ceil(1.1 * lsize / (h / rows)), kc = (int)ceil(1.1 * lsize / (w / cols));
-    for (int i = 0; spec->row_labels && i < rows; i += kr)
-        es__text(cr, info.left - 4, info.top + (i + 0.5) * h / rows, spec->row_labels[i],
-                 lsize, 1, 0.5, 0);
-    for (int j = 0; spec->col_labels && j < cols; j += kc)
-        es__text(cr, info.left + (j + 0.5) * w / cols, info.bottom + 4, spec->col_labels[j],
-                 lsize, 1, 0.5, -M_PI / 2);
-    cairo_set_line_width(cr, 1);
-    cairo_rectangle(cr, info.left, info.top, w, h);
-    cairo_stroke(cr);
-    es_plot_frame labels_only = *f;
-    labels_only.height = f->height;
-    es__draw_axes(cr, &labels_only, &info, NULL, NULL, 0);
-    es__draw_colorbar(cr, info.right + fs, info.top, fs, h, spec->cmap, vmin, vmax,
-                      spec->colorbar_label, fs);
-    cairo_surface_destroy(img);
-    rc = es__canvas_close(ctx, &cv);
-    if (info_out) *info_out = info;
-    return rc;
-}
-
 /* ---- histogram ------------------------------------------------------------- */
 
 void es_histogram_spec_init(es_histogram_spec *spec)
 {
     memset(spec, 0, sizeof *spec);
-    frame_init(&spec->frame);
+    es__frame_init(&spec->frame);
     spec->frame.ylabel = "count";
 }
 
@@ -554,7 +424,7 @@ es_status es_plot_histogram(es_ctx *ctx, const es_histogram_spec *spec, const ch
 
     info_clear(&info);
     if (info_out) *info_out = info;
-    if ((rc = check_frame(ctx, "histogram", f)) != ES_OK) return rc;
+    if ((rc = es__frame_check(ctx, "histogram", f)) != ES_OK) return rc;
     if (spec->n < 0 || (spec->n > 0 && !spec->values))
         ES_FAIL(ctx, ES_EINVAL, "histogram: %lld values but no data", (long long)spec->n);
     if (nbins < 0 || nbins > 10000)

@@ -449,26 +449,50 @@ void es__draw_legend(cairo_t *cr, double x, double y, const char *title,
 
 /* ---- colour bar ------------------------------------------------------------ */
 
+/* The colour bar's ticks and their labels. logscale: the values are log10 of
+ * the quantity, and the ticks sit at 1, 2 and 5 times powers of ten of it
+ * (every integer multiple when that gives fewer than 3), labelled with the
+ * quantity itself. */
+static void colorbar_ticks(double vmin, double vmax, int logscale, es__ticks *t,
+                           char labels[][32])
+{
+    if (logscale) {
+        static const double steps[2][9] = {{1, 2, 5}, {1, 2, 3, 4, 5, 6, 7, 8, 9}};
+        static const int nsteps[2] = {3, 9};
+        for (int pass = 0; pass < 2; pass++) {
+            t->n = 0;
+            for (double k = floor(vmin); k <= ceil(vmax) && t->n < ES__MAX_TICKS; k++)
+                for (int i = 0; i < nsteps[pass] && t->n < ES__MAX_TICKS; i++) {
+                    double v = k + log10(steps[pass][i]);
+                    if (v < vmin - 1e-9 || v > vmax + 1e-9) continue;
+                    snprintf(labels[t->n], 32, "%g", steps[pass][i] * pow(10, k));
+                    t->v[t->n++] = v;
+                }
+            if (t->n >= 3) break;
+        }
+        return;
+    }
+    es__ticks_nice(vmin, vmax, 5, 0, t);
+    for (int i = 0; i < t->n; i++) es__tick_label(t, t->v[i], 0, labels[i], 32);
+}
+
 double es__colorbar_width(cairo_t *cr, double w, double vmin, double vmax,
-                          const char *label, double size)
+                          const char *label, double size, int logscale)
 {
     es__ticks t;
-    char buf[64];
+    char labels[ES__MAX_TICKS][32];
     double tw = 0;
-    es__ticks_nice(vmin, vmax, 5, 0, &t);
-    for (int i = 0; i < t.n; i++) {
-        es__tick_label(&t, t.v[i], 0, buf, sizeof buf);
-        tw = fmax(tw, es__text_width(cr, buf, 0.85 * size));
-    }
+    colorbar_ticks(vmin, vmax, logscale, &t, labels);
+    for (int i = 0; i < t.n; i++) tw = fmax(tw, es__text_width(cr, labels[i], 0.85 * size));
     return w + 6 + tw + (label && *label ? 1.8 * size : 0) + 4;
 }
 
 void es__draw_colorbar(cairo_t *cr, double x, double y, double w, double h,
                        es_colormap cmap, double vmin, double vmax, const char *label,
-                       double size)
+                       double size, int logscale)
 {
     double rgb[3];
-    char buf[64];
+    char labels[ES__MAX_TICKS][32];
     int rows = (int)lrint(h);
     if (rows < 2) rows = 2;
     x = round(x);
@@ -489,7 +513,7 @@ void es__draw_colorbar(cairo_t *cr, double x, double y, double w, double h,
     cairo_rectangle(cr, x - 0.5, y - 0.5, w + 1, rows + 1);
     cairo_stroke(cr);
     es__ticks t;
-    es__ticks_nice(vmin, vmax, 5, 0, &t);
+    colorbar_ticks(vmin, vmax, logscale, &t, labels);
     for (int i = 0; i < t.n; i++) {
         if (t.v[i] < vmin - 1e-9 * (vmax - vmin) || t.v[i] > vmax + 1e-9 * (vmax - vmin))
             continue;
@@ -497,11 +521,10 @@ void es__draw_colorbar(cairo_t *cr, double x, double y, double w, double h,
         cairo_move_to(cr, x + w, py);
         cairo_line_to(cr, x + w + 4, py);
         cairo_stroke(cr);
-        es__tick_label(&t, t.v[i], 0, buf, sizeof buf);
-        es__text(cr, x + w + 6, py, buf, 0.85 * size, 0, 0.5, 0);
+        es__text(cr, x + w + 6, py, labels[i], 0.85 * size, 0, 0.5, 0);
     }
     if (label && *label) {
-        double tw = es__colorbar_width(cr, w, vmin, vmax, NULL, size);
+        double tw = es__colorbar_width(cr, w, vmin, vmax, NULL, size, logscale);
         es__text(cr, x + tw + 0.2 * size, y + 0.5 * h, label, size, 0.5, 0, -M_PI / 2);
     }
     cairo_restore(cr);

@@ -558,6 +558,36 @@ static es_status percentile_range(es_ctx *ctx, const es_render_spec *spec, doubl
     return ES_OK;
 }
 
+es_status es__render_range(es_ctx *ctx, const es_render_spec *spec, es_render_report *rep)
+{
+    double lo = INFINITY, hi = -INFINITY;
+    es_status rc;
+    rep->n_nan_scalars = 0;
+    for (int64_t i = 0; i < spec->nmeshes; i++) {
+        const es_render_mesh *m = &spec->meshes[i];
+        for (int64_t k = 0; k < nscalars(m); k++) {
+            double v = m->scalars[k];
+            if (!isfinite(v)) rep->n_nan_scalars++;
+            else lo = fmin(lo, v), hi = fmax(hi, v);
+        }
+    }
+    rep->vmin = spec->vmin;
+    rep->vmax = spec->vmax;
+    if ((rep->vmin == rep->vmax || !isfinite(rep->vmin) || !isfinite(rep->vmax)) && lo < hi &&
+        (spec->range_percentiles[0] > 0 || (spec->range_percentiles[1] > 0 &&
+                                           spec->range_percentiles[1] < 100)) &&
+        (rc = percentile_range(ctx, spec, &lo, &hi)) != ES_OK)
+        return rc;
+    if (rep->vmin == rep->vmax || !isfinite(rep->vmin) || !isfinite(rep->vmax)) {
+        double pair[2] = {lo, hi};
+        rep->vmin = rep->vmax = 0;
+        es__color_range(spec->cmap, pair, lo <= hi ? 2 : 0, &rep->vmin, &rep->vmax);
+    } else {
+        es__color_range(spec->cmap, NULL, 0, &rep->vmin, &rep->vmax);
+    }
+    return ES_OK;
+}
+
 es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
                     es_render_report *rep_out)
 {
@@ -574,33 +604,14 @@ es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
     if ((rc = check_spec(ctx, spec)) != ES_OK) return rc;
     int64_t n = spec->nmeshes, maxv = 0, maxf = 0;
     bool any_scalars = false;
-    double lo = INFINITY, hi = -INFINITY;
     for (int64_t i = 0; i < n; i++) {
         const es_render_mesh *m = &spec->meshes[i];
         if ((rc = check_mesh(ctx, i, m)) != ES_OK) return rc;
         maxv = m->nverts > maxv ? m->nverts : maxv;
         maxf = m->nfaces > maxf ? m->nfaces : maxf;
         any_scalars |= m->scalar_kind != ES_SCALARS_NONE;
-        for (int64_t k = 0; k < nscalars(m); k++) {
-            double v = m->scalars[k];
-            if (!isfinite(v)) rep.n_nan_scalars++;
-            else lo = fmin(lo, v), hi = fmax(hi, v);
-        }
     }
-    rep.vmin = spec->vmin;
-    rep.vmax = spec->vmax;
-    if ((rep.vmin == rep.vmax || !isfinite(rep.vmin) || !isfinite(rep.vmax)) && lo < hi &&
-        (spec->range_percentiles[0] > 0 || (spec->range_percentiles[1] > 0 &&
-                                           spec->range_percentiles[1] < 100)) &&
-        (rc = percentile_range(ctx, spec, &lo, &hi)) != ES_OK)
-        return rc;
-    if (rep.vmin == rep.vmax || !isfinite(rep.vmin) || !isfinite(rep.vmax)) {
-        double pair[2] = {lo, hi};
-        rep.vmin = rep.vmax = 0;
-        es__color_range(spec->cmap, pair, lo <= hi ? 2 : 0, &rep.vmin, &rep.vmax);
-    } else {
-        es__color_range(spec->cmap, NULL, 0, &rep.vmin, &rep.vmax);
-    }
+    if ((rc = es__render_range(ctx, spec, &rep)) != ES_OK) return rc;
 
     /* cameras, and one scale for all panels: the coarsest that fits them all */
     int ss = spec->supersample, W = spec->width, H = spec->height;
@@ -636,7 +647,8 @@ es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
         cairo_select_font_face(tcr, "sans-serif", CAIRO_FONT_SLANT_NORMAL,
                                CAIRO_FONT_WEIGHT_NORMAL);
         cb_w = (int)ceil(2 * fs + es__colorbar_width(tcr, fs, rep.vmin, rep.vmax,
-                                                     spec->colorbar_label, fs));
+                                                     spec->colorbar_label, fs,
+                                                     spec->colorbar_log10));
         cairo_destroy(tcr);
         cairo_surface_destroy(tmp);
     }
@@ -744,7 +756,7 @@ es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
         double x = round((double)(W * ncols) + fs), y = round(title_h + 0.1 * span),
                w = round(fs), h = round(0.8 * span);
         es__draw_colorbar(cr, x, y, w, h, spec->cmap, rep.vmin, rep.vmax, spec->colorbar_label,
-                          fs);
+                          fs, spec->colorbar_log10);
         rep.colorbar[0] = x, rep.colorbar[1] = y, rep.colorbar[2] = w, rep.colorbar[3] = h;
         if (rep.n_nan_scalars > 0) {
             /* a key for the grey of missing values, under the bar */
@@ -753,7 +765,8 @@ es_status es_render(es_ctx *ctx, const es_render_spec *spec, const char *path,
             cairo_rectangle(cr, x, ky, w, w);
             cairo_fill(cr);
             cairo_set_source_rgb(cr, 0, 0, 0);
-            es__text(cr, x + w + 6, ky + 0.5 * w, "n/a", 0.85 * fs, 0, 0.5, 0);
+            es__text(cr, x + w + 6, ky + 0.5 * w, spec->nan_label ? spec->nan_label : "n/a",
+                     0.85 * fs, 0, 0.5, 0);
         }
     }
     rc = es__canvas_close(ctx, &cv);

@@ -76,8 +76,8 @@ static es_status pick_column(es_ctx *ctx, const char *path, const es__csv_table 
 /* The values of column `want` (pick_column) of a scalar file into *out
  * (es__free), *n of them: one per line after an optional header line, NaN
  * for blank lines and missing cells; the column's header into head[hn]. */
-static es_status read_scalars(es_ctx *ctx, const char *path, const char *want, double **out,
-                              int64_t *n, char *head, size_t hn)
+es_status es__read_scalars(es_ctx *ctx, const char *path, const char *want, double **out,
+                           int64_t *n, char *head, size_t hn)
 {
     char *buf = NULL;
     size_t len, bom;
@@ -130,9 +130,8 @@ static es_status read_scalars(es_ctx *ctx, const char *path, const char *want, d
 
 /* What the n scalars of file sf colour on mesh i: its vertices, faces or
  * (through the topology, which mesh_out then holds) its edges. */
-static es_status match_scalars(es_ctx *ctx, const char *mesh_path, const es_meshdata *md,
-                               const char *sf, int64_t n, es_mesh **mesh_out,
-                               es_render_mesh *it)
+es_status es__match_scalars(es_ctx *ctx, const char *mesh_path, const es_meshdata *md,
+                            const char *sf, int64_t n, es_mesh **mesh_out, es_render_mesh *it)
 {
     es_status rc;
     if (n == md->nverts) {
@@ -201,11 +200,11 @@ es_status es_figure_render_files(es_ctx *ctx, const es_render_spec *spec, int64_
         it->label = labels && labels[i] ? labels[i] : n > 1 ? es__path_base(path) : NULL;
         if (nscalars == 0) continue;
         int64_t s = nscalars == 1 ? 0 : i;
-        if (!scal[s] && (rc = read_scalars(ctx, scalar_paths[s], spec->scalar_column, &scal[s],
+        if (!scal[s] && (rc = es__read_scalars(ctx, scalar_paths[s], spec->scalar_column, &scal[s],
                                            &nscal[s], *head ? NULL : head, sizeof head)) != ES_OK)
             break;
         it->scalars = scal[s];
-        rc = match_scalars(ctx, path, &md[i], scalar_paths[s], nscal[s], &mesh[i], it);
+        rc = es__match_scalars(ctx, path, &md[i], scalar_paths[s], nscal[s], &mesh[i], it);
     }
     if (rc == ES_OK) {
         es_render_spec sp = *spec;

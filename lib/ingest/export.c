@@ -107,6 +107,8 @@ es_status es_export_meshes(es_ctx *ctx, es_store *s, const int64_t *rows, int64_
     switch (format) {
     case ES_FORMAT_PLY: case ES_FORMAT_PLY_ASCII: ext = "ply"; break;
     case ES_FORMAT_OFF: ext = "off"; break;
+    case ES_FORMAT_STL: ext = "stl"; break;
+    case ES_FORMAT_GLB: ext = "glb"; break;
     default: ext = "obj"; format = ES_FORMAT_OBJ; break;
     }
     if ((rc = es__mkdir_p(ctx, dir)) != ES_OK)

@@ -7,7 +7,7 @@
  * parsed by mesh_io_num.c.
  *
  * Formats (datasets-spec/mesh-formats.md): mesh_io_obj.c, mesh_io_ply.c,
- * mesh_io_off.c.
+ * mesh_io_off.c; written only: mesh_io_stl_glb.c.
  */
 #include "meshio/meshio_pkg.h"
 #include "edgespace/es_geom.h"
@@ -96,6 +96,8 @@ es_mesh_format es_mesh_format_from_path(const char *path)
     if (!strcasecmp(dot, ".obj")) return ES_FORMAT_OBJ;
     if (!strcasecmp(dot, ".ply")) return ES_FORMAT_PLY;
     if (!strcasecmp(dot, ".off")) return ES_FORMAT_OFF;
+    if (!strcasecmp(dot, ".stl")) return ES_FORMAT_STL;
+    if (!strcasecmp(dot, ".glb")) return ES_FORMAT_GLB;
     return ES_FORMAT_AUTO;
 }
 
@@ -156,6 +158,11 @@ es_status es_meshdata_parse(es_ctx *ctx, const char *name, const char *buf, size
     case ES_FORMAT_PLY:
     case ES_FORMAT_PLY_ASCII: rc = es__ply_parse(ctx, name, buf, len, out); break;
     case ES_FORMAT_OFF: rc = es__off_parse(ctx, name, buf, len, out); break;
+    case ES_FORMAT_STL:
+    case ES_FORMAT_GLB:
+        /* float32 positions and (STL) unshared vertices: not a study's input */
+        ES_FAIL(ctx, ES_EFORMAT, "%s: %s files are written for viewers and printers, not read "
+                "(use .obj, .ply or .off)", name, format == ES_FORMAT_STL ? "STL" : "GLB");
     case ES_FORMAT_AUTO:
     default:
         ES_FAIL(ctx, ES_EFORMAT, "%s: unknown mesh format (extension is not .obj, .ply or "
@@ -197,7 +204,8 @@ static es_status meshdata_write(es_ctx *ctx, const char *path, es_mesh_format fo
         ES_FAIL(ctx, ES_EINVAL, "mesh write: missing path, faces or positions");
     if (format == ES_FORMAT_AUTO) format = es_mesh_format_from_path(path);
     if (format == ES_FORMAT_AUTO)
-        ES_FAIL(ctx, ES_EINVAL, "'%s': cannot tell the format (use .obj, .ply or .off)", path);
+        ES_FAIL(ctx, ES_EINVAL, "'%s': cannot tell the format (use .obj, .ply, .off, .stl or "
+                ".glb)", path);
     for (int64_t i = 0; i < 3 * nfaces; i++)
         if (faces[i] < 0 || faces[i] >= nverts)
             ES_FAIL(ctx, ES_ERANGE, "'%s': face %lld has vertex %lld out of range (%lld vertices)",
@@ -213,6 +221,8 @@ static es_status meshdata_write(es_ctx *ctx, const char *path, es_mesh_format fo
                            rgb);
         break;
     case ES_FORMAT_OFF: rc = es__off_write(ctx, path, f, nverts, nfaces, faces, xyz); break;
+    case ES_FORMAT_STL: rc = es__stl_write(ctx, path, f, nverts, nfaces, faces, xyz); break;
+    case ES_FORMAT_GLB: rc = es__glb_write(ctx, path, f, nverts, nfaces, faces, xyz, rgb); break;
     case ES_FORMAT_AUTO:
     default: rc = es__fail(ctx, ES_EINVAL, "'%s': unknown format %d", path, (int)format);
     }

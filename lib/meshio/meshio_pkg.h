@@ -76,5 +76,11 @@ es_status es__ply_write(es_ctx *ctx, const char *path, FILE *f, bool binary,
                         const double *xyz, const uint8_t *rgb);
 es_status es__off_write(es_ctx *ctx, const char *path, FILE *f, int64_t nverts,
                         int64_t nfaces, const int64_t *faces, const double *xyz);
+/* Write-only formats (mesh_io_stl_glb.c): binary STL with facet normals,
+ * glTF 2.0 binary with optional per-vertex colours. */
+es_status es__stl_write(es_ctx *ctx, const char *path, FILE *f, int64_t nverts, int64_t nfaces,
+                        const int64_t *faces, const double *xyz);
+es_status es__glb_write(es_ctx *ctx, const char *path, FILE *f, int64_t nverts, int64_t nfaces,
+                        const int64_t *faces, const double *xyz, const uint8_t *rgb);
 
 #endif

@@ -18,6 +18,7 @@
  */
 #include "core/core_private.h"
 #include "edgespace/es_compare.h"
+#include "procrustes/procrustes_pkg.h"
 
 #include <cblas.h>
 #include <math.h>
@@ -386,5 +387,48 @@ es_status es_compare_groups(es_ctx *ctx, int64_t n, const double *dist, const in
 done:
     es__free(ctx, d2);
     es__free(ctx, lab);
+    return rc;
+}
+
+/* Kendall's Riemannian distance of every pair: each configuration centred
+ * and scaled to unit centroid size once (a copy), then per pair the d x d
+ * cross-product's singular values (es__procrustes_rho), O(k d^2) a pair. */
+es_status es_compare_rho(es_ctx *ctx, es_mat aligned, int d, int allow_reflection, es_mat rho)
+{
+    const int64_t kd = aligned.rows, n = aligned.cols;
+    if ((d != 2 && d != 3) || kd < d || kd % d)
+        ES_FAIL(ctx, ES_EINVAL, "compare: %lld coordinates are not configurations in %d "
+                "dimensions", (long long)kd, d);
+    if (rho.rows != n || rho.cols != n || rho.ld < n)
+        ES_FAIL(ctx, ES_EMISMATCH, "compare: rho is %lld x %lld for %lld configurations",
+                (long long)rho.rows, (long long)rho.cols, (long long)n);
+    const int64_t k = kd / d;
+    double *z = es__alloc_array(ctx, kd * (n > 0 ? n : 1), sizeof *z);
+    if (!z) return ES_ENOMEM;
+    es_status rc = ES_OK;
+    for (int64_t j = 0; j < n && rc == ES_OK; j++) {
+        double *zj = z + j * kd, ss = 0;
+        for (int64_t v = 0; v < kd; v++) zj[v] = ES_AT(aligned, v, j);
+        for (int c = 0; c < d; c++) {
+            double m = 0;
+            for (int64_t p = 0; p < k; p++) m += zj[p + c * k] / (double)k;
+            for (int64_t p = 0; p < k; p++) zj[p + c * k] -= m, ss += zj[p + c * k] * zj[p + c * k];
+        }
+        if (!(ss > 0) || !isfinite(ss))
+            rc = es__fail(ctx, ES_EINVAL, "compare: configuration %lld has no size (all its "
+                          "points coincide) or a non-finite coordinate", (long long)j);
+        for (int64_t v = 0; v < kd; v++) zj[v] /= sqrt(ss);
+    }
+    for (int64_t j = 0; j < n && rc == ES_OK; j++) {
+        ES_AT(rho, j, j) = 0;
+        for (int64_t i = 0; i < j && rc == ES_OK; i++) {
+            double a[9], r = 0;
+            es__procrustes_cross(k, d, z + i * kd, z + j * kd, a);
+            rc = es__procrustes_rho(ctx, d, a, 1, 1, allow_reflection, &r);
+            ES_AT(rho, i, j) = ES_AT(rho, j, i) = r;
+        }
+        es__progress(ctx, "compare: rho", j + 1, n);
+    }
+    es__free(ctx, z);
     return rc;
 }

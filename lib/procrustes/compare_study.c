@@ -31,6 +31,7 @@ void es_compare_result_free(es_compare_result *res)
     if (!res) return;
     es_ctx *ctx = res->ctx;
     es__free(ctx, res->d_len);
+    es__free(ctx, res->d_rho);
     es__free(ctx, res->nn_len);
     es__free(ctx, res->top_pairs);
     es__free(ctx, res->top_diff);
@@ -61,6 +62,7 @@ es_status es_compare_study(es_ctx *ctx, es_mat lengths, es_mat aligned, const in
     if (!r) return ES_ENOMEM;
     r->ctx = ctx;
     r->n = n;
+    r->normalized_lengths = o.normalize_lengths != 0;
     int64_t m = n * (n - 1) / 2;
     r->ntop = o.top_pairs < m ? (o.top_pairs > 0 ? o.top_pairs : 0) : m;
     r->d_len = es__alloc_array(ctx, 2 * n * n, sizeof *r->d_len);

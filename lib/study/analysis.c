@@ -10,6 +10,7 @@
 #include "edgespace/es_study.h"
 #include "edgespace/es_geom.h"
 #include "edgespace/es_io.h"
+#include "edgespace/es_procrustes.h"
 #include "core/core_private.h"
 
 #include <math.h>
@@ -86,7 +87,33 @@ void es_group_result_free(es_group_result *r)
     es__free(ctx, r->means);
     es__free(ctx, r->counts);
     es__free(ctx, r->scales);
+    es__free(ctx, r->centroid_sizes);
     es__free(ctx, r);
+}
+
+/* Mean centroid size per group: of each row's positions as ingested (the
+ * square root of the summed squared distances of the vertices from their
+ * centroid, R's shapes::centroid.size), the size a geomorph or shapes user
+ * reads beside the scale (the sum of edge lengths). */
+static es_status group_centroid_sizes(es_ctx *ctx, es_store *store, const int64_t *rows,
+                                      int64_t nrows, const int64_t *group, es_group_result *r)
+{
+    const int64_t V = es_store_nverts(store);
+    double *xyz = es__alloc_array(ctx, 6 * (V > 0 ? V : 1), sizeof *xyz), *cfg = xyz + 3 * V;
+    r->centroid_sizes = es__calloc(ctx, (size_t)r->ngroups, sizeof *r->centroid_sizes);
+    if (!xyz || !r->centroid_sizes) {
+        es__free(ctx, xyz);
+        return ES_ENOMEM;
+    }
+    es_status rc = ES_OK;
+    for (int64_t i = 0; i < nrows && rc == ES_OK; i++) {
+        if ((rc = es_store_read_positions(ctx, store, rows[i], xyz)) != ES_OK) break;
+        es_procrustes_from_xyz(V, xyz, cfg);
+        r->centroid_sizes[group[i]] += es_procrustes_centroid_size(V, 3, cfg);
+    }
+    for (int64_t g = 0; g < r->ngroups; g++) r->centroid_sizes[g] /= (double)r->counts[g];
+    es__free(ctx, xyz);
+    return rc;
 }
 
 es_status es_study_mean(es_ctx *ctx, es_store *store, const char *name, const char *filter,
@@ -148,6 +175,7 @@ es_status es_study_mean(es_ctx *ctx, es_store *store, const char *name, const ch
         goto done;
     for (int64_t i = 0; i < nrows; i++) r->scales[group[i]] += scales[rows[i]];
     for (int64_t g = 0; g < ng; g++) r->scales[g] /= (double)r->counts[g];
+    if ((rc = group_centroid_sizes(ctx, store, rows, nrows, group, r)) != ES_OK) goto done;
     if (name) {
         char p[PATH_MAX_LEN], params[256];
         snprintf(params, sizeof params, "filter=%s; by=%s", filter ? filter : "", by ? by : "");
@@ -159,6 +187,8 @@ es_status es_study_mean(es_ctx *ctx, es_store *store, const char *name, const ch
             (rc = es_store_put_ints(ctx, store, p, r->counts, ng)) != ES_OK ||
             (rc = dpath(ctx, p, "mean", name, "scales")) != ES_OK ||
             (rc = es_store_put_vector(ctx, store, p, r->scales, ng)) != ES_OK ||
+            (rc = dpath(ctx, p, "mean", name, "centroid_sizes")) != ES_OK ||
+            (rc = es_store_put_vector(ctx, store, p, r->centroid_sizes, ng)) != ES_OK ||
             (rc = dpath(ctx, p, "mean", name, "groups")) != ES_OK ||
             (rc = es_store_put_strings(ctx, store, p, (const char *const *)r->names, ng)) != ES_OK)
             goto done;

@@ -8,6 +8,8 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
 /* Group index per row from a label column, in order of first appearance;
  * names copied (ngroups of them, es__free each). */
@@ -50,6 +52,23 @@ static es_status groups_of(es_ctx *ctx, es_store *s, const int64_t *rows, int64_
     *names = nm;
     *ng = g;
     return ES_OK;
+}
+
+/* rho of every pair (es_compare_rho) in the GPA's dimension, reflections
+ * counted as the GPA counted them (its params, "allow_reflection=1"). */
+static es_status add_rho(es_ctx *ctx, es_store *store, const char *gpa_name, es_mat al,
+                         es_compare_result *r)
+{
+    char path[512], dim[32] = "", params[512] = "";
+    snprintf(path, sizeof path, "gpa/%s", gpa_name);
+    es_status rc = es_store_get_attr(ctx, store, path, "dim", dim, sizeof dim);
+    if (rc != ES_OK) return rc;
+    /* a GPA stored before its params said so counts reflections apart */
+    if (es_store_get_attr(ctx, store, path, "params", params, sizeof params) != ES_OK)
+        params[0] = '\0';
+    if (!(r->d_rho = es__alloc_array(ctx, r->n * r->n, sizeof *r->d_rho))) return ES_ENOMEM;
+    return es_compare_rho(ctx, al, atoi(dim), strstr(params, "allow_reflection=1") != NULL,
+                          (es_mat){r->d_rho, r->n, r->n, r->n});
 }
 
 es_status es_study_compare(es_ctx *ctx, es_store *store, const char *gpa_name,
@@ -115,6 +134,7 @@ es_status es_study_compare(es_ctx *ctx, es_store *store, const char *gpa_name,
         }
     }
     if ((rc = es_compare_study(ctx, len, al, ng ? group : NULL, ng, opts, &r)) != ES_OK) goto done;
+    if ((rc = add_rho(ctx, store, gpa_name, al, r)) != ES_OK) goto done;
     if (out_dir && (rc = es_study_compare_write(ctx, r, (const char *const *)ids,
                                                 ng ? group : NULL,
                                                 (const char *const *)gnames, out_dir)) != ES_OK)
@@ -133,6 +153,7 @@ es_status es_study_compare(es_ctx *ctx, es_store *store, const char *gpa_name,
 #define P(ds) (snprintf(path, sizeof path, "%s/%s", grp, ds), path)
         PUT(es_store_put_matrix(ctx, store, P("d_lengths"), (es_mat){r->d_len, n, n, n}));
         PUT(es_store_put_matrix(ctx, store, P("d_procrustes"), (es_mat){r->d_proc, n, n, n}));
+        PUT(es_store_put_matrix(ctx, store, P("d_rho"), (es_mat){r->d_rho, n, n, n}));
         if (ng) {
             PUT(es_store_put_matrix(ctx, store, P("group_means_lengths"), (es_mat){r->mean_len, ng, ng, ng}));
             PUT(es_store_put_matrix(ctx, store, P("group_means_procrustes"), (es_mat){r->mean_proc, ng, ng, ng}));

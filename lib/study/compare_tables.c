@@ -112,7 +112,8 @@ es_status es_study_compare_write(es_ctx *ctx, const es_compare_result *r, const 
     names a = {ids, {0}}, b = {ids, {0}}, ga = {group_names, {0}}, gb = {group_names, {0}};
     if ((rc = es__mkdir_p(ctx, dir)) != ES_OK) return es__fail(ctx, rc, "compare: %s", es_ctx_errmsg(ctx));
     if ((rc = write_matrix(ctx, dir, "distances_lengths.csv", n, r->d_len, ids)) != ES_OK ||
-        (rc = write_matrix(ctx, dir, "distances_procrustes.csv", n, r->d_proc, ids)) != ES_OK)
+        (rc = write_matrix(ctx, dir, "distances_procrustes.csv", n, r->d_proc, ids)) != ES_OK ||
+        (r->d_rho && (rc = write_matrix(ctx, dir, "distances_rho.csv", n, r->d_rho, ids)) != ES_OK))
         return rc;
 
     int64_t m = n * (n - 1) / 2, *rank = es__alloc_array(ctx, 2 * m, sizeof *rank);
@@ -121,7 +122,9 @@ es_status es_study_compare_write(es_ctx *ctx, const es_compare_result *r, const 
     upper_min_ranks(ctx, n, r->d_proc, rank + m);
     if ((rc = out_open(ctx, &o, dir, "pairs.csv")) != ES_OK) { es__free(ctx, rank); return rc; }
     fputs("i,j,id_i,id_j,d_lengths,d_procrustes,rank_lengths,rank_procrustes", o.f);
-    fputs(group ? ",group_pair\n" : "\n", o.f);
+    /* rho last: the columns before it keep their places */
+    fputs(group ? ",group_pair" : "", o.f);
+    fputs(r->d_rho ? ",rho\n" : "\n", o.f);
     for (int64_t j = 1; j < n; j++)
         for (int64_t i = 0; i < j; i++) {
             fprintf(o.f, "%lld,%lld,", (long long)i + 1, (long long)j + 1);
@@ -142,6 +145,7 @@ es_status es_study_compare_write(es_ctx *ctx, const es_compare_result *r, const 
                 es_csv_write_field(o.f, pl);
                 es__free(ctx, pl);
             }
+            if (r->d_rho) fprintf(o.f, ",%.17g", r->d_rho[i + j * n]);
             fputc('\n', o.f);
         }
     es__free(ctx, rank);

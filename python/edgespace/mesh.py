@@ -165,8 +165,9 @@ class Mesh:
         return tuple(out)
 
     def write(self, path, vertices=None, fmt="auto", colors=None):
-        """Write a mesh file (es_mesh_write; coordinates exact). colors: (V, 3)
-        per-vertex colours, uint8 or floats in [0, 1] (PLY only; see
+        """Write a mesh file (es_mesh_write: OBJ, PLY, OFF with exact
+        coordinates; STL, GLB in float32 for viewers). colors: (V, 3)
+        per-vertex colours, uint8 or floats in [0, 1] (PLY and GLB; see
         edgespace.scalar_colors for values under a colour map)."""
         V = None if vertices is None else self._positions(vertices)
         f = getattr(lib, "ES_FORMAT_" + fmt.upper().replace("-", "_"))

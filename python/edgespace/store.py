@@ -927,6 +927,8 @@ class Store:
             if r.group_names != ffi.NULL else [],
             groups_len=A.struct_dict(r.groups_len, "es_group_stats"),
             groups_proc=A.struct_dict(r.groups_proc, "es_group_stats"))
+        # Kendall's rho (unit centroid size) beside the data-unit d_proc
+        res.d_rho = A.view(r.d_rho, (n, n), r).T if r.d_rho != ffi.NULL else None
         if G:
             res.mean_len = A.view(r.mean_len, (G, G), r).T
             res.mean_proc = A.view(r.mean_proc, (G, G), r).T
@@ -1023,7 +1025,7 @@ class Store:
 
     def export_meshes(self, directory, rows=None, format=None, fmt=None):
         """Rows' positions as mesh files DIR/<id>.<ext> (es_export_meshes) in
-        `format` (the CLI's --format: obj, the default, ply, ply-ascii, off)."""
+        `format` (the CLI's --format: obj, the default, ply, ply-ascii, off, stl, glb)."""
         format = renamed("Store.export_meshes", "format", format, "fmt", fmt) or "obj"
         r = None if rows is None else A.indices(rows, (None,), "rows")
         f = getattr(lib, "ES_FORMAT_" + format.upper().replace("-", "_"))

@@ -73,3 +73,62 @@ def test_coloured_ply_and_vtp(tmp_path, ctx):
     assert np.array_equal(conn.reshape(-1, 3), F) and offs[-1] == 3 * len(F)
     with pytest.raises(ValueError, match="has 3 values"):
         es.write_vtp(tmp_path / "x.vtp", X, F, point_data={"bad": [1, 2, 3]})
+
+
+def test_render_writes_coloured_ply_glb_and_vtp(tmp_path, cli, ctx):
+    """render MESH --scalars CSV -o OUT.ply|.glb|.vtp: the colours are
+    scalar_colors' (numpy's percentiles for the range) of the chosen column;
+    face values reach the vertices as numpy's mean over each vertex's faces;
+    the PLY (parser above), VTP (xml.etree) and GLB (struct, json) read back."""
+    import json
+    import struct
+    syn = es.synth("face", n=1, ctx=ctx)
+    X, F = syn["vertices"][0], syn["faces"]
+    es.Mesh(F, X, ctx=ctx).write(tmp_path / "f.obj")
+    rng = np.random.default_rng(5)
+    a, b = rng.normal(size=len(X)), rng.lognormal(sigma=2, size=len(X))
+    b[7] = np.nan
+    with open(tmp_path / "v.csv", "w") as f:
+        f.write("a,b\n" + "".join(f"{x!r},{y!r}\n" for x, y in zip(a, b)))
+    want = es.scalar_colors(b, percentiles=(5, 95))
+    r = cli("render", tmp_path / "f.obj", "--scalars", tmp_path / "v.csv", "--column", "b",
+            "--percentiles", "5,95", "-o", tmp_path / "c.ply")
+    assert "coloured mesh" in r.stdout
+    v = read_ply(tmp_path / "c.ply")
+    assert np.array_equal(np.c_[v["x"], v["y"], v["z"]], X)
+    assert np.array_equal(np.c_[v["red"], v["green"], v["blue"]], want)
+
+    cli("render", tmp_path / "f.obj", "--scalars", tmp_path / "v.csv", "--column", "b",
+        "--percentiles", "5,95", "-o", tmp_path / "c.glb")
+    data = (tmp_path / "c.glb").read_bytes()
+    jlen = struct.unpack_from("<I", data, 12)[0]
+    doc = json.loads(data[20:20 + jlen])
+    acc = doc["accessors"][doc["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"]]
+    view = doc["bufferViews"][acc["bufferView"]]
+    col = np.frombuffer(data, "u1", 4 * len(X), 28 + jlen + view["byteOffset"]).reshape(-1, 4)
+    assert np.array_equal(col[:, :3], want)
+
+    # per-face values into a VTP: cell data as given, point data the vertex means
+    fv = rng.normal(size=len(F))
+    np.savetxt(tmp_path / "f.csv", fv, header="d", comments="", fmt="%.17g")
+    cli("render", tmp_path / "f.obj", "--scalars", tmp_path / "f.csv", "-o", tmp_path / "c.vtp")
+    piece = ET.parse(tmp_path / "c.vtp").getroot().find("PolyData/Piece")
+
+    def arr(where, name):
+        e = next(d for d in piece.find(where) if d.get("Name") == name)
+        return np.array(e.text.split(), float)
+    assert np.array_equal(np.array(piece.find("Points/DataArray").text.split(), float)
+                          .reshape(-1, 3), X)
+    assert np.array_equal(arr("Polys", "connectivity").reshape(-1, 3), F)
+    assert np.array_equal(arr("CellData", "d"), fv)
+    s, n = np.zeros(len(X)), np.zeros(len(X))
+    for k in range(3):
+        np.add.at(s, F[:, k], fv)
+        np.add.at(n, F[:, k], 1)
+    assert np.allclose(arr("PointData", "d"), s / n, rtol=1e-12, atol=1e-15)
+    # the colour range is the given values' (the picture's colour bar), not the means'
+    assert np.array_equal(arr("PointData", "colors").reshape(-1, 3).astype(np.uint8),
+                          es.scalar_colors(s / n, vmin=fv.min(), vmax=fv.max()))
+    r = cli("render", tmp_path / "f.obj", tmp_path / "f.obj", "--scalars", tmp_path / "f.csv",
+            "-o", tmp_path / "x.ply", check=False)
+    assert r.returncode == 2 and "one mesh and one --scalars" in r.stderr

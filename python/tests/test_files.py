@@ -46,7 +46,11 @@ def test_meshes_are_the_commands(store_path, tmp_path, cli, ctx):
         assert f.read_bytes() == (tmp_path / "cli" / f"{i}.ply").read_bytes()
         assert np.array_equal(mesh.read_positions(f), p)   # binary PLY: the same doubles
     with es.Store(store_path, ctx=ctx) as s, pytest.raises(AttributeError):
-        s.export_meshes(tmp_path / "x", format="stl")         # no such format
+        s.export_meshes(tmp_path / "x", format="vtk")         # no such format
+    # STL for printers: one binary file per row (test_stl_glb.py reads them)
+    with es.Store(store_path, ctx=ctx) as s:
+        s.export_meshes(tmp_path / "stl", rows=rows, format="stl")
+    assert sorted(p.name for p in (tmp_path / "stl").iterdir()) == sorted(f"{i}.stl" for i in ids)
 
 
 def test_the_nearest_row_is_numpys(store_path, ctx):

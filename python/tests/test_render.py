@@ -106,19 +106,9 @@ def test_render_scalars_column_and_percentile_range(tmp_path, cli, ctx):
 
 def test_variation_figure_writes_plus_minus_and_minus_signs(store_path, tmp_path, cli):
     """The labels and title say "±" and "−" (U+00B1, U+2212), not "+-" and
-    "-": read from the PDF's ToUnicode maps (zlib, not the library)."""
-    import re
-    import zlib
+    "-": read from the PDF's ToUnicode maps (pdf_text: zlib, not the library)."""
+    from pdf_text import pdf_codepoints
     cli("pca", store_path, "--name", "faces")
     cli("variation", store_path, "--pca", "faces", "--pcs", "1", "-o", tmp_path / "v.pdf")
-    data = (tmp_path / "v.pdf").read_bytes()
-    maps = b""
-    for m in re.finditer(rb"stream\r?\n(.*?)\r?\nendstream", data, re.S):
-        try:
-            text = zlib.decompress(m.group(1))
-        except zlib.error:
-            continue
-        if b"beginbfchar" in text:
-            maps += text
-    codes = set(re.findall(rb"<[0-9a-f]+> <([0-9a-f]{4})>", maps))
-    assert b"00b1" in codes and b"2212" in codes
+    codes = pdf_codepoints(tmp_path / "v.pdf")
+    assert "\u00b1" in codes and "\u2212" in codes

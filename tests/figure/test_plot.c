@@ -379,6 +379,68 @@ static void test_heatmap(es_ctx *ctx)
     ES_CHECK_FAILS(ctx, es_plot_heatmap(ctx, &s, png, NULL), ES_EINVAL, "matrix");
 }
 
+/* The study's distance heat map puts rows and columns in group order: six
+ * rows of two interleaved groups, distinct distances, and every cell's
+ * pixel checked against the distance of the rows the order says (group,
+ * then id): an independent permutation in the test, not the library's. */
+static void test_compare_heatmap_order(es_ctx *ctx)
+{
+    enum { N = 6 };
+    double d[N * N];
+    const int64_t group[N] = {1, 0, 1, 0, 1, 0};
+    const char *ids[N] = {"f", "e", "d", "c", "b", "a"};
+    const char *gnames[2] = {"angry", "happy"};
+    const int order[N] = {5, 3, 1, 4, 2, 0};   /* group 0 by id a, c, e; group 1 b, d, f */
+    for (int j = 0; j < N; j++)
+        for (int i = 0; i < N; i++)
+            d[i + j * N] = i == j ? 0 : (group[i] != group[j]) + 0.05 * (i + j);
+    es_compare_result r;
+    memset(&r, 0, sizeof r);
+    r.n = N;
+    r.d_len = r.d_proc = d;
+    r.normalized_lengths = 1;
+    es_plot_info info;
+    const char *png = tp_path("plot", "compare_heatmap.png");
+    ES_CHECK_OK(ctx, es_figure_compare_heatmap(ctx, &r, 0, ids, group, gnames, png, &info));
+    double hi = 0;
+    for (int k = 0; k < N * N; k++) hi = fmax(hi, d[k]);
+    tp_image im;
+    ES_CHECK(tp_load(png, &im) == 0);
+    if (im.s) {
+        int ok = 0, block_low = 0;
+        for (int b = 0; b < N; b++)
+            for (int a = 0; a < N; a++) {
+                double px, py, rgb[3], want[3], v = d[order[a] + order[b] * N];
+                es_plot_info_to_device(&info, b + 0.5, N - a - 0.5, &px, &py);
+                es_colormap_rgb(ES_CMAP_VIRIDIS, v / hi, want);
+                tp_rgb(&im, (int)px, (int)py, rgb);
+                ok += tp_dist(rgb, want) < 0.02;
+                block_low += (a < 3) == (b < 3) && v < 1;
+            }
+        ES_CHECK_MSG(ok == N * N, "%d of %d cells have the colour of the grouped order", ok,
+                     N * N);
+        ES_CHECK(block_low == 2 * 9);   /* within-group blocks on the diagonal */
+        tp_free(&im);
+    }
+    /* the same matrix without groups: by id alone (a..f is rows 5..0) */
+    ES_CHECK_OK(ctx, es_figure_compare_heatmap(ctx, &r, 1, ids, NULL, NULL, png, &info));
+    ES_CHECK(tp_load(png, &im) == 0);
+    if (im.s) {
+        double px, py, rgb[3], want[3];
+        es_plot_info_to_device(&info, 1.5, N - 0.5, &px, &py);   /* row a, column b */
+        es_colormap_rgb(ES_CMAP_VIRIDIS, d[5 + 4 * N] / hi, want);
+        tp_rgb(&im, (int)px, (int)py, rgb);
+        ES_CHECK(tp_dist(rgb, want) < 0.02);
+        tp_free(&im);
+    }
+    /* a heat map's groups must be adjacent runs */
+    es_heatmap_spec s;
+    es_heatmap_spec_init(&s);
+    s.values = (es_mat){d, N, N, N};
+    s.row_groups = group;
+    ES_CHECK_FAILS(ctx, es_plot_heatmap(ctx, &s, png, NULL), ES_EINVAL, "not adjacent");
+}
+
 static void test_histogram(es_ctx *ctx)
 {
     enum { N = 500 };
@@ -842,6 +904,7 @@ int main(void)
     test_lines(ctx);
     test_long_lines(ctx);
     test_heatmap(ctx);
+    test_compare_heatmap_order(ctx);
     test_histogram(ctx);
     test_alloc_failures(ctx);
     test_table(ctx);

@@ -283,7 +283,7 @@ static void test_study(es_ctx *ctx)
     const char *gn[2] = {"one", "two"};
     ES_CHECK_OK(ctx, es_study_compare_write(ctx, r, ids, group, gn, dir));
 #if ES_HAVE_FIGURES
-    ES_CHECK_OK(ctx, es_figure_compare_write(ctx, r, ids, group, gn, dir));
+    ES_CHECK_OK(ctx, es_figure_compare_write(ctx, r, ids, group, gn, dir, NULL));
 #endif
     char path[512];
     static const struct { const char *f; int64_t lines; } files[] = {
@@ -303,6 +303,43 @@ static void test_study(es_ctx *ctx)
                    ES_EMISMATCH, "12 edge-length vectors but 11 configurations");
 }
 
+/* rho against R's shapes 1.2.7 (riemdist, Dryden's package):
+ *   x <- rbind(c(0,0,0), c(1,0,0), c(0,1,0), c(0,0,1), c(1,1,1))
+ *   y <- x + 3 * rbind(c(.1,0,0), c(0,.2,0), c(0,0,.1), c(.05,0,0), c(0,0,.3))
+ *   m <- x; m[,1] <- -m[,1]                     # x mirrored
+ *   p <- rbind(c(0,0), c(2,0), c(1,1.5), c(.3,2))
+ *   q <- rbind(c(1,1), c(3,1.2), c(2.1,2), c(1,3.5))
+ *   riemdist(x, y); riemdist(x, m); riemdist(x, m, reflect = TRUE); riemdist(p, q)
+ * (python/tests/test_compare_units.py runs R live on a whole study). */
+static void test_rho_against_r(es_ctx *ctx)
+{
+    static const double x[15] = {0, 1, 0, 0, 1, 0, 0, 1, 0, 1, 0, 0, 0, 1, 1};
+    static const double dy[15] = {.1, 0, 0, .05, 0, 0, .2, 0, 0, 0, 0, 0, .1, 0, .3};
+    double cfg[3 * 15], rho[9];
+    for (int v = 0; v < 15; v++) {
+        cfg[v] = x[v];
+        cfg[15 + v] = x[v] + 3 * dy[v];
+        cfg[30 + v] = v < 5 ? -x[v] : x[v];   /* mirrored in the first coordinate */
+    }
+    es_mat al = {cfg, 15, 3, 15}, r = {rho, 3, 3, 3};
+    ES_CHECK_OK(ctx, es_compare_rho(ctx, al, 3, 0, r));
+    ES_CHECK_CLOSE(rho[1 * 3 + 0], 0.290002254625452, 1e-12, 0);
+    ES_CHECK_CLOSE(rho[2 * 3 + 0], 1.11024233511357, 1e-12, 0);
+    ES_CHECK(rho[0] == 0 && rho[3 + 0] == rho[1]);
+    ES_CHECK_OK(ctx, es_compare_rho(ctx, al, 3, 1, r));
+    ES_CHECK(fabs(rho[2 * 3 + 0]) < 1e-6);   /* R: 2.1e-08 */
+    static const double pq[16] = {0, 2, 1, .3, 0, 0, 1.5, 2, 1, 3, 2.1, 1, 1, 1.2, 2, 3.5};
+    ES_CHECK_OK(ctx, es_compare_rho(ctx, (es_mat){(double *)pq, 8, 2, 8}, 2, 0,
+                                    (es_mat){rho, 2, 2, 2}));
+    ES_CHECK_CLOSE(rho[2], 0.305578949731456, 1e-12, 0);
+    /* invariant to scale: the same pair, one of them 7 times larger */
+    double big[16];
+    for (int v = 0; v < 16; v++) big[v] = v < 8 ? pq[v] : 7 * pq[v];
+    ES_CHECK_OK(ctx, es_compare_rho(ctx, (es_mat){big, 8, 2, 8}, 2, 0, (es_mat){rho, 2, 2, 2}));
+    ES_CHECK_CLOSE(rho[2], 0.305578949731456, 1e-12, 0);
+    ES_CHECK_FAILS(ctx, es_compare_rho(ctx, al, 4, 0, r), ES_EINVAL, "dimensions");
+}
+
 int main(void)
 {
     es_ctx *ctx = NULL;
@@ -313,6 +350,7 @@ int main(void)
     test_nn_disagreement(ctx);
     test_groups(ctx);
     test_study(ctx);
+    test_rho_against_r(ctx);
     es_ctx_free(ctx);
     ES_TEST_END();
 }

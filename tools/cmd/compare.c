@@ -4,6 +4,7 @@
 #include "commands.h"
 
 #include <getopt.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,7 +18,8 @@ static const char usage[] =
     "the pairs the spaces disagree on most, and with --by the distances between\n"
     "group means in both spaces with permutation p-values and an F test.\n"
     "Results go to /analysis/compare/NAME in the store; -o DIR writes CSV files\n"
-    "and figures (two distance heat maps, a scatter of distance pairs).\n"
+    "and figures (two distance heat maps, rows ordered by --by's groups, and a\n"
+    "scatter of distance pairs).\n"
     "\n"
     "  -g, --gpa NAME          GPA result to use (required)\n"
     "  -b, --by COLUMN         label column defining groups\n"
@@ -25,6 +27,7 @@ static const char usage[] =
     "  -o, --output DIR        write CSV files and figures to DIR\n"
     "      --name NAME         result name (default: the GPA name)\n"
     "      --top N             disagreeing pairs reported (default 20)\n"
+    "      --figures FMT       figure format: svg (default), png or pdf\n"
     "      --no-figures        CSV files only\n"
     "      --seed S            seed of the permutations (default the library's)\n"
     "  -q, --quiet             print nothing on success\n"
@@ -33,18 +36,40 @@ static const char usage[] =
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";
 
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Median of the upper triangle of an n x n matrix (NaN when n < 2 or out
+ * of memory: a figure of the report, not of the study). */
+static double upper_median(int64_t n, const double *d)
+{
+    int64_t m = n * (n - 1) / 2, t = 0;
+    double *v = m > 0 ? malloc((size_t)m * sizeof *v) : NULL, med = NAN;
+    if (!v) return med;
+    for (int64_t j = 1; j < n; j++)
+        for (int64_t i = 0; i < j; i++) v[t++] = d[i + j * n];
+    qsort(v, (size_t)m, sizeof *v, cmp_double);
+    med = m % 2 ? v[m / 2] : 0.5 * (v[m / 2 - 1] + v[m / 2]);
+    free(v);
+    return med;
+}
+
 int cmd_compare(int argc, char **argv)
 {
-    enum { O_NAME = 256, O_TOP, O_NOFIG, O_SEED };
+    enum { O_NAME = 256, O_TOP, O_NOFIG, O_SEED, O_FIGFMT };
     static const struct option longopts[] = {
         {"gpa", required_argument, NULL, 'g'},     {"by", required_argument, NULL, 'b'},
         {"permutations", required_argument, NULL, 'p'},
         {"output", required_argument, NULL, 'o'},  {"name", required_argument, NULL, O_NAME},
         {"top", required_argument, NULL, O_TOP},   {"no-figures", no_argument, NULL, O_NOFIG},
+        {"figures", required_argument, NULL, O_FIGFMT},
         {"seed", required_argument, NULL, O_SEED}, {"quiet", no_argument, NULL, 'q'},
         {"replace", no_argument, NULL, 'R'}, {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
-    const char *gpa = NULL, *by = NULL, *out = NULL, *name = NULL;
+    const char *gpa = NULL, *by = NULL, *out = NULL, *name = NULL, *format = "svg";
     es_compare_opts o;
     es_store_mode wmode = ES_STORE_WRITE;   /* --replace: ES_STORE_REPLACE */
     int c, quiet = 0, figures = 1, have_seed = 0;
@@ -68,6 +93,11 @@ int cmd_compare(int argc, char **argv)
                 return cli_usage_error("compare", "bad --top '%s'", optarg);
             break;
         case O_NOFIG: figures = 0; break;
+        case O_FIGFMT:
+            if (strcmp(optarg, "svg") && strcmp(optarg, "png") && strcmp(optarg, "pdf"))
+                return cli_usage_error("compare", "bad --figures '%s' (svg, png or pdf)", optarg);
+            format = optarg;
+            break;
         case O_SEED:
             if (cli_parse_i64(optarg, &seed)) return cli_usage_error("compare", "bad --seed '%s'", optarg);
             have_seed = 1;
@@ -89,10 +119,11 @@ int cmd_compare(int argc, char **argv)
     es_status rc = es_store_open(ctx, argv[optind], wmode, &s);
 #if ES_HAVE_FIGURES
     if (rc == ES_OK && figures)
-        rc = es_figure_compare(ctx, s, gpa, by, &o, name, out, cmd, &r);
+        rc = es_figure_compare(ctx, s, gpa, by, &o, name, out, cmd, format, &r);
     else
 #else
     (void)figures;   /* a build without figures writes the tables only */
+    (void)format;
 #endif
     if (rc == ES_OK)
         rc = es_study_compare(ctx, s, gpa, by, &o, name, out, cmd, &r);
@@ -110,6 +141,10 @@ int cmd_compare(int argc, char **argv)
                 printf("groups by '%s': edge lengths F %.4g (p %.4g, R2 %.3f); Procrustes F "
                        "%.4g (p %.4g, R2 %.3f)\n", by, r->groups_len.f, r->groups_len.p,
                        r->groups_len.r2, r->groups_proc.f, r->groups_proc.p, r->groups_proc.r2);
+            if (r->d_rho)   /* the data-unit figures beside Kendall's rho (unit size) */
+                printf("Procrustes distances: median %.4g data units, median rho %.4g rad "
+                       "(Riemannian, unit centroid size)\n", upper_median(r->n, r->d_proc),
+                       upper_median(r->n, r->d_rho));
             if (out) printf("outputs in %s\n", out);
         }
         es_store_close(s);

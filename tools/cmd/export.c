@@ -23,7 +23,8 @@ static const char usage[] =
     "  -l, --lengths CSV     write normalized edge lengths (rows sum to 1)\n"
     "      --raw             with --lengths: write scale x length instead\n"
     "  -M, --meshes DIR      write meshes into DIR (created if absent)\n"
-    "  -f, --format FMT      mesh format: obj (default), ply, ply-ascii, off\n"
+    "  -f, --format FMT      mesh format: obj (default), ply, ply-ascii, off; stl,\n"
+    "                        glb (float32, for viewers and printers)\n"
     "  -w, --where FILTER    only rows matching col=value[,col=value...]\n"
     "                        (--where FILTER, as in the other commands)\n"
     "                        (quote a value holding ',': col=\"a,b\")\n"
@@ -118,7 +119,10 @@ int cmd_export(int argc, char **argv)
             else if (!strcmp(optarg, "ply")) fmt = ES_FORMAT_PLY;
             else if (!strcmp(optarg, "ply-ascii")) fmt = ES_FORMAT_PLY_ASCII;
             else if (!strcmp(optarg, "off")) fmt = ES_FORMAT_OFF;
-            else return cli_usage_error("export", "unknown format '%s'", optarg);
+            else if (!strcmp(optarg, "stl")) fmt = ES_FORMAT_STL;
+            else if (!strcmp(optarg, "glb")) fmt = ES_FORMAT_GLB;
+            else return cli_usage_error("export", "unknown format '%s' (obj, ply, ply-ascii, "
+                                        "off, stl, glb)", optarg);
             break;
         case 'S': statismo = optarg; break;
         case 'P': so.pca_name = optarg; break;

@@ -101,6 +101,17 @@ int cmd_gpa(int argc, char **argv)
                    rep.rmsrho, rep.gss);
             double *pct = NULL;
             int64_t np = 0;
+            /* centroid size: the data-unit scale; rho: unit-size shape distance */
+            double *cs = NULL;
+            int64_t ncs = 0;
+            snprintf(path, sizeof path, "gpa/%s/size", name);
+            if (es_store_get_vector(ctx, s, path, &cs, &ncs) == ES_OK && ncs > 0) {
+                double sum = 0;
+                for (int64_t i = 0; i < ncs; i++) sum += cs[i];
+                printf("mean centroid size %.6g (data units); rho to the mean: rms %.6g rad\n",
+                       sum / (double)ncs, rep.rmsrho);
+            }
+            es_free(ctx, cs);
             snprintf(path, sizeof path, "gpa/%s/pc_percent", name);
             if (es_store_get_vector(ctx, s, path, &pct, &np) == ES_OK) {
                 printf("PC variance (%%):");

@@ -76,9 +76,12 @@ int cmd_mean(int argc, char **argv)
         goto done;
     }
     FILE *out = cli_report_stream(csv);   /* "-o -": stdout is the CSV alone */
-    fprintf(out, "%-20s %8s %14s\n", by ? by : "group", "rows", "mean scale");
+    /* the scale is the sum of edge lengths; centroid size is what GPA users know */
+    fprintf(out, "%-20s %8s %14s %14s\n", by ? by : "group", "rows", "mean scale",
+            "centroid size");
     for (int64_t g = 0; g < r->ngroups; g++)
-        fprintf(out, "%-20s %8lld %14.6g\n", r->names[g], (long long)r->counts[g], r->scales[g]);
+        fprintf(out, "%-20s %8lld %14.6g %14.6g\n", r->names[g], (long long)r->counts[g],
+                r->scales[g], r->centroid_sizes[g]);
     /* the table first: a failure leaves the store as it was */
     if ((csv && (rc = es_study_write_mean_table(ctx, st, r, csv)) != ES_OK) ||
         (rc = es_store_commit(ctx, st)) != ES_OK) {

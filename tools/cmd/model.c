@@ -56,7 +56,8 @@ static const char usage[] =
     "  -o, --output PATH      write the ANOVA table as CSV (- for stdout); with\n"
     "                         --pairwise the pairwise table goes to PATH's stem +\n"
     "                         .pairwise.csv (after a blank line for -)\n"
-    "      --figure PATH      with --edges: -log10 q of every edge on the mean mesh\n"
+    "      --figure PATH      with --edges: the F of every edge with q < 0.05 on the\n"
+    "                         mean mesh (log colour scale), the others grey\n"
     "  -h, --help             show this help\n"
     "\n"
     "Exit status: 0 ok, 1 failure, 2 usage error.\n";

@@ -8,6 +8,7 @@
 #include <getopt.h>
 #include <stdio.h>
 #include <string.h>
+#include <strings.h>
 
 #define VERB "render"
 
@@ -20,9 +21,13 @@ const char *__lsan_default_suppressions(void) { return "leak:libfontconfig.so\n"
 
 static void usage(FILE *f)
 {
-    fputs("usage: edgespace render MESH... -o OUT.png|.svg|.pdf [options]\n\n"
+    fputs("usage: edgespace render MESH... -o OUT.png|.svg|.pdf [options]\n"
+          "       edgespace render MESH --scalars CSV -o OUT.ply|.glb|.vtp [options]\n\n"
           "Draw meshes (OBJ, PLY, OFF) side by side, each seen along its smallest\n"
-          "principal axis unless --view is given; one colour bar when scalars are.\n\n"
+          "principal axis unless --view is given; one colour bar when scalars are.\n"
+          "With a .ply, .glb or .vtp output, write the mesh itself with the same\n"
+          "vertex colours (--cmap, --range, --percentiles, --column) for MeshLab,\n"
+          "Blender or ParaView; the VTP also holds the values.\n\n"
           "options:\n"
           "  -o, --output PATH      output file; the extension picks the format\n"
           "      --view X,Y,Z       direction the camera looks along\n"
@@ -177,8 +182,20 @@ int cmd_render(int argc, char **argv)
     const char *lab[MAX_MESHES] = {NULL};   /* NULL: the file name (several meshes) */
     for (int i = 0; i < nlabels; i++) lab[i] = labels[i];
     es_render_report rep;
-    es_status st = es_figure_render_files(ctx, &spec, nm, (const char *const *)argv + optind,
-                                          nscalar_files, scalar_files, lab, out, &rep);
+    /* a mesh file out: the same colours on the mesh itself, for other viewers */
+    const char *dot = strrchr(out, '.');
+    int mesh_out = dot && (!strcasecmp(dot, ".ply") || !strcasecmp(dot, ".glb") ||
+                           !strcasecmp(dot, ".vtp"));
+    if (mesh_out && (nm != 1 || nscalar_files != 1)) {
+        es_ctx_free(ctx);
+        return cli_usage_error(VERB, "a coloured mesh (%s) takes one mesh and one --scalars",
+                               dot);
+    }
+    es_status st = mesh_out ? es_figure_color_file(ctx, &spec, argv[optind], scalar_files[0], out,
+                                                   &rep)
+                            : es_figure_render_files(ctx, &spec, nm,
+                                                     (const char *const *)argv + optind,
+                                                     nscalar_files, scalar_files, lab, out, &rep);
     if (st != ES_OK) {
         cli_fail(VERB, ctx, st);
         es_ctx_free(ctx);
@@ -187,8 +204,10 @@ int cmd_render(int argc, char **argv)
     if (rep.n_nan_scalars)
         fprintf(stderr, "edgespace %s: warning: %lld missing or non-finite scalars drawn grey\n",
                 VERB, (long long)rep.n_nan_scalars);
-    printf("%s: %d x %d, view %.4g,%.4g,%.4g up %.4g,%.4g,%.4g", out, rep.width, rep.height,
-           rep.view[0], rep.view[1], rep.view[2], rep.up[0], rep.up[1], rep.up[2]);
+    if (mesh_out) printf("%s: coloured mesh", out);
+    else
+        printf("%s: %d x %d, view %.4g,%.4g,%.4g up %.4g,%.4g,%.4g", out, rep.width, rep.height,
+               rep.view[0], rep.view[1], rep.view[2], rep.up[0], rep.up[1], rep.up[2]);
     if (nscalar_files) printf(", colour range %.4g..%.4g", rep.vmin, rep.vmax);
     printf("\n");
     es_ctx_free(ctx);

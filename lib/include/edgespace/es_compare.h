@@ -36,6 +36,17 @@ extern "C" {
  * column with zero or non-finite sum when normalizing. */
 ES_API es_status es_compare_distances(es_ctx *ctx, es_mat x, int normalize, es_mat dist);
 
+/* Kendall's Riemannian shape distance rho (radians, in [0, pi/2]; the
+ * distance of configurations centred and scaled to unit centroid size,
+ * as R's shapes::riemdist) between every pair of columns of aligned (k*d x
+ * n, each column a k x d configuration: x-block, y-block[, z-block]) into
+ * rho (n x n, ld >= n). allow_reflection: reflections count as the same
+ * shape (riemdist(reflect = TRUE)). Invariant to the columns' placement,
+ * rotation and scale, so any alignment gives the same rho. ES_EINVAL for d
+ * not 2 or 3, rows not a multiple of d, or a configuration of zero size. */
+ES_API es_status es_compare_rho(es_ctx *ctx, es_mat aligned, int d, int allow_reflection,
+                                es_mat rho);
+
 /* Spearman correlation of the upper triangles of d1 and d2 (n x n each,
  * ld = n) with a Mantel permutation test. permutations = 0 skips the test
  * (*p = NaN). Ties get average ranks. */
@@ -98,6 +109,10 @@ typedef struct es_compare_result {
     double *mean_len, *mean_proc;  /* ngroups x ngroups distances of group means */
     double *p_len, *p_proc;        /* their permutation p-values */
     es_group_stats groups_len, groups_proc;
+    int normalized_lengths;        /* d_len is between unit-sum length vectors (opts) */
+    /* n x n Riemannian distances rho (es_compare_rho) when the study knows
+     * the configurations' dimension (es_study_compare), else NULL */
+    double *d_rho;
     /* Filled by the study on a store (es_study_compare), NULL otherwise: the
      * row ids (n), each row's group (n) and the group names (ngroups). */
     char **ids;

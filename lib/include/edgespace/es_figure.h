@@ -21,20 +21,36 @@
 extern "C" {
 #endif
 
-/* The comparison study's figures in dir (made if missing): heatmap_lengths.svg,
- * heatmap_procrustes.svg (the two distance matrices) and pairs_scatter.svg
- * (distance pairs, coloured by group pair when group is given). ids: n names
- * (NULL: 1-based numbers); group_names: ngroups names (NULL: numbers). */
+/* The comparison study's figures in dir (made if missing), format "png",
+ * "pdf" or "svg" (NULL: svg) as the files' extension: heatmap_lengths,
+ * heatmap_procrustes (the two distance matrices, es_figure_compare_heatmap)
+ * and pairs_scatter (distance pairs, coloured by group pair when group is
+ * given). ids: n names (NULL: 1-based numbers); group_names: ngroups names
+ * (NULL: numbers). */
 ES_API es_status es_figure_compare_write(es_ctx *ctx, const es_compare_result *res,
                                          const char *const *ids, const int64_t *group,
-                                         const char *const *group_names, const char *dir);
+                                         const char *const *group_names, const char *dir,
+                                         const char *format);
 
-/* es_study_compare (es_study.h) and, with out_dir, its figures beside its
- * tables. */
+/* One distance matrix of the study (which 0: edge lengths, 1: Procrustes)
+ * as a heat map at path (format by extension): rows and columns ordered by
+ * group (group may be NULL), then by id, then by row; white lines between
+ * groups and their names beside them; ids as row and column labels up to
+ * 60 rows (group names only above that); the colour bar names the distance
+ * and its units (between unit-sum length vectors when the study normalized
+ * the lengths; data units of the GPA-aligned configurations). info (may be
+ * NULL) receives es_plot_heatmap's plot area. */
+ES_API es_status es_figure_compare_heatmap(es_ctx *ctx, const es_compare_result *res, int which,
+                                           const char *const *ids, const int64_t *group,
+                                           const char *const *group_names, const char *path,
+                                           es_plot_info *info);
+
+/* es_study_compare (es_study.h) and, with out_dir, its figures (in format,
+ * as es_figure_compare_write) beside its tables. */
 ES_API es_status es_figure_compare(es_ctx *ctx, es_store *store, const char *gpa_name,
                                    const char *by, const es_compare_opts *opts,
                                    const char *name, const char *out_dir, const char *command,
-                                   es_compare_result **res);
+                                   const char *format, es_compare_result **res);
 
 /* ---- a figure of a CSV table (edgespace plot) -------------------------------
  *
@@ -141,13 +157,29 @@ ES_API es_status es_figure_render_files(es_ctx *ctx, const es_render_spec *spec,
                                         const char *const *labels, const char *out_path,
                                         es_render_report *rep);
 
+/* One mesh file coloured by one scalar file, as es_figure_render_files
+ * would draw it (spec: cmap, vmin/vmax, range_percentiles, scalar_column;
+ * the rest ignored), written to out_path by its extension: .ply (binary,
+ * vertex colours), .glb (COLOR_0) or .vtp (VTK XML PolyData for ParaView:
+ * the values per point, per cell too for face values, and the colours as
+ * UInt8 "colors"). Face and edge values colour each vertex by the mean of
+ * the finite values around it, on the colour range of the values given (the
+ * one es_figure_render_files' colour bar shows); NaN is ES_NAN_GREY. rep (may be NULL) gets
+ * the colour range and the non-finite count. Errors: those of
+ * es_figure_render_files; ES_EINVAL for another extension. */
+ES_API es_status es_figure_color_file(es_ctx *ctx, const es_render_spec *spec,
+                                      const char *mesh_path, const char *scalar_path,
+                                      const char *out_path, es_render_report *rep);
+
 /* ---- models and shape variation ---------------------------------------------- */
 
 /* The per-edge tests of a model (es_study_model with opts.edge_term) drawn
  * on the mean mesh of its rows (the Procrustes mean of their positions, in
- * the store's frame): each edge coloured by -log10 of its FDR q-value
- * (faces show the mean of their three edges), the number of edges with
- * q < 0.05 in the title. ES_EINVAL when r has no per-edge tests. */
+ * the store's frame): each edge with FDR q < 0.05 coloured by its F on a
+ * log scale (colour bar "per-edge F (log)", range the 2nd to 98th
+ * percentile of the coloured edges), the others grey (ES_NAN_GREY); faces
+ * show the mean of their three edges (grey when one of them is). The number
+ * of edges with q < 0.05 is in the title. ES_EINVAL when r has no per-edge tests. */
 ES_API es_status es_figure_edge_tests(es_ctx *ctx, es_store *store,
                                       const es_study_model_result *r, const char *out_path);
 

@@ -29,7 +29,10 @@ typedef enum es_mesh_format {
     ES_FORMAT_OBJ,
     ES_FORMAT_PLY,      /* writer: binary little endian */
     ES_FORMAT_PLY_ASCII,
-    ES_FORMAT_OFF
+    ES_FORMAT_OFF,
+    ES_FORMAT_STL,      /* written only: binary, float32, facet normals */
+    ES_FORMAT_GLB       /* written only: glTF 2.0 binary, float32 positions, uint32
+                         * indices, vertex colours as COLOR_0 */
 } es_mesh_format;
 
 typedef struct es_meshdata {
@@ -60,11 +63,12 @@ ES_API es_status es_mesh_read_positions(es_ctx *ctx, const es_mesh *mesh, const 
                                         double *xyz);
 
 /* Write positions xyz (3 x V) with mesh's faces. Format from the extension
- * when ES_FORMAT_AUTO (.obj, .ply = binary little endian, .off).
+ * when ES_FORMAT_AUTO (.obj, .ply = binary little endian, .off, .stl, .glb).
  * xyz: NULL writes the mesh's reference positions (ES_EINVAL if it has none).
- * vertex_rgb: NULL or 3 x V bytes of per-vertex colour (PLY only).
- * Coordinates are written exactly (%.17g, or binary doubles); reading the
- * file back gives the same arrays. ES_EIO names the path and the reason.
+ * vertex_rgb: NULL or 3 x V bytes of per-vertex colour (PLY and GLB).
+ * OBJ, PLY and OFF coordinates are written exactly (%.17g, or binary
+ * doubles); reading the file back gives the same arrays. STL and GLB hold
+ * float32 for viewers and printers and are not read back. ES_EIO names the path and the reason.
  * The file is written beside the target (PATH.PID.part) and renamed over
  * it when complete: a failed write leaves an existing file as it was; the
  * old file's permissions are kept and a symlink is written through. */

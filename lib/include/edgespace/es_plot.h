@@ -149,12 +149,21 @@ typedef struct es_heatmap_spec {
     /* Colour range; vmin == vmax (the default 0, 0): the finite data range,
      * symmetric about 0 for ES_CMAP_RDBU. */
     double vmin, vmax;
-    const char *colorbar_label; /* NULL: none */
+    const char *colorbar_label; /* NULL: none; say the quantity and its units */
+    /* Groups of adjacent rows and of adjacent columns, or NULL: row_groups[i]
+     * is row i's index into group_names, the same along each run of adjacent
+     * rows (sort the matrix by group first). A white line separates the runs
+     * and each run's name stands beside it: left of the row labels, above
+     * the columns (where it fits). */
+    const int64_t *row_groups, *col_groups;
+    const char *const *group_names; /* NULL: the 1-based group numbers */
 } es_heatmap_spec;
 
 ES_API void es_heatmap_spec_init(es_heatmap_spec *spec);
-/* Cells with NaN are drawn ES_NAN_GREY and counted in n_skipped. In the
- * info, xmin..xmax is 0..cols and ymin..ymax is 0..rows (row 0 on top). */
+/* Cells are vector rectangles (sharp at any zoom in SVG and PDF) up to
+ * 512 x 512 cells, one nearest-neighbour image above that. Cells with NaN
+ * are drawn ES_NAN_GREY and counted in n_skipped. In the info, xmin..xmax
+ * is 0..cols and ymin..ymax is 0..rows (row 0 on top). */
 ES_API es_status es_plot_heatmap(es_ctx *ctx, const es_heatmap_spec *spec, const char *path,
                                  es_plot_info *info);
 

@@ -100,6 +100,10 @@ typedef struct es_render_spec {
     double vmin, vmax;
     int colorbar;              /* draw a colour bar when there are scalars (1) */
     const char *colorbar_label;
+    /* The scalars are log10 of a quantity: the colour bar's ticks sit at 1,
+     * 2 and 5 times powers of ten of the quantity, labelled with it (0). */
+    int colorbar_log10;
+    const char *nan_label;     /* key of the grey of non-finite scalars (NULL: "n/a") */
     const char *title;         /* above the row, or NULL */
     double base_rgb[3];        /* surface colour without scalars (light grey-beige) */
     double background_rgb[3];  /* (1, 1, 1) */

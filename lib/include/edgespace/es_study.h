@@ -52,7 +52,9 @@ typedef struct es_group_result {
     char **names;       /* ngroups group names ("all" without a grouping column) */
     double *means;      /* E x ngroups, column g */
     int64_t *counts;    /* rows per group */
-    double *scales;     /* mean scale per group */
+    double *scales;     /* mean scale per group (sum of raw edge lengths) */
+    double *centroid_sizes; /* mean centroid size per group (shapes::centroid.size of the
+                               positions as ingested) */
 } es_group_result;
 ES_API void es_group_result_free(es_group_result *r);
 
