@@ -17,7 +17,9 @@
  * "~ expression + subject" with permutations within subject
  * (es_study_model: residual randomization, type I sums of squares) on the
  * normalized edge lengths and on the GPA's aligned coordinates, pairwise
- * distances between the expressions' least-squares means. Apes: a truss
+ * distances between the expressions' least-squares means, and per-edge
+ * tests of expression (F, permutation p, FDR q) drawn on the mean face
+ * (expression_edges.png, es_figure_edge_tests). Apes: a truss
  * store of all landmark pairs (es_landmarks_to_store_edges) -> GPA -> the
  * model "~ log(size) + group" in both spaces (size: the sum of the truss
  * lengths, or the centroid size), with its common allometric component;
@@ -145,8 +147,37 @@ static int gpa_of(notebook *nb, es_store *st)
 
 /* ---- the face study ------------------------------------------------------------ */
 
+/* Where on the face expression acts: per-edge tests of ~ expression +
+ * subject (F, permutation p, FDR q) drawn on the mean face
+ * (es_figure_edge_tests); *nsig: edges with q < 0.05. */
+static int edge_figure(notebook *nb, es_store *st, int64_t perms, int64_t *nsig)
+{
+    es_study_model_opts o;
+    es_study_model_result *r = NULL;
+    es_status rc;
+    es_study_model_opts_init(&o);
+    o.formula = "~ expression + subject";
+    o.block = "subject";
+    o.permutations = perms;
+    o.edge_term = "expression";
+    o.command = "notebooks-c/06_models";
+    nb_step(nb, "faces: per-edge tests and their figure");
+    if ((rc = es_study_model(nb->ctx, st, &o, &r)) != ES_OK)
+        return nb_fail(nb, rc, "per-edge tests");
+    *nsig = 0;
+    for (int64_t e = 0; e < r->ntests; e++) *nsig += r->edge_q[e] < 0.05;
+    rc = es_figure_edge_tests(nb->ctx, st, r, nb_path(nb, "expression_edges.png"));
+    es_study_model_free(r);
+    if (rc != ES_OK) return nb_fail(nb, rc, "per-edge figure");
+    nb_image(nb, "expression_edges.png", "Per-edge F of expression (subject as block) on the "
+             "mean face: edges with FDR q < 0.05 coloured on a log scale, the others grey");
+    nb_p(nb, "%lld of the edges change with expression at FDR q < 0.05 (%lld permutations "
+         "within subject).", (long long)*nsig, (long long)perms);
+    return 0;
+}
+
 static int faces(notebook *nb, int64_t perms, FILE *csv, double *p_len, double *p_proc,
-                 double *r2_len, double *r2_proc)
+                 double *r2_len, double *r2_proc, int64_t *n_edges_sig)
 {
     char store_path[4400], dir[4400];
     const char *manifest, *source = nb_dataset(nb, "face-study");
@@ -212,7 +243,8 @@ static int faces(notebook *nb, int64_t perms, FILE *csv, double *p_len, double *
                     nb_row(nb, "%s - %s|%.4g|%.4f", pw->levels[a], pw->levels[b],
                            pw->dist[a + b * pw->nlevels], pw->pval[a + b * pw->nlevels]);
         }
-        if ((rc = es_store_commit(nb->ctx, st)) != ES_OK) bad = nb_fail(nb, rc, "commit");
+        if (!bad) bad = edge_figure(nb, st, perms, n_edges_sig);
+        if (!bad && (rc = es_store_commit(nb->ctx, st)) != ES_OK) bad = nb_fail(nb, rc, "commit");
     }
     es_study_model_free(rl);
     es_study_model_free(rp);
@@ -287,6 +319,7 @@ int main(int argc, char **argv)
     notebook nb;
     double p_len = NAN, p_proc = NAN, r2_len = NAN, r2_proc = NAN;
     double p_size_proc = NAN, p_size_len = NAN, cac_diff = NAN;
+    int64_t n_edges_sig = -1;
     int rc = nb_open(&nb, "06_models", "Linear models on shape: blocked designs and allometry, "
                      "in both spaces", argc, argv);
     if (rc) return rc;
@@ -298,7 +331,7 @@ int main(int argc, char **argv)
          "significant for the apes in Procrustes space.");
     FILE *csv = nb_csv_open(&nb, "anova.csv", "space,term,df,ss,r2,f,p");   /* + Z in the report */
     if (!csv) return nb_close(&nb);
-    int bad = faces(&nb, perms, csv, &p_len, &p_proc, &r2_len, &r2_proc);
+    int bad = faces(&nb, perms, csv, &p_len, &p_proc, &r2_len, &r2_proc, &n_edges_sig);
     if (!bad) bad = apes(&nb, perms, csv, &p_size_proc, &p_size_len, &cac_diff);
     nb_csv_close(&nb, csv);
     if (!bad) {
@@ -307,6 +340,8 @@ int main(int argc, char **argv)
         nb_check(&nb, "faces: expression p in Procrustes space", p_proc, "<=", 0.05);
         nb_check(&nb, "faces: expression R^2 in edge-length space", r2_len, ">", 0.0);
         nb_check(&nb, "faces: expression R^2 in Procrustes space", r2_proc, ">", 0.0);
+        nb_check(&nb, "faces: edges with FDR q < 0.05 for expression (figure drawn)",
+                 (double)n_edges_sig, ">", 0.0);
         if (!isnan(p_size_proc))
             nb_check(&nb, "apes: log(size) p in Procrustes space", p_size_proc, "<=", 0.05);
         if (!isnan(p_size_proc))
