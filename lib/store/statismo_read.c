@@ -101,16 +101,7 @@ static es_status check_groups(es_ctx *ctx, hid_t file, const char *path)
     static const char *const names[] = {"representer", "model", "version"};
     es__h5_raw *raw = NULL;
     es_status rc = es__h5_raw_open(ctx, file, path, &raw);
-    if (rc == ES_OK) rc = es__h5_check_object(raw, file, "the root group");
-    if (rc == ES_OK) rc = es__h5_check_group(raw, file, "/");
-    for (size_t i = 0; rc == ES_OK && i < sizeof names / sizeof names[0]; i++) {
-        hid_t g;
-        if (H5Lexists(file, names[i], H5P_DEFAULT) <= 0) continue;   /* said later */
-        if ((rc = es__h5_check_named(raw, file, names[i])) != ES_OK) break;
-        if ((g = H5Gopen2(file, names[i], H5P_DEFAULT)) < 0) continue;
-        rc = es__h5_check_group(raw, g, names[i]);
-        H5Gclose(g);
-    }
+    if (rc == ES_OK) rc = es__h5_check_groups(raw, file, names, sizeof names / sizeof names[0]);
     es__h5_raw_close(raw);
     return rc;
 }

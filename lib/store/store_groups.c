@@ -154,3 +154,18 @@ es_status es__h5_check_group(es__h5_raw *raw, hid_t group, const char *name)
     es__free(ctx, t.heapdata);
     return rc;
 }
+
+es_status es__h5_check_groups(es__h5_raw *raw, hid_t file, const char *const *names, size_t n)
+{
+    es_status rc = es__h5_check_object(raw, file, "the root group");
+    if (rc == ES_OK) rc = es__h5_check_group(raw, file, "/");
+    for (size_t i = 0; rc == ES_OK && i < n; i++) {
+        hid_t g;
+        if (H5Lexists(file, names[i], H5P_DEFAULT) <= 0) continue;   /* said later */
+        if ((rc = es__h5_check_named(raw, file, names[i])) != ES_OK) break;
+        if ((g = H5Gopen2(file, names[i], H5P_DEFAULT)) < 0) continue;
+        rc = es__h5_check_group(raw, g, names[i]);
+        H5Gclose(g);
+    }
+    return rc;
+}

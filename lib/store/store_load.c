@@ -332,17 +332,7 @@ static es_status check_shapes(es_store *s, es__h5_raw *raw, int64_t *n)
 static es_status check_groups(es_store *s, es__h5_raw *raw)
 {
     static const char *const names[] = {"/topology", "/shapes", "/labels", "/analysis"};
-    es_status rc = es__h5_check_object(raw, s->file, "the root group");
-    if (rc == ES_OK) rc = es__h5_check_group(raw, s->file, "/");
-    for (size_t i = 0; rc == ES_OK && i < sizeof names / sizeof names[0]; i++) {
-        hid_t g;
-        if (H5Lexists(s->file, names[i], H5P_DEFAULT) <= 0) continue;   /* said later */
-        if ((rc = es__h5_check_named(raw, s->file, names[i]))) break;
-        if ((g = H5Gopen2(s->file, names[i], H5P_DEFAULT)) < 0) continue;
-        rc = es__h5_check_group(raw, g, names[i]);
-        H5Gclose(g);
-    }
-    return rc;
+    return es__h5_check_groups(raw, s->file, names, sizeof names / sizeof names[0]);
 }
 
 es_status es__store_load(es_store *s)

@@ -182,6 +182,12 @@ es_status es__h5_object_addr(es_ctx *ctx, hid_t obj, uint64_t *addr);
  * runs out (24 GB for three changed bytes) and B-tree children without
  * bound. A group with links in its header (new style) has nothing to check. */
 es_status es__h5_check_group(es__h5_raw *raw, hid_t group, const char *name);
+/* The root group's header and symbol table, then each of the n groups
+ * named under it that exists (header first, then its symbol table), before
+ * HDF5 searches, opens or decodes any of them; an absent one is left for
+ * the caller to name. For a store (store_load.c) and a statismo model
+ * (statismo_read.c). */
+es_status es__h5_check_groups(es__h5_raw *raw, hid_t file, const char *const *names, size_t n);
 /* Check every message of an object header before HDF5 decodes any of it
  * (store_headers.c): the header at oaddr, of the open object obj, or of
  * the object `name` under loc (found without decoding its header); name
