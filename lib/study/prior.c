@@ -14,30 +14,29 @@
 #include "edgespace/es_procrustes.h"
 
 #include <math.h>
+#include <sys/mman.h>
 
 struct es_study_rows {
     es_ctx *ctx;
     int64_t n, nv, ne;
     double *aligned;        /* 3V x n: row i's positions in the frame */
     double *alpha;          /* E x n: row i's dihedrals */
-    double *trig;           /* 2 E x n: their cosines, then their sines (each row's made
-                               when a prior first uses it: a one-point command pays for
-                               the rows its point draws on, a session once) */
-    uint8_t *have_trig;     /* n */
-    const double **pa, **pd, **pc, **ps;   /* column pointers for es_embed_prior_from_rows */
+    const double **pa, **pd;   /* column pointers for es_embed_prior_from_rows */
+    void *map;              /* when aligned and alpha lie in a mapped cache file */
+    size_t map_len;
 };
 
 void es_study_rows_free(es_study_rows *r)
 {
     if (!r) return;
-    es__free(r->ctx, r->aligned);
-    es__free(r->ctx, r->alpha);
-    es__free(r->ctx, r->trig);
-    es__free(r->ctx, r->have_trig);
+    if (r->map) {
+        munmap(r->map, r->map_len);
+    } else {
+        es__free(r->ctx, r->aligned);
+        es__free(r->ctx, r->alpha);
+    }
     es__free(r->ctx, (void *)r->pa);
     es__free(r->ctx, (void *)r->pd);
-    es__free(r->ctx, (void *)r->pc);
-    es__free(r->ctx, (void *)r->ps);
     es__free(r->ctx, r);
 }
 
@@ -88,28 +87,35 @@ done:
 
 es_status es__study_rows_check_memory(es_ctx *ctx, const es_mesh *mesh, int64_t n)
 {
-    /* each row's aligned positions and dihedrals, and the cosines and sines
-     * of its dihedrals once a prior uses it (make_trig) */
+    /* each row's aligned positions and dihedrals */
     char what[64];
-    uint64_t per = 8 * (3 * (uint64_t)es_mesh_nverts(mesh) + 3 * (uint64_t)es_mesh_nedges(mesh));
+    uint64_t per = 8 * (3 * (uint64_t)es_mesh_nverts(mesh) + (uint64_t)es_mesh_nedges(mesh));
     uint64_t bytes;
     if (__builtin_mul_overflow((uint64_t)n, per, &bytes)) bytes = UINT64_MAX;
     snprintf(what, sizeof what, " for the prior's %llu rows", (unsigned long long)n);
     return es_embed_check_memory(ctx, mesh, bytes, what);
 }
 
-es_status es__study_rows_new(es_ctx *ctx, int64_t n, int64_t nv, int64_t ne, es_study_rows **out,
-                             double **aligned, double **alpha)
+/* The rows' struct and column pointers over arrays aligned and alpha,
+ * owned by the rows from here on (freed, or unmapped when map is set). */
+static es_status rows_over(es_ctx *ctx, int64_t n, int64_t nv, int64_t ne, double *aligned,
+                           double *alpha, void *map, size_t map_len, es_study_rows **out)
 {
     es_study_rows *r;
     *out = NULL;
-    if (!(r = es__calloc(ctx, 1, sizeof *r))) return ES_ENOMEM;
+    if (!(r = es__calloc(ctx, 1, sizeof *r))) {
+        if (map) munmap(map, map_len);
+        else es__free(ctx, aligned), es__free(ctx, alpha);
+        return ES_ENOMEM;
+    }
     r->ctx = ctx;
     r->n = n;
     r->nv = nv;
     r->ne = ne;
-    r->aligned = es__alloc_array(ctx, 3 * nv * n, sizeof *r->aligned);
-    r->alpha = es__alloc_array(ctx, ne * n, sizeof *r->alpha);
+    r->aligned = aligned;
+    r->alpha = alpha;
+    r->map = map;
+    r->map_len = map_len;
     r->pa = es__alloc_array(ctx, n, sizeof *r->pa);
     r->pd = es__alloc_array(ctx, n, sizeof *r->pd);
     if (!r->aligned || !r->alpha || !r->pa || !r->pd) {
@@ -120,10 +126,26 @@ es_status es__study_rows_new(es_ctx *ctx, int64_t n, int64_t nv, int64_t ne, es_
         r->pa[j] = r->aligned + 3 * nv * j;
         r->pd[j] = r->alpha + ne * j;
     }
-    *aligned = r->aligned;
-    *alpha = r->alpha;
     *out = r;
     return ES_OK;
+}
+
+es_status es__study_rows_new(es_ctx *ctx, int64_t n, int64_t nv, int64_t ne, es_study_rows **out,
+                             double **aligned, double **alpha)
+{
+    es_status rc = rows_over(ctx, n, nv, ne, es__alloc_array(ctx, 3 * nv * n, sizeof **aligned),
+                             es__alloc_array(ctx, ne * n, sizeof **alpha), NULL, 0, out);
+    if (rc != ES_OK) return rc;
+    *aligned = (*out)->aligned;
+    *alpha = (*out)->alpha;
+    return ES_OK;
+}
+
+es_status es__study_rows_mapped(es_ctx *ctx, int64_t n, int64_t nv, int64_t ne, void *map,
+                                size_t map_len, double *aligned, double *alpha,
+                                es_study_rows **out)
+{
+    return rows_over(ctx, n, nv, ne, aligned, alpha, map, map_len, out);
 }
 
 void es__study_rows_arrays(const es_study_rows *r, const double **aligned, const double **alpha)
@@ -167,48 +189,9 @@ done:
     return ES_OK;
 }
 
-/* The cosines and sines of the dihedrals of the rows weights w use, each
- * row's once: the prior's circular mean then needs no trigonometry per
- * point (es_embed_prior_from_rows_sc). */
-static es_status make_trig(es_ctx *ctx, es_study_rows *r, const double *w)
-{
-    int64_t ne = r->ne, n = r->n;
-    if (!r->trig) {
-        r->trig = es__alloc_array(ctx, 2 * ne * n, sizeof *r->trig);
-        r->have_trig = es__alloc_array(ctx, n, sizeof *r->have_trig);
-        r->pc = es__alloc_array(ctx, n, sizeof *r->pc);
-        r->ps = es__alloc_array(ctx, n, sizeof *r->ps);
-        if (!r->trig || !r->have_trig || !r->pc || !r->ps) {
-            es__free(ctx, r->trig);
-            r->trig = NULL;
-            return ES_ENOMEM;
-        }
-        for (int64_t j = 0; j < n; j++) {
-            r->pc[j] = r->trig + 2 * ne * j;
-            r->ps[j] = r->trig + 2 * ne * j + ne;
-        }
-    }
-    for (int64_t j = 0; j < n; j++) {
-        if (w[j] == 0 || r->have_trig[j]) continue;
-        double *c = (double *)r->pc[j], *s = (double *)r->ps[j];
-        const double *a = r->alpha + ne * j;
-        for (int64_t e = 0; e < ne; e++) {
-            c[e] = cos(a[e]);
-            s[e] = sin(a[e]);
-        }
-        r->have_trig[j] = 1;
-    }
-    return ES_OK;
-}
-
 es_status es_study_prior(es_ctx *ctx, const es_study_rows *r, const double *w, double *xyz,
                          double *alpha, double *sd)
 {
     if (!r || !w) ES_FAIL(ctx, ES_EINVAL, "prior: no rows or weights");
-    if (alpha || sd) {
-        es_status rc = make_trig(ctx, (es_study_rows *)r, w);   /* a cache inside the rows */
-        if (rc != ES_OK) return rc;
-    }
-    return es_embed_prior_from_rows_sc(ctx, r->nv, r->ne, r->n, r->pa, r->pd, r->pc, r->ps, w,
-                                       xyz, alpha, sd);
+    return es_embed_prior_from_rows(ctx, r->nv, r->ne, r->n, r->pa, r->pd, w, xyz, alpha, sd);
 }
