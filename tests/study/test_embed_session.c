@@ -194,6 +194,20 @@ int main(void)
     embed_all(ctx, s, 1, got, nv);
     ES_CHECK(same(ref, got, 3 * n3) && saw_cache_note > 0);
     ES_CHECK(stat(cache, &st) == 0 && st.st_size == size);   /* written whole again */
+    {   /* longer than its sizes say (the cache is read mapped: its length is checked) */
+        FILE *f = fopen(cache, "ab");
+        ES_CHECK(f && fwrite("trailing", 1, 8, f) == 8 && fclose(f) == 0);
+        saw_cache_note = 0;
+        embed_all(ctx, s, 1, got, nv);
+        ES_CHECK_MSG(same(ref, got, 3 * n3) && strstr(cache_notes, "longer than"), "notes: %s",
+                     cache_notes);
+        ES_CHECK(stat(cache, &st) == 0 && st.st_size == size);
+    }
+    ES_CHECK(truncate(cache, 0) == 0);                    /* empty */
+    saw_cache_note = 0;
+    embed_all(ctx, s, 1, got, nv);
+    ES_CHECK(same(ref, got, 3 * n3) && saw_cache_note > 0);
+    ES_CHECK(stat(cache, &st) == 0 && st.st_size == size);
 
     /* a cache that cannot be written: a folder in its place */
     remove(cache);
