@@ -5,7 +5,9 @@
 #include "commands.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 typedef struct command {
     const char *name;
@@ -59,8 +61,28 @@ static void print_help(FILE *f)
     fputs("\nRun 'edgespace <command> --help' for a command's options.\n", f);
 }
 
+/* OpenBLAS (the pthreads build Debian links) starts its worker threads
+ * when it is loaded and again whenever its thread count is set (the
+ * embedding sets it to 1 around each solve, solve.c), and each worker
+ * spins in sched_yield for 2^28 cycles before it sleeps: in a one-point
+ * command a tenth of a second of CPU on the other core, for nothing
+ * (face-study, `embed --point mean --fast`, quiet machine: 0.50 s CPU,
+ * 0.37 s with the spin cut short; the same wall time). The spin's length
+ * is read from OPENBLAS_THREAD_TIMEOUT (the exponent) only while the
+ * library loads, so a process started without it runs itself again with
+ * 2^4: idle workers then sleep at once and wake on the next threaded call,
+ * so large BLAS work (a PCA) keeps its threads. A user's own setting is
+ * kept; if the exec fails the command simply runs as it is. */
+static void run_with_short_blas_spin(char **argv)
+{
+    if (getenv("OPENBLAS_THREAD_TIMEOUT")) return;
+    if (setenv("OPENBLAS_THREAD_TIMEOUT", "4", 1) != 0) return;
+    execv("/proc/self/exe", argv);
+}
+
 int main(int argc, char **argv)
 {
+    run_with_short_blas_spin(argv);
     if (argc < 2) {
         print_help(stderr);
         return CLI_USAGE;
