@@ -1,7 +1,10 @@
 /* tests/parallel/test_parallel_cli.c — `mpirun -n P edgespace pca STORE`
  * (the -Dmpi=enabled build) stores the result one process stores: the same
  * eigenvalues, components and scores to 1e-12, for the Gram and the
- * randomized route, at P = 2 and 4; the store file itself is untouched
+ * randomized route, at P = 2 and 4; `mpirun -n P edgespace model` the same
+ * ANOVA table (SS and F to 1e-12, p-values and every permuted F the same
+ * bits: permutation b is drawn alike on every rank) with its pairwise
+ * table, and its CSV written once; the store file itself is untouched
  * (results live beside it), a taken name is refused by all ranks with one
  * message, and a command that does not run on ranks yet says so.
  *
@@ -81,6 +84,44 @@ static void same_pca(es_ctx *ctx, const char *a, const char *b)
     es_store_close(s);
 }
 
+/* model/<a> and model/<b> agree: SS, F, Z and coefficients to 1e-12 of
+ * their scale, p-values and the permuted F equal (the oracle is the
+ * one-process run of the same command and seed). */
+static void same_model(es_ctx *ctx, const char *a, const char *b)
+{
+    es_store *s = NULL;
+    ES_CHECK_OK(ctx, es_store_open(ctx, store, ES_STORE_READ, &s));
+    if (!s) return;
+    static const char *const ds[] = {"ss", "f", "z", "p", "coefficients", "f_perm", "lsmeans"};
+    for (int k = 0; k < 7; k++) {
+        char pa[200], pb[200];
+        es_mat ma = {0}, mb = {0};
+        snprintf(pa, sizeof pa, "model/%s/%s", a, ds[k]);
+        snprintf(pb, sizeof pb, "model/%s/%s", b, ds[k]);
+        if (k < 4) {
+            ES_CHECK_OK(ctx, es_store_get_vector(ctx, s, pa, &ma.data, &ma.rows));
+            ES_CHECK_OK(ctx, es_store_get_vector(ctx, s, pb, &mb.data, &mb.rows));
+            ma.cols = mb.cols = 1;
+        } else {
+            ES_CHECK_OK(ctx, es_store_get_matrix(ctx, s, pa, &ma));
+            ES_CHECK_OK(ctx, es_store_get_matrix(ctx, s, pb, &mb));
+        }
+        int64_t n = ma.rows * ma.cols;
+        ES_CHECK_MSG(ma.data && mb.data && ma.rows == mb.rows && ma.cols == mb.cols && n > 0,
+                     "%s vs %s: %s shapes differ", a, b, ds[k]);
+        if (ma.data && mb.data && ma.rows == mb.rows && ma.cols == mb.cols) {
+            /* p and the permuted F: the same permutations, the same sums */
+            double tol = k == 3 ? 0 : k == 5 ? 1e-12 * maxabs(ma.data, n)
+                                             : 1e-12 * maxabs(ma.data, n) + 1e-300;
+            ES_CHECK_MSG(maxdiff(ma.data, mb.data, n) <= tol, "%s vs %s: %s differ by %g", a, b,
+                         ds[k], maxdiff(ma.data, mb.data, n));
+        }
+        es_free(ctx, ma.data);
+        es_free(ctx, mb.data);
+    }
+    es_store_close(s);
+}
+
 int main(int argc, char **argv)
 {
     ES_TEST_BEGIN();
@@ -128,6 +169,30 @@ int main(int argc, char **argv)
         snprintf(args, sizeof args, "pca '%s' --name %s", store, name);
         ES_CHECK_MSG(run_mpi(P, args, err, sizeof err) != 0 && strstr(err, "exists already"),
                      "mpirun -n %d pca again: %s", P, err);
+        char *first = strstr(err, "exists already");
+        ES_CHECK_MSG(first && !strstr(first + 1, "exists already"), "the refusal is not said "
+                     "once: %s", err);
+    }
+    /* model: every rank shares the permutations, rank 0 stores and writes */
+    ES_RUN(&r, dir, "model", store, "~ grp", "--name", "serial", "--seed", "5",
+           "--permutations", "199", "--pairwise", "grp");
+    ES_CHECK_MSG(r.status == 0, "%s", r.err);
+    for (int P = 2; P <= 4; P += 2) {
+        char name[32], csv[900];
+        snprintf(name, sizeof name, "np%d", P);
+        snprintf(csv, sizeof csv, "%s/model_np%d.csv", dir, P);
+        snprintf(args, sizeof args, "model '%s' '~ grp' --name %s --seed 5 --permutations 199 "
+                 "--pairwise grp -o '%s'", store, name, csv);
+        ES_CHECK_MSG(run_mpi(P, args, err, sizeof err) == 0, "mpirun -n %d model: %s", P, err);
+        same_model(ctx, "serial", name);
+        size_t nc = 0;
+        char *text = es_test_slurp(csv, &nc);
+        ES_CHECK_MSG(text && strstr(text, "grp") && strstr(text, "Residual"),
+                     "the CSV of mpirun -n %d model: %s", P, text ? text : "(none)");
+        free(text);
+        /* the name is taken now: refused once, before any permutation */
+        ES_CHECK_MSG(run_mpi(P, args, err, sizeof err) != 0 && strstr(err, "exists already"),
+                     "mpirun -n %d model again: %s", P, err);
         char *first = strstr(err, "exists already");
         ES_CHECK_MSG(first && !strstr(first + 1, "exists already"), "the refusal is not said "
                      "once: %s", err);

@@ -165,11 +165,23 @@ int cmd_model(int argc, char **argv)
     es_store *st = NULL;
     es_study_model_result *r = NULL;
     int ret = CLI_FAIL;
-    es_status rc = es_store_open(ctx, argv[optind], o.name ? wmode : ES_STORE_READ, &st);
+    /* on the ranks of an MPI job every rank reads the shapes and fits, each
+     * evaluating its share of every term's permutations (es_model_fit);
+     * rank 0 alone writes the store and the files. A taken name is refused
+     * before the fit, agreed on by all ranks, so none is left in a sum. */
+    const int writer = es_ctx_rank(ctx) == 0;
+    es_status rc = es_store_open(ctx, argv[optind], o.name && writer ? wmode : ES_STORE_READ, &st);
+    if (rc == ES_OK && o.name && writer) rc = es_store_result_check(ctx, st, "model", o.name);
+    rc = es_ctx_agree(ctx, rc);
+    if (!writer) o.name = NULL;
     if (rc == ES_OK) rc = es_study_model(ctx, st, &o, &r);
-    if (rc == ES_OK) rc = es_store_commit(ctx, st);
+    if (rc == ES_OK && writer) rc = es_store_commit(ctx, st);
     if (rc != ES_OK) {
         cli_fail("model", ctx, rc);
+        goto done;
+    }
+    if (!writer) {   /* the tables and figures are rank 0's to write */
+        ret = CLI_OK;
         goto done;
     }
     char *text = NULL;
