@@ -424,6 +424,15 @@ static void test_auto_view(es_ctx *ctx)
     const char *svg = tp_path("render", "row.svg");
     ES_CHECK_OK(ctx, es_render(ctx, &spec, svg, &rep));
     ES_CHECK(tp_file_has(svg, "<?xml", "<svg") && tp_file_size(svg) > 20000);
+    /* a vector figure holds each panel at supersample x its pixels (3 x 320),
+     * drawn at the panel's size */
+    {
+        size_t nsvg = 0;
+        char *text = es_test_slurp(svg, &nsvg);
+        ES_CHECK(spec.supersample == 3 && text && strstr(text, "width=\"960\"") &&
+                 strstr(text, "matrix(0.333333,0,0,0.333333,320,"));
+        free(text);
+    }
 
     /* a three-quarter view of the face, explicit */
     es_render_mesh one = as_item(&f, "face, 3/4 view");

@@ -14,7 +14,8 @@
  * is exact for interpenetrating and cyclically overlapping triangles,
  * shades per pixel and is O(pixels + triangles) without a sort; the price
  * is that in SVG/PDF output the mesh panels are embedded images (text and
- * colour bar stay vector).
+ * colour bar stay vector), kept at `supersample` times the panel's pixels
+ * so that they stay sharp when zoomed or printed (PNG: box-filtered down).
  *
  * Camera: by default each mesh is seen along its smallest principal axis
  * (PCA of its vertices), centred on its centroid, from the side its faces
