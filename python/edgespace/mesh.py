@@ -13,6 +13,7 @@ import numpy as np
 
 from . import _arrays as A
 from ._context import ctx_of
+from ._names import renamed
 from ._native import ffi, lib
 
 _DIHEDRAL = {"auto": "ES_EMBED_DIHEDRAL_AUTO", "on": "ES_EMBED_DIHEDRAL_ON",
@@ -79,6 +80,10 @@ def study_embedding(xyz, faces, res):
     rep["scale"] = float(res.scale)
     rep["init"] = ffi.string(res.init).decode("utf-8", "replace")
     return Embedding(xyz, faces, rep)
+
+
+# es_mesh_write's formats (es_io.h's es_format), as the CLI's --format names them
+FORMATS = ("auto", "obj", "ply", "ply-ascii", "off", "stl", "glb")
 
 
 class Mesh:
@@ -164,13 +169,18 @@ class Mesh:
                       int(normalize), out, out + 1, out + 2)
         return tuple(out)
 
-    def write(self, path, vertices=None, fmt="auto", colors=None):
+    def write(self, path, vertices=None, format=None, colors=None, fmt=None):
         """Write a mesh file (es_mesh_write: OBJ, PLY, OFF with exact
-        coordinates; STL, GLB in float32 for viewers). colors: (V, 3)
+        coordinates; STL, GLB in float32 for viewers) in `format` (the CLI's
+        --format; default "auto": from the extension; fmt= is the old
+        spelling). colors: (V, 3)
         per-vertex colours, uint8 or floats in [0, 1] (PLY and GLB; see
         edgespace.scalar_colors for values under a colour map)."""
+        fmt = renamed("Mesh.write", "format", format, "fmt", fmt) or "auto"
         V = None if vertices is None else self._positions(vertices)
-        f = getattr(lib, "ES_FORMAT_" + fmt.upper().replace("-", "_"))
+        f = getattr(lib, "ES_FORMAT_" + str(fmt).upper().replace("-", "_"), None)
+        if f is None:
+            raise ValueError(f"Mesh.write: format '{str(fmt)[:16]}': one of {', '.join(FORMATS)}")
         rgb = ffi.NULL
         if colors is not None:
             c = np.asarray(colors)

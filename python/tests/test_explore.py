@@ -232,8 +232,8 @@ def test_saving_writes_a_mesh_and_a_point_and_nothing_else(study, tmp_path):
             with pytest.raises(RequestError, match="a name is"):
                 ex.save(bad, shape)
         with pytest.raises(RequestError, match="format"):
-            ex.save("ok", shape, fmt="stl")
-        out = ex.save("smile_ish", shape, fmt="ply")
+            ex.save("ok", shape, format="stl")
+        out = ex.save("smile_ish", shape, format="ply")
         assert out["path"] == str(tmp_path / "smile_ish.ply")
         with es.Store(store) as s:
             assert np.array_equal(s.mesh.read_positions(out["path"]), shape.V)
@@ -246,9 +246,9 @@ def test_saving_writes_a_mesh_and_a_point_and_nothing_else(study, tmp_path):
         # and its result files)
         digest = stored_digest(store)
         with pytest.raises(RequestError, match="exists"):
-            ex.save("smile_ish", shape, fmt="ply")
+            ex.save("smile_ish", shape, format="ply")
         with pytest.raises(RequestError, match="point/smile_ish"):
-            ex.save("smile_ish", shape, fmt="obj")       # the file is new, the point is not
+            ex.save("smile_ish", shape, format="obj")       # the file is new, the point is not
         assert not (tmp_path / "smile_ish.obj").exists()
         assert stored_digest(store) == digest
         png = ex.save_png("view", b"\x89PNG\r\n\x1a\n")

@@ -73,6 +73,19 @@ def test_export_meshes_format_beside_fmt(store_path, ctx, tmp_path):
     assert all(a.read_bytes() == b.read_bytes() for a, b in zip(new, old))
 
 
+def test_mesh_write_format_beside_fmt(store_path, ctx, tmp_path):
+    with es.Store(store_path, ctx=ctx) as s:
+        m = s.mesh
+        m.write(tmp_path / "new.dat", format="off")
+        one_warning(lambda: m.write(tmp_path / "old.dat", fmt="off"), "format")
+        with pytest.raises(TypeError):
+            m.write(tmp_path / "both.dat", format="off", fmt="off")
+        with pytest.raises(ValueError, match="'xyz'.*obj"):
+            m.write(tmp_path / "bad.dat", format="xyz")
+    assert (tmp_path / "new.dat").read_bytes() == (tmp_path / "old.dat").read_bytes()
+    assert (tmp_path / "new.dat").read_bytes().startswith(b"OFF")
+
+
 def test_explore_module_components_beside_pcs(tmp_path):
     """python -m edgespace.explore takes --components as edgespace explore
     does; --pcs still parses, says its new name, and is checked the same."""

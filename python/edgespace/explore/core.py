@@ -41,6 +41,7 @@ import numpy as np
 
 from .._context import Context
 from .._errors import Error, ExistsError
+from .._names import renamed
 from .._native import has as _has_symbol
 from ..render import auto_view
 from ..store import Store
@@ -435,12 +436,14 @@ class Explorer:
                      time.perf_counter() - t0, row=row_id, cpu_seconds=time.thread_time() - c0)
 
     # -- saving ----------------------------------------------------------------
-    def save(self, name, shape, fmt="ply"):
-        """Write shape's mesh to NAME.FMT in the store's folder and store its
+    def save(self, name, shape, format=None, fmt=None):
+        """Write shape's mesh to NAME.FORMAT (ply by default; fmt= is the old
+        spelling) in the store's folder and store its
         point as /analysis/point/NAME (the store opened for writing only for
         this, and committed). Refused, with nothing written, when the name is
         not a plain file name, the file exists or the store has a point of
         that name; a failed store write removes the mesh it wrote."""
+        fmt = renamed("Explorer.save", "format", format, "fmt", fmt) or "ply"
         if fmt not in MESH_FORMATS:
             raise RequestError(f"format '{str(fmt)[:16]}': one of {', '.join(MESH_FORMATS)}")
         path = self._new_file(name, fmt)
