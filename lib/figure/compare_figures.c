@@ -47,11 +47,13 @@ es_status es_figure_compare_heatmap(es_ctx *ctx, const es_compare_result *r, int
                                     const char *const *gnames, const char *path,
                                     es_plot_info *info)
 {
-    if (!r || (which != 0 && which != 1) || !path)
+    if (!r || which < 0 || which > 2 || !path)
         ES_FAIL(ctx, ES_EINVAL, "compare heatmap: no result, no path or a matrix %d "
-                "that is neither 0 (edge lengths) nor 1 (Procrustes)", which);
+                "that is not 0 (edge lengths), 1 (Procrustes) or 2 (rho)", which);
+    if (which == 2 && !r->d_rho)
+        ES_FAIL(ctx, ES_EINVAL, "compare heatmap: the result has no rho distances");
     const int64_t n = r->n;
-    const double *d = which ? r->d_proc : r->d_len;
+    const double *d = which == 2 ? r->d_rho : which ? r->d_proc : r->d_len;
     order_key *key = es__alloc_array(ctx, n, sizeof *key);
     double *sorted = es__alloc_array(ctx, n * n, sizeof *sorted);
     int64_t *sgroup = es__alloc_array(ctx, n, sizeof *sgroup);
@@ -70,15 +72,17 @@ es_status es_figure_compare_heatmap(es_ctx *ctx, const es_compare_result *r, int
         es_heatmap_spec_init(&h);
         h.frame.width = 720;
         h.frame.height = 660;   /* square cells beside the colour bar */
-        h.frame.title = which ? "Procrustes distances (GPA-aligned)"
-                              : "edge-length distances (scale-normalized)";
+        h.frame.title = which == 2 ? "Riemannian shape distances ρ (unit centroid size)"
+                        : which ? "Procrustes distances (GPA-aligned)"
+                                : "edge-length distances (scale-normalized)";
         h.values = (es_mat){sorted, n, n, n};
         /* ids while they can be read (two per line of text at most); the
          * group names carry a larger matrix */
         h.row_labels = h.col_labels = ids && n <= 60 ? sids : NULL;
         h.row_groups = h.col_groups = group ? sgroup : NULL;
         h.group_names = gnames;
-        h.colorbar_label = which ? "Procrustes distance (data units, GPA-aligned)"
+        h.colorbar_label = which == 2 ? "ρ (radians, as shapes::riemdist)"
+                           : which ? "Procrustes distance (data units, GPA-aligned)"
                            : r->normalized_lengths
                                ? "distance between unit-sum length vectors"
                                : "edge-length distance (data units)";
@@ -112,8 +116,8 @@ es_status es_figure_compare_write(es_ctx *ctx, const es_compare_result *r,
     if ((rc = check_format(ctx, format)) != ES_OK) return rc;
     if ((rc = es__mkdir_p(ctx, dir)) != ES_OK)
         return es__fail(ctx, rc, "compare: %s", es_ctx_errmsg(ctx));
-    const char *files[2] = {"heatmap_lengths", "heatmap_procrustes"};
-    for (int s = 0; s < 2; s++) {
+    const char *files[3] = {"heatmap_lengths", "heatmap_procrustes", "heatmap_rho"};
+    for (int s = 0; s < (r->d_rho ? 3 : 2); s++) {
         snprintf(path, sizeof path, "%s/%s.%s", dir, files[s], format);
         if ((rc = es_figure_compare_heatmap(ctx, r, s, ids, group, gnames, path, NULL)) != ES_OK)
             return rc;

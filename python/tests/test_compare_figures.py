@@ -34,6 +34,11 @@ def test_compare_heatmaps_label_rows_groups_and_units(store_path, tmp_path, cli)
     assert len(runs) == 3 and all(g == sorted(g) for _, g in runs)
     proc = pdf_strings(out / "heatmap_procrustes.pdf")
     assert "Procrustes distance (data units, GPA-aligned)" in proc
+    # rho, the distance geomorph and shapes users read: its own map, labelled
+    rho = pdf_strings(out / "heatmap_rho.pdf")
+    assert "ρ (radians, as shapes::riemdist)" in rho
+    assert "Riemannian shape distances ρ (unit centroid size)" in rho
+    assert sorted(s for s in rho if s in ids) == sorted(ids + ids)
     # PNG by the same option; an unknown format is a usage error naming it
     cli("compare", store_path, "--gpa", "g", "--by", "expression", "-p", "9", "-o", out,
         "--figures", "png", "--replace")

@@ -75,9 +75,9 @@ int main(void)
     ES_CHECK_MSG(r.status == 0 && strstr(r.out, "groups by 'end'"), "%s%s", r.out, r.err);
     static const char *files[] = {"summary.csv", "pairs.csv", "group_means.csv",
                                   "heatmap_lengths.svg", "heatmap_procrustes.svg",
-                                  "pairs_scatter.svg"};
+                                  "heatmap_rho.svg", "pairs_scatter.svg"};
     /* the figures only in a build with figures (cairo) */
-    for (int i = 0; i < (ES_HAVE_FIGURES ? 6 : 3); i++)
+    for (int i = 0; i < (ES_HAVE_FIGURES ? 7 : 3); i++)
         ES_CHECK_MSG(exists(out, files[i]), "%s missing", files[i]);
     ES_RUN(&r, dir, "info", store);
     ES_CHECK(r.status == 0 && strstr(r.out, "compare") && strstr(r.out, "gpa"));

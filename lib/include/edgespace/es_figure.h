@@ -23,7 +23,8 @@ extern "C" {
 
 /* The comparison study's figures in dir (made if missing), format "png",
  * "pdf" or "svg" (NULL: svg) as the files' extension: heatmap_lengths,
- * heatmap_procrustes (the two distance matrices, es_figure_compare_heatmap)
+ * heatmap_procrustes and, when the result has them, heatmap_rho (the
+ * distance matrices, es_figure_compare_heatmap)
  * and pairs_scatter (distance pairs, coloured by group pair when group is
  * given). ids: n names (NULL: 1-based numbers); group_names: ngroups names
  * (NULL: numbers). */
@@ -32,7 +33,8 @@ ES_API es_status es_figure_compare_write(es_ctx *ctx, const es_compare_result *r
                                          const char *const *group_names, const char *dir,
                                          const char *format);
 
-/* One distance matrix of the study (which 0: edge lengths, 1: Procrustes)
+/* One distance matrix of the study (which 0: edge lengths, 1: Procrustes,
+ * 2: Riemannian rho at unit centroid size, ES_EINVAL if the result has none)
  * as a heat map at path (format by extension): rows and columns ordered by
  * group (group may be NULL), then by id, then by row; white lines between
  * groups and their names beside them; ids as row and column labels up to
