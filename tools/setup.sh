@@ -85,18 +85,25 @@ configure_and_build() {
   ninja -C "$build_dir" >&2
 }
 
-# three.js for edgespace explore's page, from the npm registry at the version
-# and checksum python/edgespace/explore/web/package-lock.json pins, into
-# web/node_modules (not committed), which the server serves: the page loads
-# nothing from elsewhere. Skipped when that version is there already.
-install_web() {
-  local web="$here/python/edgespace/explore/web" want have
-  want=$(node -p "require('$web/package-lock.json').packages['node_modules/three'].version")
-  have=$(node -p "try { require('$web/node_modules/three/package.json').version } catch (e) { '' }")
+# JavaScript from the npm registry at the versions and checksums each
+# folder's package-lock.json pins, into its node_modules (not committed):
+# three.js for edgespace explore's page (python/edgespace/explore/web, which
+# the server serves: the page loads nothing from elsewhere) and Khronos'
+# glTF validator, the reader the tests check GLB files with (tests/js).
+# A folder whose pinned versions are there already is skipped.
+install_npm_folder() {
+  local dir=$1 pkg=$2 want have
+  want=$(node -p "require('$dir/package-lock.json').packages['node_modules/$pkg'].version")
+  have=$(node -p "try { require('$dir/node_modules/$pkg/package.json').version } catch (e) { '' }")
   if [ "$want" != "$have" ]; then
-    echo "setup: three.js $want for edgespace explore (npm ci)" >&2
-    (cd "$web" && npm ci --ignore-scripts --no-audit --no-fund --loglevel=error >&2)
+    echo "setup: $pkg $want (npm ci in ${dir#"$here"/})" >&2
+    (cd "$dir" && npm ci --ignore-scripts --no-audit --no-fund --loglevel=error >&2)
   fi
+}
+
+install_web() {
+  install_npm_folder "$here/python/edgespace/explore/web" three
+  install_npm_folder "$here/tests/js" gltf-validator
 }
 
 # python/ on Debian's interpreter's path (idempotent; rewritten when the

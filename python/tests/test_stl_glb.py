@@ -1,10 +1,12 @@
 """STL and GLB files as other tools read them: parsed here with struct and
 json by the formats' specifications (binary STL; Khronos glTF 2.0, "GLB File
 Format Specification"), not by the library, and checked against numpy's
-float32 positions, face normals and the faces; the Khronos gltf_validator
-runs on the GLB when it is installed."""
+float32 positions, face normals and the faces; and every GLB read by
+Khronos' own glTF validator (its npm build, pinned in tests/js and installed
+by tools/setup.sh), which must find no error or warning and count the
+vertices and triangles numpy counts."""
 import json
-import shutil
+import pathlib
 import struct
 import subprocess
 
@@ -12,6 +14,24 @@ import numpy as np
 import pytest
 
 import edgespace as es
+
+
+VALIDATOR = pathlib.Path(__file__).resolve().parents[2] / "tests" / "js" / "validate_gltf.js"
+
+
+def khronos_valid(path, nverts, ntris, attributes):
+    """Khronos' validator's report on path: no errors, no warnings, and its
+    own counts of vertices, triangles and vertex attributes."""
+    assert (VALIDATOR.parent / "node_modules" / "gltf-validator").is_dir(), \
+        "Khronos' glTF validator is missing: tools/setup.sh installs it (npm ci in tests/js)"
+    r = subprocess.run(["node", str(VALIDATOR), str(path)], capture_output=True, text=True)
+    assert r.returncode in (0, 1), r.stderr
+    rep = json.loads(r.stdout)
+    assert rep["issues"]["numErrors"] == 0 and rep["issues"]["numWarnings"] == 0, rep["issues"]
+    info = rep["info"]
+    assert (info["totalVertexCount"], info["totalTriangleCount"]) == (nverts, ntris)
+    assert info["maxAttributes"] == attributes and info["drawCallCount"] == 1
+    return rep
 
 
 @pytest.fixture
@@ -70,11 +90,7 @@ def test_glb_chunks_accessors_and_colours(face, tmp_path, ctx):
     a, col = accessor(prim["attributes"]["COLOR_0"], "u1", 4)
     assert a["normalized"] and a["componentType"] == 5121
     assert np.array_equal(col[:, :3], rgb) and (col[:, 3] == 255).all()
-    validator = shutil.which("gltf_validator")
-    if validator:
-        r = subprocess.run([validator, "-o", str(tmp_path / "f.glb")], capture_output=True,
-                           text=True)
-        assert json.loads(r.stdout)["issues"]["numErrors"] == 0, r.stdout
+    khronos_valid(tmp_path / "f.glb", len(V), len(F), attributes=2)
     # without colours: no COLOR_0, and the BIN chunk holds positions and indices only
     es.Mesh(F, V, ctx=ctx).write(tmp_path / "g.glb")
     data = (tmp_path / "g.glb").read_bytes()
@@ -82,3 +98,9 @@ def test_glb_chunks_accessors_and_colours(face, tmp_path, ctx):
     doc = json.loads(data[20:20 + jlen])
     assert "COLOR_0" not in doc["meshes"][0]["primitives"][0]["attributes"]
     assert doc["buffers"][0]["byteLength"] == 12 * len(V) + 12 * len(F)
+    khronos_valid(tmp_path / "g.glb", len(V), len(F), attributes=1)
+    # the validator is no rubber stamp: the same file cut short has errors
+    (tmp_path / "cut.glb").write_bytes(data[:len(data) - 8])
+    r = subprocess.run(["node", str(VALIDATOR), str(tmp_path / "cut.glb")], capture_output=True,
+                       text=True)
+    assert r.returncode == 1 and json.loads(r.stdout)["issues"]["numErrors"] > 0
