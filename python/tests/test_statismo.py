@@ -109,6 +109,25 @@ def test_edge_length_model_is_the_linearized_embeddings(store_path, tmp_path, ct
     assert np.allclose(m["scores"], W @ alpha.T, rtol=0, atol=1e-4 * np.abs(alpha).max())
 
 
+def test_export_takes_the_embedding_options(store_path, tmp_path, cli, ctx):
+    """--fast (and the other embedding options) reach the model's embeddings:
+    its mean is `edgespace embed --point mean --fast`'s mesh (the oracle: the
+    embed command's OBJ, read back), and they go with --statismo of a PCA only."""
+    with es.Store(store_path, write=True, ctx=ctx) as st:
+        st.pca("faces", components=3)
+        mesh = st.mesh
+    cli("export", store_path, "--statismo", tmp_path / "fast.h5", "--pca", "faces", "-k", "2",
+        "--fast")
+    cli("embed", store_path, "--point", "mean", "--pca", "faces", "--fast", "--no-store", "-o",
+        tmp_path / "mean.obj")
+    X = mesh.read_positions(tmp_path / "mean.obj")
+    with h5py.File(tmp_path / "fast.h5", "r") as f:
+        mean = f["model/mean"][:]
+    assert np.allclose(mean, X.reshape(-1).astype(np.float32), rtol=0, atol=1e-6 * np.abs(X).max())
+    r = cli("export", store_path, "--meshes", tmp_path / "m", "--fast", check=False)
+    assert r.returncode == 2 and "go with --statismo of a PCA" in r.stderr
+
+
 def test_export_errors(store_path, tmp_path, cli, ctx):
     with es.Store(store_path, write=True, ctx=ctx) as st:
         st.pca("faces", components=3)

@@ -40,6 +40,8 @@ static const char usage[] =
     "      --sd C            the step along each PC, in sd (default 1)\n"
     "      --noise-variance V  the model's noise variance (default: 0 for a PCA,\n"
     "                        the PPCA estimate for a GPA)\n"
+    "  with --statismo --pca, how the points are embedded:\n"
+    CLI_EMBED_HELP
     "  -r, --result KIND/NAME  a stored result (gpa/all, model/m, ...) as a table\n"
     "      --table TABLE     which of its tables (default: the kind's first;\n"
     "                        'attributes' for any result; a wrong name lists them)\n"
@@ -93,7 +95,7 @@ int cmd_export(int argc, char **argv)
         {"sd", required_argument, NULL, 'c'}, {"noise-variance", required_argument, NULL, 'n'},
         {"result", required_argument, NULL, 'r'},  {"table", required_argument, NULL, 't'},
         {"output", required_argument, NULL, 'o'},    {"where", required_argument, NULL, 'w'},
-        {NULL, 0, NULL, 0}};
+        CLI_EMBED_LONGOPTS, {NULL, 0, NULL, 0}};
     const char *lengths = NULL, *meshes = NULL, *filter = NULL, *statismo = NULL;
     const char *result = NULL, *table = NULL, *csv = NULL;
     es_study_statismo_opts so;
@@ -102,7 +104,7 @@ int cmd_export(int argc, char **argv)
     es_ctx *ctx;
     es_status rc;
     int64_t *rows = NULL, nrows = 0;
-    int c, raw = 0;
+    int c, e, raw = 0, embed_opts = 0;
     es_study_statismo_opts_init(&so);
     optind = 1;
     while ((c = cli_getopt(argc, argv, "l:M:f:w:r:o:k:h", longopts)) != -1) {
@@ -140,10 +142,20 @@ int cmd_export(int argc, char **argv)
                 return cli_usage_error("export", "--noise-variance wants a number >= 0");
             break;
         case 'h': fputs(usage, stdout); return CLI_OK;
-        default: return cli_usage_error("export", "bad option");
+        default:
+            if ((e = cli_embed_option("export", c, optarg, &so.embed)) >= 0) {
+                if (e) return e;
+                embed_opts = 1;
+                break;
+            }
+            return cli_usage_error("export", "bad option");
         }
     }
     if (optind != argc - 1) return cli_usage_error("export", "give exactly one STORE");
+    if (embed_opts && (!statismo || so.gpa_name))
+        return cli_usage_error("export", "--iters, --refine-iters, --fast, --solver and "
+                               "--bending go with --statismo of a PCA (its points are "
+                               "embedded)");
     if (statismo) return export_statismo(argv[optind], statismo, &so,
                                          filter || lengths || meshes || result, argc, argv);
     if (so.pca_name || so.gpa_name)
