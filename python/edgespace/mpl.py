@@ -27,7 +27,7 @@ from .render import _mesh_arrays, auto_view
 from .store import PCA, Store
 
 DEBIAN_PACKAGE = "python3-matplotlib"
-ZOOM = 1.4
+ZOOM = 1.5
 
 
 def _matplotlib():
@@ -281,11 +281,14 @@ def plot_mesh(mesh, scalars=None, scalar_kind="vertex", edges=None, cmap="viridi
     surface = Poly3DCollection(V[F], facecolors=rgba, **poly_kw)
     ax.add_collection3d(surface)
 
-    centre, half = (V.min(0) + V.max(0)) / 2, (V.max(0) - V.min(0)).max() / 2 or 1.0
+    # a cube around the mesh's bounding sphere: the mesh stays inside the
+    # Axes however it is turned (by elev/azim or by dragging)
+    centre = (V.min(0) + V.max(0)) / 2
+    half = np.linalg.norm(V - centre, axis=1).max() or 1.0
     ax.set(xlim=(centre[0] - half, centre[0] + half), ylim=(centre[1] - half, centre[1] + half),
            zlim=(centre[2] - half, centre[2] + half))
-    # a cube of the mesh's largest span, drawn larger than matplotlib's box
-    # (which leaves room for axes and tick labels, hidden here)
+    # drawn larger than matplotlib's box, which leaves room for the axes'
+    # tick labels (hidden here): the sphere then fills most of the Axes
     ax.set_box_aspect((1, 1, 1), zoom=ZOOM)
     ax.view_init(elev=e, azim=a, roll=roll, vertical_axis=axis)
     if orthographic:

@@ -215,9 +215,10 @@ def test_mesh_polygons_and_colours_by_vertex(esm, store_path, ctx):
     import matplotlib
     expect = matplotlib.colormaps["viridis"]((values[F].mean(1) - lo) / (hi - lo))
     assert np.allclose(surface.get_facecolor(), expect[which], atol=1e-12)
-    # equal scales: a cube around the mesh
+    # equal scales: a cube around the mesh's bounding sphere (about its box's centre)
     spans = [np.ptp(lim) for lim in (ax.get_xlim(), ax.get_ylim(), ax.get_zlim())]
-    assert np.allclose(spans, np.ptp(V, axis=0).max())
+    centre = (V.min(0) + V.max(0)) / 2
+    assert np.allclose(spans, 2 * np.linalg.norm(V - centre, axis=1).max())
     # percentiles=None: the full range; vmin/vmax: as given
     ax = esm.plot_mesh(mesh, scalars=values, percentiles=None)
     assert np.allclose(ax.figure.axes[-1].get_ylim(), (values.min(), values.max()))
@@ -301,6 +302,10 @@ def test_mesh_camera_is_the_library_s(esm, plt, ctx):
         P = np.array([ex - x[0], ey - y[0]])
         PPt = P @ P.T
         assert np.abs(PPt - PPt[0, 0] * np.eye(2)).max() < 1e-9 * PPt[0, 0]
+        # the whole mesh inside the Axes
+        x, y, _ = proj3d.proj_transform(V[:, 0], V[:, 1], V[:, 2], ax.M)
+        px = ax.transData.transform(np.c_[x, y])
+        assert (px >= ax.bbox.p0).all() and (px <= ax.bbox.p1).all()
         plt.close(ax.figure)
     # elev/azim replace the camera's angles, about the axis nearest its up:
     # y, which then points straight up (no roll)
