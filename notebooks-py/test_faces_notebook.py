@@ -62,8 +62,9 @@ def test_the_notebook_ran_and_its_checks_passed(runs):
     text = "".join("".join(o.get("text", "")) for c in code for o in c["outputs"])
     assert text.count("ok   ") == 5 and "FAIL" not in text
     images = sum("image/png" in o.get("data", {}) for c in code for o in c["outputs"])
-    assert images >= 4                                    # scree, scatter, faces, heat map
-    for f in ("expressions.png", "happy_t_heatmap.png", "pc1_pc2.png", "mean_neutral.obj"):
+    assert images >= 5                # scree, scatter, the scatters by matplotlib, faces, heat map
+    for f in ("expressions.png", "happy_t_heatmap.png", "pc1_pc2.png", "mean_neutral.obj",
+              "pc_scores.pdf"):
         assert (py / f).stat().st_size > 1000
 
 

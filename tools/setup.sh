@@ -35,6 +35,7 @@ packages=(
   python3-cffi python3-numpy python3-pytest python3-h5py python3-tqdm python3-pandas
   jupyter-nbconvert python3-ipykernel
   python3-scipy              # the published pipeline's oracle (fmin_l_bfgs_b)
+  python3-matplotlib         # edgespace.mpl: the figures as matplotlib Axes for notebooks
   # R, for the tests that run datasets-spec/store-format.md's R snippets
   r-cran-hdf5r r-bioc-rhdf5
   r-cran-vegan               # the oracle of edgespace model (tools/oracle/adonis2.R)

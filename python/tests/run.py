@@ -37,6 +37,9 @@ GROUPS = {
     # oracles: SciPy's fmin_l_bfgs_b, the minimizer of the published pipeline
     # (test_paper_oracle.py; skipped without it, and --check fails)
     "oracle": {"scipy": "python3-scipy"},
+    # edgespace.mpl, the figures as matplotlib Axes (test_mpl.py; skipped
+    # without it, and --check fails)
+    "figures": {"matplotlib": "python3-matplotlib"},
 }
 PROGRAMS = {"notebooks": {"jupyter-nbconvert": "jupyter-nbconvert"},
             "browser": {"chromium": "chromium", "chromedriver": "chromium-driver",
