@@ -295,13 +295,14 @@ int cli_embed_option(const char *verb, int c, const char *arg, es_embed_opts *o)
     case 0x103:
         if (cli_parse_i64(arg, &n) || n < 0 || n > 1000000)
             return cli_usage_error(verb, "--iters wants a count >= 0");
-        o->lg_max_iter = (int)n;
+        o->lg_max_iter = o->lg_max_iter_large = (int)n;   /* at every size */
         return 0;
     case 0x104: {
         es_embed_opts f;
         es_embed_opts_fast(&f);
         o->lg_polish = f.lg_polish;
         o->lg_max_iter = f.lg_max_iter;
+        o->lg_max_iter_large = f.lg_max_iter_large;
         o->lg_rms_tol = f.lg_rms_tol;
         o->lg_max_tol = f.lg_max_tol;
         return 0;

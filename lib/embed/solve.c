@@ -61,6 +61,17 @@ void es_embed_opts_init(es_embed_opts *o)
     o->lg_max_tol = 1e-2;
     o->lg_rtol = 1e-4;
     o->lg_polish = 4;
+    /* sfm_surrey subdivided, quiet machine (tools/bench/bench_points): at
+     * 54K vertices one polish iteration costs about 25 local-global ones
+     * and at 216K about 35, and more local-global iterations then do at
+     * least as well: 216K mean 57 iterations, 6.5 s, max 0.97 %, bending
+     * 1.14 x the prior's, against 40 + 2 polish iterations, 11.9 s, max
+     * 0.93 %, bending 1.18; mean + 2 sd on PC 2 (not realizable) 7.0 s,
+     * max 3.1 %, bending 1.71 against 12.1 s, 2.7 %, 1.89; at 54K 1.5 s,
+     * max 2.5 %, bending 1.56 against 3.2 s, 2.1 %, 1.63. At 13.6K the
+     * polish still bent less (1.33 against 1.41) for 0.5 s more */
+    o->polish_max_verts = 50000;
+    o->lg_max_iter_large = 70;
     o->realize_bend = 3;
     o->realize_margin = 0.01;
 }
@@ -262,10 +273,22 @@ static es_status refine_from_start(es_embedder *emb, const es_embed_opts *o, es_
     return ES_OK;
 }
 
-/* The local-global iterations of one solve, at most (exact targets: twice). */
-static int shape_iters(const es_embed_opts *o)
+/* Whether the Levenberg-Marquardt polish may run: asked for, and the mesh
+ * below the size where more local-global iterations take its place. */
+static int polish_allowed(const es_embedder *emb, const es_embed_opts *o)
 {
-    return o->prior_exact ? 2 * o->lg_max_iter : o->lg_max_iter;
+    return o->lg_polish > 0 && o->refine_max_iter > 0 &&
+           !(o->polish_max_verts > 0 && emb->nv >= o->polish_max_verts);
+}
+
+/* The local-global iterations of one solve, at most (exact targets: twice);
+ * a mesh too large for the polish gets lg_max_iter_large instead. */
+static int shape_iters(const es_embedder *emb, const es_embed_opts *o)
+{
+    int n = o->lg_polish > 0 && !polish_allowed(emb, o) && o->lg_max_iter_large > o->lg_max_iter
+                ? o->lg_max_iter_large
+                : o->lg_max_iter;
+    return o->prior_exact ? 2 * n : n;
 }
 
 /* From the start's positions: the local-global solve (local_global.c) on
@@ -286,7 +309,7 @@ static es_status shape_from_start(es_embedder *emb, const es_embed_opts *o, es__
     es__lg_result res;
     /* a warm start keeps the last factor while the weights are within 10 %
      * of its own (local_global.c: assemble) */
-    es__lg_opts lo = {shape_iters(o), o->lg_history, o->lg_rms_tol, o->lg_max_tol, o->lg_rtol,
+    es__lg_opts lo = {shape_iters(emb, o), o->lg_history, o->lg_rms_tol, o->lg_max_tol, o->lg_rtol,
                       o->verbose, warm ? 0.1 : 0};
     es_status rc;
     if (rep->n_bad_faces > 0 && o->realize_margin >= 0) {
@@ -306,7 +329,7 @@ static es_status shape_from_start(es_embedder *emb, const es_embed_opts *o, es__
      * rows: bending 1.22 x the prior's with the last weight, 1.07 with 3 x
      * the first, length RMS 0.04 % -> 0.13 %) */
     int inconsistent = rep->n_bad_faces > 0 && o->realize_bend > 0 && bp;
-    if ((!res.met || inconsistent) && o->lg_polish > 0 && o->refine_max_iter > 0) {
+    if ((!res.met || inconsistent) && polish_allowed(emb, o)) {
         es__refine_opts ro = es__refine_opts_from(o);
         es__bend_prior hold;
         /* a few iterations: chasing the last edges' error for longer crumpled
@@ -408,7 +431,7 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
     if (start) {
         /* from given positions (a prior's realization) */
         int lg = o->solver != ES_EMBED_SOLVER_LM;
-        emb->progress_total = 1 + (lg ? shape_iters(o) : o->refine_max_iter > 0 ? o->refine_max_iter : 0);
+        emb->progress_total = 1 + (lg ? shape_iters(emb, o) : o->refine_max_iter > 0 ? o->refine_max_iter : 0);
         es__progress(ctx, "embedding", 0, emb->progress_total);
         if ((rc = positions_start(emb, ext, init_alpha ? alpha : NULL, L, xyz, &rep)) != ES_OK)
             return rc;

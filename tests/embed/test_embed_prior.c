@@ -4,7 +4,8 @@
  * (es_pca_row_weights, checked against the known combination), the prior of
  * a row (its own mesh comes back), a blend of two open height fields
  * (realized, in the prior's frame, near the blend, no more bending than the
- * blend, closer to it than the solve without a prior), a closed mesh (the
+ * blend, closer to it than the solve without a prior), the polish and the
+ * mesh size from which local-global iterations replace it, a closed mesh (the
  * same result as es_interp_embed), and bad arguments.
  */
 #define ES_MODULE_EMBED   /* the module's own test: its package header too */
@@ -216,6 +217,32 @@ static void test_open(es_ctx *ctx)
                          d1, d0);
             ES_CHECK(!r0.has_prior && es_embedder_vertex_deviation(emb) == NULL);
             free(plain);
+        }
+        {   /* the polish and the size from which more local-global iterations
+             * take its place (polish_max_verts): tolerances that 5 local-global
+             * iterations do not meet */
+            double *out2 = malloc(3 * (size_t)nv * sizeof *out2);
+            es_embed_opts o;
+            es_embed_report rp, rl, r0;
+            es_embed_opts_init(&o);
+            o.lg_max_iter = 5;
+            o.lg_max_iter_large = 12;
+            o.lg_rms_tol = 1e-9;
+            o.lg_max_tol = 1e-8;
+            ES_CHECK(o.polish_max_verts > nv);   /* the default: this mesh is polished */
+            ES_CHECK_OK(ctx, es_embed_prior_solve(ctx, emb, len, 0, &pr, &o, out2, &rp));
+            o.polish_max_verts = nv;             /* as large as the limit */
+            ES_CHECK_OK(ctx, es_embed_prior_solve(ctx, emb, len, 0, &pr, &o, out2, &rl));
+            o.polish_max_verts = 0;              /* no limit */
+            ES_CHECK_OK(ctx, es_embed_prior_solve(ctx, emb, len, 0, &pr, &o, out2, &r0));
+            ES_CHECK_MSG(rp.lg_iters == 5 && rp.refine_iters > 0 && rl.refine_iters == 0 &&
+                             rl.lg_iters > 5 && rl.lg_iters <= 12 && r0.lg_iters == 5 &&
+                             r0.refine_iters == rp.refine_iters,
+                         "polished %lld + %lld, at the limit %lld + %lld, no limit %lld + %lld",
+                         (long long)rp.lg_iters, (long long)rp.refine_iters,
+                         (long long)rl.lg_iters, (long long)rl.refine_iters,
+                         (long long)r0.lg_iters, (long long)r0.refine_iters);
+            free(out2);
         }
         ES_CHECK(plain_rms(nv, out, prior) <= 1e-2 * diag);
         ES_CHECK(plain_rms(nv, out, prior) <= aligned_rms(ctx, nv, out, prior) * (1 + 1e-6));

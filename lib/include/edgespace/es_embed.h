@@ -161,6 +161,12 @@ typedef struct es_embed_opts {
                                  tolerances: Levenberg-Marquardt iterations at most
                                  (and at most refine_max_iter) toward them (default 4;
                                  0: local-global alone, es_embed_opts_fast) */
+    int64_t polish_max_verts; /* meshes with this many vertices or more skip the polish
+                                 (its 3V x 3V factorization then costs more than 25
+                                 local-global iterations) and get lg_max_iter_large
+                                 local-global iterations instead (default 50000; 0:
+                                 the polish at every size) */
+    int lg_max_iter_large;    /* those meshes' local-global iterations at most (70) */
     double realize_bend;      /* for such a target (no mesh has its lengths) the
                                  Levenberg-Marquardt finish always runs, with the prior's
                                  bending term held at realize_bend x prior_mu, so that the
