@@ -156,6 +156,21 @@ es_status es__match_scalars(es_ctx *ctx, const char *mesh_path, const es_meshdat
     return ES_OK;
 }
 
+/* The colour bar's label for a column header: the quantity and its units for
+ * the columns `embed --residuals` writes (lib/study/embed_point.c), the
+ * header itself for any other. */
+static const char *column_label(const char *head)
+{
+    static const struct { const char *column, *label; } known[] = {
+        {"closure", "closure energy at the vertex (no unit)"},
+        {"edge_error", "mean relative edge-length error at the vertex"},
+        {"deviation", "distance from the prior / bounding-box diagonal"},
+    };
+    for (size_t i = 0; i < sizeof known / sizeof *known; i++)
+        if (!strcmp(head, known[i].column)) return known[i].label;
+    return head;
+}
+
 static es_status check_args(es_ctx *ctx, const es_render_spec *spec, int64_t n,
                             const char *const *mesh_paths, int64_t nscalars,
                             const char *const *scalar_paths, const char *out_path)
@@ -208,7 +223,7 @@ es_status es_figure_render_files(es_ctx *ctx, const es_render_spec *spec, int64_
     }
     if (rc == ES_OK) {
         es_render_spec sp = *spec;
-        if (!sp.colorbar_label && *head) sp.colorbar_label = head;
+        if (!sp.colorbar_label && *head) sp.colorbar_label = column_label(head);
         sp.meshes = items;
         sp.nmeshes = n;
         rc = es_render(ctx, &sp, out_path, rep);

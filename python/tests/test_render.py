@@ -112,3 +112,23 @@ def test_variation_figure_writes_plus_minus_and_minus_signs(store_path, tmp_path
     cli("variation", store_path, "--pca", "faces", "--pcs", "1", "-o", tmp_path / "v.pdf")
     codes = pdf_codepoints(tmp_path / "v.pdf")
     assert "\u00b1" in codes and "\u2212" in codes
+
+
+def test_residual_columns_name_their_quantity_on_the_colour_bar(store_path, tmp_path, cli):
+    """render --scalars of `embed --residuals`: the colour bar names the
+    quantity and its unit, not the CSV's column name (read from the PDF's
+    text by pdf_text, not by the library); any other column keeps its name."""
+    from pdf_text import pdf_strings
+    cli("embed", store_path, "--point", "mean", "-o", tmp_path / "m.ply", "--residuals",
+        tmp_path / "r.csv", "--no-store")
+    labels = {"closure": "closure energy at the vertex (no unit)",
+              "edge_error": "mean relative edge-length error at the vertex",
+              "deviation": "distance from the prior / bounding-box diagonal"}
+    for column, label in labels.items():
+        cli("render", tmp_path / "m.ply", "--scalars", tmp_path / "r.csv", "--column", column,
+            "-o", tmp_path / f"{column}.pdf")
+        assert label in pdf_strings(tmp_path / f"{column}.pdf"), column
+    with open(tmp_path / "o.csv", "w") as f:
+        f.write("thickness\n" + "1\n" * len(open(tmp_path / "r.csv").readlines()[1:]))
+    cli("render", tmp_path / "m.ply", "--scalars", tmp_path / "o.csv", "-o", tmp_path / "o.pdf")
+    assert "thickness" in pdf_strings(tmp_path / "o.pdf")
