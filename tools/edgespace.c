@@ -62,9 +62,8 @@ static void print_help(FILE *f)
 }
 
 /* OpenBLAS (the pthreads build Debian links) starts its worker threads
- * when it is loaded and again whenever its thread count is set (the
- * embedding sets it to 1 around each solve, solve.c), and each worker
- * spins in sched_yield for 2^28 cycles before it sleeps: in a one-point
+ * when it is loaded, and each worker spins in sched_yield for 2^28 cycles
+ * before it sleeps, then again after every threaded call: in a one-point
  * command a tenth of a second of CPU on the other core, for nothing
  * (face-study, `embed --point mean --fast`, quiet machine: 0.50 s CPU,
  * 0.37 s with the spin cut short; the same wall time). The spin's length
