@@ -140,8 +140,7 @@ es_status es_embed_prior_from_rows_sc(es_ctx *ctx, int64_t nverts, int64_t nedge
     if (var) memset(var, 0, (size_t)nedges * sizeof *var);
     for (int64_t k = 0; k < n; k++) {
         if (w[k] == 0) continue;
-        if (var) add_deviations(nedges, w[k], alpha_rows[k], c, acc, var);
-        else add_deviations(nedges, w[k], alpha_rows[k], c, acc, NULL);
+        add_deviations(nedges, w[k], alpha_rows[k], c, acc, var);
     }
     for (int64_t e = 0; e < nedges; e++) {
         double mean = c[e] + acc[e];

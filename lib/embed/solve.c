@@ -273,19 +273,26 @@ static es_status refine_from_start(es_embedder *emb, const es_embed_opts *o, es_
     return ES_OK;
 }
 
+/* Whether the mesh is large enough that local-global iterations take the
+ * polish's place (polish_max_verts, measured above). */
+static int polish_too_costly(const es_embedder *emb, const es_embed_opts *o)
+{
+    return o->polish_max_verts > 0 && emb->nv >= o->polish_max_verts;
+}
+
 /* Whether the Levenberg-Marquardt polish may run: asked for, and the mesh
- * below the size where more local-global iterations take its place. */
+ * below that size. */
 static int polish_allowed(const es_embedder *emb, const es_embed_opts *o)
 {
-    return o->lg_polish > 0 && o->refine_max_iter > 0 &&
-           !(o->polish_max_verts > 0 && emb->nv >= o->polish_max_verts);
+    return o->lg_polish > 0 && o->refine_max_iter > 0 && !polish_too_costly(emb, o);
 }
 
 /* The local-global iterations of one solve, at most (exact targets: twice);
- * a mesh too large for the polish gets lg_max_iter_large instead. */
+ * a polished solve on a mesh too large for the polish gets
+ * lg_max_iter_large instead. */
 static int shape_iters(const es_embedder *emb, const es_embed_opts *o)
 {
-    int n = o->lg_polish > 0 && !polish_allowed(emb, o) && o->lg_max_iter_large > o->lg_max_iter
+    int n = o->lg_polish > 0 && polish_too_costly(emb, o) && o->lg_max_iter_large > o->lg_max_iter
                 ? o->lg_max_iter_large
                 : o->lg_max_iter;
     return o->prior_exact ? 2 * n : n;

@@ -98,8 +98,9 @@ es_status es__study_rows_check_memory(es_ctx *ctx, const es_mesh *mesh, int64_t 
 
 /* The rows' struct and column pointers over arrays aligned and alpha,
  * owned by the rows from here on (freed, or unmapped when map is set). */
-static es_status rows_over(es_ctx *ctx, int64_t n, int64_t nv, int64_t ne, double *aligned,
-                           double *alpha, void *map, size_t map_len, es_study_rows **out)
+es_status es__study_rows_mapped(es_ctx *ctx, int64_t n, int64_t nv, int64_t ne, void *map,
+                                size_t map_len, double *aligned, double *alpha,
+                                es_study_rows **out)
 {
     es_study_rows *r;
     *out = NULL;
@@ -133,19 +134,13 @@ static es_status rows_over(es_ctx *ctx, int64_t n, int64_t nv, int64_t ne, doubl
 es_status es__study_rows_new(es_ctx *ctx, int64_t n, int64_t nv, int64_t ne, es_study_rows **out,
                              double **aligned, double **alpha)
 {
-    es_status rc = rows_over(ctx, n, nv, ne, es__alloc_array(ctx, 3 * nv * n, sizeof **aligned),
-                             es__alloc_array(ctx, ne * n, sizeof **alpha), NULL, 0, out);
+    es_status rc = es__study_rows_mapped(ctx, n, nv, ne, NULL, 0,
+                                         es__alloc_array(ctx, 3 * nv * n, sizeof **aligned),
+                                         es__alloc_array(ctx, ne * n, sizeof **alpha), out);
     if (rc != ES_OK) return rc;
     *aligned = (*out)->aligned;
     *alpha = (*out)->alpha;
     return ES_OK;
-}
-
-es_status es__study_rows_mapped(es_ctx *ctx, int64_t n, int64_t nv, int64_t ne, void *map,
-                                size_t map_len, double *aligned, double *alpha,
-                                es_study_rows **out)
-{
-    return rows_over(ctx, n, nv, ne, aligned, alpha, map, map_len, out);
 }
 
 void es__study_rows_arrays(const es_study_rows *r, const double **aligned, const double **alpha)

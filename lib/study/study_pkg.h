@@ -96,8 +96,9 @@ es_status es__model_save(es_ctx *ctx, es_store *s, const es_study_model_opts *o,
 es_status es__study_rows_check_memory(es_ctx *ctx, const es_mesh *mesh, int64_t n);
 es_status es__study_rows_new(es_ctx *ctx, int64_t n, int64_t nv, int64_t ne, es_study_rows **out,
                              double **aligned, double **alpha);
-/* The same over arrays that lie in map (map_len bytes, from mmap), which
- * the rows unmap when freed (a cache file read in place). */
+/* The rows over arrays they own from here on: aligned and alpha freed with
+ * them, or, when map is set (map_len bytes from mmap: a cache file read in
+ * place), lying in map, which they unmap. */
 es_status es__study_rows_mapped(es_ctx *ctx, int64_t n, int64_t nv, int64_t ne, void *map,
                                 size_t map_len, double *aligned, double *alpha,
                                 es_study_rows **out);
