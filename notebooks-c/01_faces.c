@@ -467,8 +467,8 @@ static int points(notebook *nb, study *s)
         s->pts[e + 3 * E] = s->pca->mean[e];
     }
     s->pt_name[0] = "mean_neutral";   s->pt_label[0] = "mean neutral";
-    s->pt_name[1] = "mean_plus_happy"; s->pt_label[1] = "+ happy - neutral";
-    s->pt_name[2] = "mean_plus_angry"; s->pt_label[2] = "+ angry - neutral";
+    s->pt_name[1] = "mean_plus_happy"; s->pt_label[1] = "+ happy − neutral";
+    s->pt_name[2] = "mean_plus_angry"; s->pt_label[2] = "+ angry − neutral";
     s->pt_name[3] = "pca_mean";       s->pt_label[3] = "mean (all)";
     for (int i = 0; i < 3; i++) s->pt_scale[i] = s->scale_neutral;
     s->pt_scale[3] = s->scale_all;
@@ -476,9 +476,9 @@ static int points(notebook *nb, study *s)
         static const char *nm[3][2] = {{"pc1_minus2sd", "pc1_plus2sd"},
                                        {"pc2_minus2sd", "pc2_plus2sd"},
                                        {"pc3_minus2sd", "pc3_plus2sd"}};
-        static const char *lb[3][2] = {{"PC 1 -2 sd", "PC 1 +2 sd"},
-                                       {"PC 2 -2 sd", "PC 2 +2 sd"},
-                                       {"PC 3 -2 sd", "PC 3 +2 sd"}};
+        static const char *lb[3][2] = {{"PC 1 −2 sd", "PC 1 +2 sd"},
+                                       {"PC 2 −2 sd", "PC 2 +2 sd"},
+                                       {"PC 3 −2 sd", "PC 3 +2 sd"}};
         double sd = sqrt(s->pca->eigenvalues[k]);
         const double *u = s->pca->components + k * E;
         for (int j = 0; j < 2; j++) {
@@ -702,7 +702,7 @@ static int pictures(notebook *nb, study *s)
         const int *idx = k == 0 ? pc1 : k == 1 ? pc2 : pc3;
         char file[32], title[64];
         snprintf(file, sizeof file, "pc%d.png", k + 1);
-        snprintf(title, sizeof title, "Mean -/+ 2 sd along PC %d", k + 1);
+        snprintf(title, sizeof title, "Mean ± 2 sd along PC %d", k + 1);
         if (render_row(nb, s, idx, 3, file, title)) return 1;
         nb_image(nb, file, "PC %d: mean %+.2f sd, mean of all faces, mean %+.2f sd "
                  "(meshes: pc%d_*.obj)", k + 1, s->pt_sd[idx[0]], s->pt_sd[idx[2]], k + 1);
