@@ -245,10 +245,24 @@ static cholmod_factor *analyze_with(es_embedder *emb, cholmod_sparse *A, int ord
  * the vertex elimination tree; H3 is then built in that order and analysed
  * as it is (perm_block_pattern). A caller that kept the order of an
  * earlier embedder of the same topology (es_embedder_ordering) passes it
- * back, and the ordering is not computed again. */
+ * back, and the ordering is not computed again.
+ *
+ * This V x V factor (stage 3's frames, and the local-global matrix of
+ * local_global.c, which solves with it every iteration) is simplicial:
+ * a surface's vertex graph has small supernodes, too small for the BLAS
+ * that a supernodal factor calls on them. Measured with the embedder's
+ * orders and amalgamation on subdivided sfm_surrey faces and face-study,
+ * one thread (factorization / solve with 3 right-hand sides, ms,
+ * supernodal -> simplicial): 3.4K 4.7 / 0.33 -> 1.0 / 0.08; 9.4K
+ * 18.8 / 1.31 -> 10.0 / 0.52; 13.6K 31 / 1.33 -> 6.9 / 0.46; 54K
+ * 132 / 9.5 -> 57 / 5.0; 216K 456 / 50 -> 472 / 36. The 3V x 3V matrix of
+ * the Levenberg-Marquardt stages (build_h3) stays supernodal: its 3 x 3
+ * blocks make supernodes the BLAS is fast on (9.4K: 92 ms against 180). */
 static es_status analyze_vertex_graph(es_embedder *emb, const int64_t *order)
 {
     int64_t nv = emb->nv;
+    int sup = emb->cm.supernodal;
+    emb->cm.supernodal = CHOLMOD_SIMPLICIAL;   /* see the comment above */
     if (order) {
         cholmod_common *cm = &emb->cm;
         int nmethods = cm->nmethods, ord = cm->method[0].ordering, post = cm->postorder;
@@ -267,6 +281,7 @@ static es_status analyze_vertex_graph(es_embedder *emb, const int64_t *order)
         return rc != ES_OK ? rc : es__fail(emb->ctx, ES_ENOMEM, "embed: CHOLMOD out of memory "
                                                                 "in analyze");
     }
+    emb->cm.supernodal = sup;
     memcpy(emb->perm, emb->L1->Perm, (size_t)nv * sizeof *emb->perm);
     for (int64_t j = 0; j < nv; j++) emb->pinv[emb->perm[j]] = j;
     return ES_OK;
