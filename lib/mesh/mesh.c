@@ -228,6 +228,7 @@ es_status es__mesh_new(es_ctx *ctx, int64_t nverts, int64_t nfaces, const int64_
     m = es__calloc(ctx, 1, sizeof *m);
     if (!m) return ES_ENOMEM;
     m->ctx = ctx;
+    atomic_init(&m->refs, 1);
     m->nv = nverts;
     m->nf = nfaces;
     m->faces = es__alloc_array(ctx, 3 * nfaces > 0 ? 3 * nfaces : 1, sizeof *m->faces);
@@ -256,9 +257,15 @@ fail:
     return rc;
 }
 
+es_mesh *es__mesh_ref(es_mesh *m)
+{
+    if (m) atomic_fetch_add(&m->refs, 1);
+    return m;
+}
+
 void es_mesh_free(es_mesh *m)
 {
-    if (!m) return;
+    if (!m || atomic_fetch_sub(&m->refs, 1) > 1) return;
     es_ctx *ctx = m->ctx;
     es__free(ctx, m->faces);
     es__free(ctx, m->xyz);

@@ -12,10 +12,12 @@
 #error "mesh/mesh_pkg.h is private to lib/mesh/ (see lib/README.md)"
 #endif
 
+#include <stdatomic.h>
 #include "mesh/mesh_private.h"
 
 struct es_mesh {
     es_ctx *ctx;
+    _Atomic int64_t refs; /* holders (es__mesh_ref); es_mesh_free drops one */
     int64_t nv, nf, ne;
     int64_t *faces;       /* 3 x F */
     double *xyz;          /* 3 x V or NULL */

@@ -11,4 +11,10 @@
 es_status es__mesh_new(es_ctx *ctx, int64_t nverts, int64_t nfaces, const int64_t *faces,
                        const double *xyz, int warn_unreferenced, es_mesh **out);
 
+/* One more holder of m (immutable once made): es_mesh_free then frees it
+ * only when the last holder lets go. Returns m. The store hands its
+ * topology out this way (es_store_mesh), so that the commands that ask for
+ * it more than once build it once. */
+es_mesh *es__mesh_ref(es_mesh *m);
+
 #endif

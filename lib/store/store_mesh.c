@@ -61,6 +61,20 @@ es_status es_store_mesh(es_ctx *ctx, es_store *store, es_mesh **out)
         ES_FAIL(ctx, ES_EINVAL, "store: '%s' is a truss store (%lld edges between landmarks, "
                 "no faces): it has no mesh to embed or check; give --triangles at ingest for "
                 "one", es_store_path(store), (long long)es_store_nedges(store));
+    /* a command asks for the topology several times (the point's lengths,
+     * the embedding, the report): built once, then shared (meshes are
+     * immutable); a write since (a new generation or a first row) makes it
+     * afresh. Only under the store's own context, which outlives the
+     * store's reference. */
+    if (store->mesh && (store->mesh_generation != store->generation ||
+                        store->mesh_nrows != (store->nrows > 0))) {
+        es_mesh_free(store->mesh);
+        store->mesh = NULL;
+    }
+    if (store->mesh && ctx == store->ctx) {
+        *out = es__mesh_ref(store->mesh);
+        return ES_OK;
+    }
     if (!es__mul_i64(F, 3, &n3) || !(faces = es__alloc_array(ctx, n3, sizeof *faces)))
         return ES_ENOMEM;
     if ((rc = es_store_read_faces(ctx, store, faces))) goto done;
@@ -76,6 +90,11 @@ es_status es_store_mesh(es_ctx *ctx, es_store *store, es_mesh **out)
         rc = es__fail(ctx, ES_EFORMAT, "store: '%s': its faces make %lld edges but it stores "
                       "%lld", es_store_path(store), (long long)ne,
                       (long long)es_store_nedges(store));
+    }
+    if (rc == ES_OK && ctx == store->ctx) {
+        store->mesh = es__mesh_ref(*out);
+        store->mesh_generation = store->generation;
+        store->mesh_nrows = store->nrows > 0;
     }
 done:
     es__free(ctx, faces);

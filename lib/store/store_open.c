@@ -32,6 +32,7 @@ static void release(es_store *s, bool keep_work)
     if (s->work && !keep_work) unlink(s->work);
     es__beside_release(s);
     es__store_free_rows(s);
+    es_mesh_free(s->mesh);
     es__free(ctx, s->work);
     es__free(ctx, s->path);
     es__free(ctx, s->target);

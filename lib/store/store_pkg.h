@@ -84,6 +84,11 @@ struct es_store {
     char store_id[33];     /* format 3: the id its results carry */
     es__beside *side;      /* results beside the store this handle opened or wrote */
     int64_t nside, side_cap;
+    es_mesh *mesh;         /* es_store_mesh's last answer (one reference), made with
+                            * ctx, while generation and nrows are mesh_generation and
+                            * mesh_nrows: its faces and row 0 cannot have changed */
+    uint64_t mesh_generation;
+    int64_t mesh_nrows;
 };
 
 /* ---- HDF5 helpers (store_h5.c); callers run inside H5E_BEGIN_TRY ---- */

@@ -273,7 +273,34 @@ int main(void)
             ES_CHECK(!strcmp(fp, es_store_fingerprint(s)));
             free(edges);
         }
+        /* asked again it is the same (built once, shared); each caller's
+         * reference outlives the others' and the store's (ASan in CI would
+         * see a use after free): row 0's positions, read independently */
+        es_mesh *again = NULL, *other_ctx = NULL;
+        es_ctx *ctx2 = NULL;
+        ES_CHECK_OK(ctx, es_store_mesh(ctx, s, &again));
+        ES_CHECK(again == mesh);
+        ES_CHECK(es_ctx_new(&ctx2) == ES_OK);
+        ES_CHECK_OK(ctx2, es_store_mesh(ctx2, s, &other_ctx));
+        ES_CHECK(other_ctx && other_ctx != mesh);   /* another context: its own */
         es_mesh_free(mesh);
+        es_store_close(s);
+        s = NULL;
+        if (again && es_mesh_xyz(again)) {
+            double *row0 = NULL;
+            es_store *s2 = NULL;
+            ES_CHECK_OK(ctx, es_store_open(ctx, store, ES_STORE_READ, &s2));
+            if (s2 && (row0 = malloc((size_t)(3 * es_store_nverts(s2)) * sizeof *row0))) {
+                ES_CHECK_OK(ctx, es_store_read_positions(ctx, s2, 0, row0));
+                ES_CHECK(!memcmp(row0, es_mesh_xyz(again),
+                                 (size_t)(3 * es_mesh_nverts(again)) * sizeof *row0));
+            }
+            free(row0);
+            es_store_close(s2);
+        }
+        es_mesh_free(again);
+        es_mesh_free(other_ctx);
+        es_ctx_free(ctx2);
     }
     es_store_close(s);
     s = NULL;
