@@ -47,6 +47,9 @@
 #include <math.h>
 #include <string.h>
 
+/* doubles a face in emb->lg_rest (rest_triangles) */
+#define REST 12
+
 /* ---- the matrix: its pattern once per embedder, its values per solve ---- */
 
 static es_status prepare(es_embedder *emb, int history)
@@ -60,7 +63,7 @@ static es_status prepare(es_embedder *emb, int history)
     if (emb->F1) return ES_OK;
     if ((!emb->lg_w && !(emb->lg_w = es__alloc_array(emb->ctx, ne + 1, sizeof(double)))) ||
         (!emb->lg_wf && !(emb->lg_wf = es__alloc_array(emb->ctx, ne + 1, sizeof(double)))) ||
-        (!emb->lg_rest && !(emb->lg_rest = es__alloc_array(emb->ctx, 9 * emb->nf + 1, sizeof(double)))) ||
+        (!emb->lg_rest && !(emb->lg_rest = es__alloc_array(emb->ctx, REST * emb->nf + 1, sizeof(double)))) ||
         (!emb->lg_work && !(emb->lg_work = es__alloc_array(emb->ctx, 6 * 3 * nv + 1, sizeof(double)))))
         return ES_ENOMEM;
     if (!emb->A1) emb->A1 = cholmod_l_copy_sparse(emb->H1, &emb->cm);
@@ -153,8 +156,9 @@ static es_status assemble(es_embedder *emb, const double *L, double reuse)
 /* Each face's triangle of lengths L as the 2D vectors of its edges k = 0,
  * 1, 2 (edge k joins corners k and k + 1), from corner 0's angle by
  * Kahan's formula (emb->ang, es__corner_angles), each times its edge's
- * weight, then the three weights: 9 doubles a face, read in order by the
- * local step (the weights gathered by edge cost a cache miss each). A face
+ * weight, then the three weights and their inverses: REST doubles a face,
+ * read in order by the local step (the weights gathered by edge cost a
+ * cache miss each; the inverses spare it three divisions a face). A face
  * whose lengths break the triangle inequality is flattened to a segment. */
 static void rest_triangles(es_embedder *emb, const double *L)
 {
@@ -162,20 +166,23 @@ static void rest_triangles(es_embedder *emb, const double *L)
     for (int64_t f = 0; f < emb->nf; f++) {
         double l0 = L[FE[3 * f]], l2 = L[FE[3 * f + 2]], th = emb->ang[3 * f];
         double t2x = l2 * cos(th), t2y = l2 * sin(th);
-        double *r = emb->lg_rest + 9 * f, w[3];
+        double *r = emb->lg_rest + REST * f, w[3];
         for (int k = 0; k < 3; k++) w[k] = emb->lg_w[FE[3 * f + k]];
         r[0] = w[0] * l0, r[1] = 0;                 /* corner 1 - corner 0 */
         r[2] = w[1] * (t2x - l0), r[3] = w[1] * t2y;   /* corner 2 - corner 1 */
         r[4] = -w[2] * t2x, r[5] = -w[2] * t2y;      /* corner 0 - corner 2 */
         r[6] = w[0], r[7] = w[1], r[8] = w[2];
+        r[9] = 1.0 / w[0], r[10] = 1.0 / w[1], r[11] = 1.0 / w[2];
     }
 }
 
 /* R = S (S^T S)^(-1/2) for a 3 x 2 S (row-major): the 3 x 2 matrix with
  * orthonormal columns nearest to S. The square root of the 2 x 2 SPD
- * M = S^T S is (M + s I) / sqrt(tr M + 2 s), s = sqrt(det M). A face
- * crushed to a segment or a point gets any orthonormal pair whose first
- * column follows S's longer column. */
+ * M = S^T S is (M + s I) / q, s = sqrt(det M), q = sqrt(tr M + 2 s), and
+ * det(M + s I) = s q^2, so M^(-1/2) = adj(M + s I) / (s q): one division
+ * (the local step's hottest loop; it had six). A face crushed to a segment
+ * or a point gets any orthonormal pair whose first column follows S's
+ * longer column. */
 static void polar32(const double *S, double *R)
 {
     double a11 = S[0] * S[0] + S[2] * S[2] + S[4] * S[4];
@@ -183,10 +190,8 @@ static void polar32(const double *S, double *R)
     double a22 = S[1] * S[1] + S[3] * S[3] + S[5] * S[5];
     double det = a11 * a22 - a12 * a12, tr = a11 + a22;
     if (tr > 0 && det > 1e-24 * tr * tr) {
-        double s = sqrt(det), q = sqrt(tr + 2 * s);
-        double m11 = (a11 + s) / q, m12 = a12 / q, m22 = (a22 + s) / q;
-        double md = m11 * m22 - m12 * m12;
-        double i11 = m22 / md, i12 = -m12 / md, i22 = m11 / md;
+        double s = sqrt(det), q = sqrt(tr + 2 * s), inv = 1.0 / (s * q);
+        double i11 = (a22 + s) * inv, i12 = -a12 * inv, i22 = (a11 + s) * inv;
         for (int i = 0; i < 3; i++) {
             R[2 * i] = S[2 * i] * i11 + S[2 * i + 1] * i12;
             R[2 * i + 1] = S[2 * i] * i12 + S[2 * i + 1] * i22;
@@ -223,7 +228,7 @@ static double local_step(const es_embedder *emb, const double *xyz, double *b, d
     memset(acc, 0, (size_t)(3 * nv) * sizeof *acc);
     for (int64_t f = 0; f < emb->nf; f++) {
         const int64_t *fv = F + 3 * f;
-        const double *r = emb->lg_rest + 9 * f, *w = r + 6;
+        const double *r = emb->lg_rest + REST * f, *w = r + 6, *wi = r + 9;
         const double *p0 = xyz + 3 * fv[0], *p1 = xyz + 3 * fv[1], *p2 = xyz + 3 * fv[2];
         double d[3][3], S[6], R[6];
         for (int i = 0; i < 3; i++) {
@@ -240,7 +245,7 @@ static double local_step(const es_embedder *emb, const double *xyz, double *b, d
         double *a0 = acc + 3 * fv[0], *a1 = acc + 3 * fv[1], *a2 = acc + 3 * fv[2];
         for (int k = 0; k < 3; k++) {
             double *to = k == 0 ? a1 : k == 1 ? a2 : a0, *from = k == 0 ? a0 : k == 1 ? a1 : a2;
-            double iw = 1.0 / w[k], e = 0;
+            double iw = wi[k], e = 0;
             for (int i = 0; i < 3; i++) {
                 double ri = R[2 * i] * r[2 * k] + R[2 * i + 1] * r[2 * k + 1];   /* w_k R r_k */
                 double dv = d[k][i] - ri * iw;
