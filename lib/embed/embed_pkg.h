@@ -307,6 +307,17 @@ es_status es__embed_solve_ext(es_ctx *ctx, es_embedder *emb, const double *targe
                               double scale, const double *init_alpha, const es__solve_ext *ext,
                               const es_embed_opts *opts, double *xyz, es_embed_report *report);
 
+/* Whether the Levenberg-Marquardt polish may run after the local-global
+ * iterations: asked for, and the mesh below polish_max_verts. */
+int es__polish_allowed(const es_embedder *emb, const es_embed_opts *o);
+
+/* Whether `start`, scaled to the target's sum at `scale` as the solve
+ * scales it, is more than max_rms (RMS ratio) off the target's lengths:
+ * then a solve from positions with start_auto tries stages 2-3 from the
+ * dihedrals too (positions_start). Uses emb->ltarget, lpath and xyz_try. */
+int es__start_beyond(es_embedder *emb, const double *target, double scale, const double *start,
+                     double max_rms);
+
 /* ---- vertex figures (closure.c) ----------------------------------------- */
 
 /* Corner angles of all faces from lengths (3 x F, angle at corner k of

@@ -9,6 +9,7 @@
 #define EDGESPACE_EMBED_PRIVATE_H
 
 #include "core/core_private.h"
+#include "edgespace/es_embed.h"
 
 /* ---- sparse SPD systems (spd.c) ---------------------------------------------
  * A set of sparse symmetric positive definite matrices that share one
@@ -41,6 +42,20 @@ es_status es__spd_solve(es__spd *s, int64_t id, int64_t nrhs, double *b, int64_t
 /* Matrices in the set and their order. */
 int64_t es__spd_count(const es__spd *s);
 int64_t es__spd_size(const es__spd *s, int64_t id);
+
+/* ---- the prior's dihedrals, only where a solve reads them (prior.c) ----------
+ * Whether es_embed_prior_solve(emb, target, scale, prior, opts) reads
+ * prior->alpha and prior->sd, for a prior with these positions and start
+ * (NULL: none): on a closed mesh without the bending term (the dihedral
+ * path), with the Levenberg-Marquardt solver or polish, or where the start
+ * is too far off the lengths (prior_start_max_rms: stages 2-3 from the
+ * dihedrals are tried). Otherwise they may be NULL and the output is the
+ * same; only report.closure_before, then measured at the prior positions'
+ * own dihedrals, differs. A study's session spares the circular means over
+ * its rows that way (face-study, 87 rows: a seventh of a slider step). */
+int es__prior_solve_reads_dihedrals(es_embedder *emb, const double *target, double scale,
+                                    const double *prior_xyz, const double *start,
+                                    const es_embed_opts *opts);
 
 /* ---- rotations (align.c) ----------------------------------------------------- */
 

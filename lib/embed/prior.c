@@ -14,6 +14,7 @@
  * midpoints come out as es_interp_embed's).
  */
 #include "embed/embed_pkg.h"
+#include "embed/embed_private.h"
 #include "edgespace/es_geom.h"
 
 #include <math.h>
@@ -228,6 +229,32 @@ static es_status shape_quality(es_ctx *ctx, es_embedder *emb, const double *xyz,
     return ES_OK;
 }
 
+/* Whether es_embed_prior_solve below uses the bending term (open meshes,
+ * or closed ones when asked); without it a closed mesh takes the dihedral
+ * path from the prior's dihedrals. */
+static int bends(const es_embedder *emb, const es_embed_opts *o)
+{
+    int open = 0;
+    for (int64_t e = 0; e < emb->ne && !open; e++) open = emb->eb[e];
+    return o->prior_mu > 0 && (open || o->prior_bend_closed);
+}
+
+int es__prior_solve_reads_dihedrals(es_embedder *emb, const double *target, double scale,
+                                    const double *prior_xyz, const double *start,
+                                    const es_embed_opts *opts)
+{
+    es_embed_opts dflt;
+    if (!emb || !target || !prior_xyz) return 1;
+    if (!opts) {
+        es_embed_opts_init(&dflt);
+        opts = &dflt;
+    }
+    if (!bends(emb, opts) || opts->solver == ES_EMBED_SOLVER_LM || es__polish_allowed(emb, opts))
+        return 1;
+    return es__start_beyond(emb, target, scale, start ? start : prior_xyz,
+                            opts->prior_start_max_rms);
+}
+
 es_status es_embed_prior_solve(es_ctx *ctx, es_embedder *emb, const double *target, double scale,
                                const es_embed_prior *prior, const es_embed_opts *opts, double *xyz,
                                es_embed_report *report)
@@ -237,7 +264,7 @@ es_status es_embed_prior_solve(es_ctx *ctx, es_embedder *emb, const double *targ
     es__bend_prior bp;
     es__solve_ext ext;
     double sum = 0, f;
-    int open = 0, bend;
+    int bend;
     es_status rc;
     if (!emb) ES_FAIL(ctx, ES_EINVAL, "embed: no embedder");
     if (!prior || !prior->xyz) ES_FAIL(ctx, ES_EINVAL, "embed: the prior's positions are required");
@@ -273,8 +300,7 @@ es_status es_embed_prior_solve(es_ctx *ctx, es_embedder *emb, const double *targ
     f = scale > 0 && sum > 0 ? scale / sum : 1.0;
     for (int64_t e = 0; e < emb->ne; e++) emb->ltarget[e] = target[e] * f;
     es__bend_weights(emb, emb->ltarget, prior->sd, opts->prior_sd_floor, emb->omega);
-    for (int64_t e = 0; e < emb->ne && !open; e++) open = emb->eb[e];
-    bend = opts->prior_mu > 0 && (open || opts->prior_bend_closed);
+    bend = bends(emb, opts);
     bp = (es__bend_prior){emb->prior_alpha, emb->omega, emb->flap, opts->prior_mu,
                           opts->prior_decay, opts->prior_mu * opts->prior_mu_floor};
     memset(&ext, 0, sizeof ext);

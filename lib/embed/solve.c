@@ -213,17 +213,25 @@ static es_status linear_stages(es_embedder *emb, const double *alpha, const doub
  * lengths (a vertex blend of rows whose parts rotate far apart, e.g. two
  * poses of a cat: 6-8 %; a blend of faces: 0.7-2.2 %), the stages 2-3 mesh
  * of alpha if that is closer. */
+/* xyz = start scaled so that its lengths sum to `sum`; returns the RMS
+ * ratio of its lengths against L. */
+static double scaled_start(const es_embedder *emb, const double *start, const double *L,
+                           double sum, double *xyz)
+{
+    double s0 = 0, rms, mx;
+    edge_lengths_of(emb, start, emb->lpath);
+    for (int64_t e = 0; e < emb->ne; e++) s0 += emb->lpath[e];
+    for (int64_t i = 0; i < 3 * emb->nv; i++) xyz[i] = start[i] * (s0 > 0 ? sum / s0 : 1.0);
+    es__length_fit(emb, xyz, L, &rms, &mx);
+    return rms;
+}
+
 static es_status positions_start(es_embedder *emb, const es__solve_ext *ext, const double *alpha,
                                  const double *L, double *xyz, es_embed_report *rep)
 {
     int64_t n3 = 3 * emb->nv;
-    double s0 = 0, mx;
     es_status rc;
-    edge_lengths_of(emb, ext->start_xyz, emb->lpath);
-    for (int64_t e = 0; e < emb->ne; e++) s0 += emb->lpath[e];
-    for (int64_t i = 0; i < n3; i++)
-        xyz[i] = ext->start_xyz[i] * (s0 > 0 ? rep->scale / s0 : 1.0);
-    es__length_fit(emb, xyz, L, &rep->rms_ratio_linear, &mx);
+    rep->rms_ratio_linear = scaled_start(emb, ext->start_xyz, L, rep->scale, xyz);
     if (ext->start_auto && alpha && rep->rms_ratio_linear > ext->start_max_rms) {
         double r2, m2, *lx = emb->xyz_best;
         if ((rc = linear_stages(emb, alpha, L, lx, rep)) != ES_OK) return rc;
@@ -234,6 +242,18 @@ static es_status positions_start(es_embedder *emb, const es__solve_ext *ext, con
         }
     }
     return ES_OK;
+}
+
+int es__start_beyond(es_embedder *emb, const double *target, double scale, const double *start,
+                     double max_rms)
+{
+    double sum = 0, f;
+    for (int64_t e = 0; e < emb->ne; e++) sum += target[e];
+    if (!(sum > 0 && isfinite(sum))) return 1;   /* the solve refuses it; let it */
+    f = scale > 0 ? scale / sum : 1.0;
+    for (int64_t e = 0; e < emb->ne; e++) emb->ltarget[e] = target[e] * f;
+    /* as embed_solve forms L and the scale, and positions_start decides */
+    return scaled_start(emb, start, emb->ltarget, scale > 0 ? scale : sum, emb->xyz_try) > max_rms;
 }
 
 /* Stage 4 (Levenberg-Marquardt on the lengths, with the bending prior) from
@@ -282,7 +302,7 @@ static int polish_too_costly(const es_embedder *emb, const es_embed_opts *o)
 
 /* Whether the Levenberg-Marquardt polish may run: asked for, and the mesh
  * below that size. */
-static int polish_allowed(const es_embedder *emb, const es_embed_opts *o)
+int es__polish_allowed(const es_embedder *emb, const es_embed_opts *o)
 {
     return o->lg_polish > 0 && o->refine_max_iter > 0 && !polish_too_costly(emb, o);
 }
@@ -336,7 +356,7 @@ static es_status shape_from_start(es_embedder *emb, const es_embed_opts *o, es__
      * rows: bending 1.22 x the prior's with the last weight, 1.07 with 3 x
      * the first, length RMS 0.04 % -> 0.13 %) */
     int inconsistent = rep->n_bad_faces > 0 && o->realize_bend > 0 && bp;
-    if ((!res.met || inconsistent) && polish_allowed(emb, o)) {
+    if ((!res.met || inconsistent) && es__polish_allowed(emb, o)) {
         es__refine_opts ro = es__refine_opts_from(o);
         es__bend_prior hold;
         /* a few iterations: chasing the last edges' error for longer crumpled

@@ -18,6 +18,7 @@
  * walk of the synthetic faces from mean - 2 sd on PC 1 (bending 1.48), it
  * kept every later frame folded (1.45-1.49, where each frame alone bends
  * 1.00-1.21); that frame starts from its prior instead. */
+#include "embed/embed_private.h"
 #include "study/study_pkg.h"
 
 #include <math.h>
@@ -135,11 +136,19 @@ es_status es_study_embedder_solve(es_ctx *ctx, es_study_embedder *se, const doub
     memset(res, 0, sizeof *res);
     res->scale = scale;
     int64_t n3 = 3 * se->nv;
-    if ((rc = es_study_prior(ctx, se->rows, w, se->prior, alpha, sd)) != ES_OK) return rc;
+    if ((rc = es_study_prior(ctx, se->rows, w, se->prior, NULL, NULL)) != ES_OK) return rc;
     warm = warm && se->have_last && se->last_ok;
     if (warm)   /* (the solve scales the start to the target's sum) */
         for (int64_t i = 0; i < n3; i++) se->start[i] = se->prior[i] + se->correction[i];
-    es_embed_prior pr = {se->prior, alpha, sd, warm ? se->start : NULL};
+    /* the circular means of the rows' dihedrals and their spread (twice the
+     * work of the positions' blend) only where the solve reads them: not
+     * for local-global iterations alone (a slider, a walk, --fast) from a
+     * start near the lengths */
+    int dihedrals = es__prior_solve_reads_dihedrals(se->emb, lengths, scale, se->prior,
+                                                    warm ? se->start : NULL, &o);
+    if (dihedrals && (rc = es_study_prior(ctx, se->rows, w, NULL, alpha, sd)) != ES_OK) return rc;
+    es_embed_prior pr = {se->prior, dihedrals ? alpha : NULL, dihedrals ? sd : NULL,
+                         warm ? se->start : NULL};
     if ((rc = es_embed_prior_solve(ctx, se->emb, lengths, scale, &pr, &o, xyz, &res->report)) !=
         ES_OK)
         return rc;

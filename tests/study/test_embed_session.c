@@ -276,6 +276,31 @@ int main(void)
         es_study_embedder_free(se);
         free(walk);
     }
+    {   /* local-global alone (--fast, a slider): the session does not form the
+         * circular means of the rows' dihedrals, which such a solve does not
+         * read, and its mesh is the very one es_embed_prior_solve makes given
+         * them (the oracle: the whole prior, es_study_prior) */
+        es_study_embedder *se = NULL;
+        es_study_embed_result r;
+        es_embed_report rep;
+        es_embed_opts fo;
+        int64_t ne = es_store_nedges(s), N = es_store_nrows(s);
+        double *l0 = malloc((size_t)(ne + N) * sizeof *l0), *w0 = l0 + ne, sc;
+        double *pri = malloc((size_t)(n3 + 2 * ne) * sizeof *pri), *al = pri + n3, *sd = al + ne;
+        es_embed_opts_fast(&fo);
+        ES_CHECK_OK(ctx, es_study_embedder_open(ctx, s, 1, &se));
+        for (int k = 0; k < 3; k++) {
+            ES_CHECK_OK(ctx, es_study_point_weights(ctx, s, points[k], "p", l0, &sc, w0));
+            ES_CHECK_OK(ctx, es_study_embedder_solve(ctx, se, l0, sc, w0, &fo, 0, 0, got, &r));
+            ES_CHECK_OK(ctx, es_study_prior(ctx, es_study_embedder_rows(se), w0, pri, al, sd));
+            es_embed_prior pr = {pri, al, sd, NULL};
+            ES_CHECK_OK(ctx, es_embed_prior_solve(ctx, es_study_embedder_embedder(se), l0, sc,
+                                                  &pr, &fo, ref, &rep));
+            ES_CHECK(same(ref, got, n3) && r.report.lg_iters == rep.lg_iters);
+        }
+        es_study_embedder_free(se);
+        free(l0), free(pri);
+    }
     {   /* the session keeps a point's leaves (embed_leaves.c): its embedding of an
          * expression is the one of the lengths, scale and row weights that
          * es_study_point_weights reads afresh from the store (the oracle), on every
