@@ -28,7 +28,7 @@
 #include <unistd.h>
 
 #define CACHE_MAGIC 0x3165686361437365ull   /* "esCache1" */
-#define CACHE_VERSION 2                     /* bump when the cached values change meaning */
+#define CACHE_VERSION 3                     /* bump when the cached values or the check change */
 #define CACHE_HEAD 7                        /* header words */
 
 /* The cache file's path: the store's with ".es-cache" appended. */
@@ -66,22 +66,46 @@ es_status es__study_cache_key(es_ctx *ctx, es_store *s, uint64_t *key)
 }
 
 /* The body's check word: FNV-1a's step over whole 64-bit words (h ^ w,
- * times the FNV prime). Both steps are bijections, so a body that differs
- * in any one word always gives another check; a changed value that stays
- * finite (a flipped sign) would otherwise be taken as a row's. */
-static uint64_t check_words(uint64_t h, const void *p, int64_t nwords)
+ * times the FNV prime) in four lanes, word i into lane i mod 4, the lanes
+ * folded with the same step at the end. Both steps are bijections, so a
+ * body that differs in any one word always gives another check; a changed
+ * value that stays finite (a flipped sign) would otherwise be taken as a
+ * row's. Four lanes because one is a chain of multiplications each
+ * waiting for the last: 25 ms of a fresh command's 0.3 s on face-study's
+ * 40 MB (format 2), against a quarter of that. */
+typedef struct check_lanes {
+    uint64_t h[4];
+    int64_t next;   /* the lane of the next word */
+} check_lanes;
+
+static void check_words(check_lanes *c, const void *p, int64_t nwords)
 {
     const uint64_t *w = p;
-    for (int64_t i = 0; i < nwords; i++) h = (h ^ w[i]) * ES__FNV_PRIME;
-    return h;
+    int64_t i = 0;
+    for (; i < nwords && c->next != 0; i++, c->next = (c->next + 1) & 3)
+        c->h[c->next] = (c->h[c->next] ^ w[i]) * ES__FNV_PRIME;
+    uint64_t h0 = c->h[0], h1 = c->h[1], h2 = c->h[2], h3 = c->h[3];
+    for (; i + 4 <= nwords; i += 4) {
+        h0 = (h0 ^ w[i]) * ES__FNV_PRIME;
+        h1 = (h1 ^ w[i + 1]) * ES__FNV_PRIME;
+        h2 = (h2 ^ w[i + 2]) * ES__FNV_PRIME;
+        h3 = (h3 ^ w[i + 3]) * ES__FNV_PRIME;
+    }
+    c->h[0] = h0, c->h[1] = h1, c->h[2] = h2, c->h[3] = h3;
+    for (; i < nwords; i++, c->next = (c->next + 1) & 3)
+        c->h[c->next] = (c->h[c->next] ^ w[i]) * ES__FNV_PRIME;
 }
 
 static uint64_t body_check(int64_t nv, int64_t ne, int64_t n, const int64_t *order,
                            const double *aligned, const double *alpha)
 {
-    uint64_t h = check_words(ES__FNV_OFFSET, order, nv);
-    h = check_words(h, aligned, 3 * nv * n);
-    return check_words(h, alpha, ne * n);
+    check_lanes c = {{ES__FNV_OFFSET, ES__FNV_OFFSET, ES__FNV_OFFSET, ES__FNV_OFFSET}, 0};
+    check_words(&c, order, nv);
+    check_words(&c, aligned, 3 * nv * n);
+    check_words(&c, alpha, ne * n);
+    uint64_t h = ES__FNV_OFFSET;
+    for (int k = 0; k < 4; k++) h = (h ^ c.h[k]) * ES__FNV_PRIME;
+    return h;
 }
 
 /* Whether order is a permutation of 0 .. nv-1 (a corrupt cache's would be

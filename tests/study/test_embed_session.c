@@ -86,15 +86,19 @@ static void corrupt(const char *path, long at, const void *bytes, size_t n)
     fclose(f);
 }
 
-/* The cache's check word, computed here from the format's description:
- * FNV-1a's step over the body's 64-bit words. */
+/* The cache's check word, computed here from the format's description
+ * (datasets-spec/cache-format.md): FNV-1a's step over the body's 64-bit
+ * words in four lanes (word i into lane i mod 4), the lanes folded by the
+ * same step. */
 static uint64_t check_word(const unsigned char *body, size_t bytes)
 {
-    uint64_t h = 0xcbf29ce484222325ull, w;
+    const uint64_t basis = 0xcbf29ce484222325ull, prime = 0x100000001b3ull;
+    uint64_t lane[4] = {basis, basis, basis, basis}, w, h = basis;
     for (size_t i = 0; i + 8 <= bytes; i += 8) {
         memcpy(&w, body + i, 8);
-        h = (h ^ w) * 0x100000001b3ull;
+        lane[(i / 8) % 4] = (lane[(i / 8) % 4] ^ w) * prime;
     }
+    for (int k = 0; k < 4; k++) h = (h ^ lane[k]) * prime;
     return h;
 }
 
