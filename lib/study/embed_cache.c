@@ -75,36 +75,52 @@ es_status es__study_cache_key(es_ctx *ctx, es_store *s, uint64_t *key)
  * 40 MB (format 2), against a quarter of that. */
 typedef struct check_lanes {
     uint64_t h[4];
-    int64_t next;   /* the lane of the next word */
+    int64_t next;        /* the lane of the next word */
+    uint64_t nonfinite;  /* non-zero once a double word was an infinity or a NaN */
 } check_lanes;
 
-static void check_words(check_lanes *c, const void *p, int64_t nwords)
+/* A double's exponent bits all set: an infinity or a NaN. */
+#define NONFINITE(w) (((w) & 0x7ff0000000000000ull) == 0x7ff0000000000000ull)
+
+/* The words into the lanes; doubles: also whether one is not finite (in the
+ * same pass: the rows are read from memory once, not three times) */
+static void check_words(check_lanes *c, const void *p, int64_t nwords, int doubles)
 {
     const uint64_t *w = p;
+    uint64_t bad = 0;
     int64_t i = 0;
-    for (; i < nwords && c->next != 0; i++, c->next = (c->next + 1) & 3)
+    for (; i < nwords && c->next != 0; i++, c->next = (c->next + 1) & 3) {
         c->h[c->next] = (c->h[c->next] ^ w[i]) * ES__FNV_PRIME;
+        bad |= NONFINITE(w[i]);
+    }
     uint64_t h0 = c->h[0], h1 = c->h[1], h2 = c->h[2], h3 = c->h[3];
     for (; i + 4 <= nwords; i += 4) {
         h0 = (h0 ^ w[i]) * ES__FNV_PRIME;
         h1 = (h1 ^ w[i + 1]) * ES__FNV_PRIME;
         h2 = (h2 ^ w[i + 2]) * ES__FNV_PRIME;
         h3 = (h3 ^ w[i + 3]) * ES__FNV_PRIME;
+        bad |= NONFINITE(w[i]) | NONFINITE(w[i + 1]) | NONFINITE(w[i + 2]) | NONFINITE(w[i + 3]);
     }
     c->h[0] = h0, c->h[1] = h1, c->h[2] = h2, c->h[3] = h3;
-    for (; i < nwords; i++, c->next = (c->next + 1) & 3)
+    for (; i < nwords; i++, c->next = (c->next + 1) & 3) {
         c->h[c->next] = (c->h[c->next] ^ w[i]) * ES__FNV_PRIME;
+        bad |= NONFINITE(w[i]);
+    }
+    if (doubles) c->nonfinite |= bad;
 }
 
+/* The check word of the body; *nonfinite: whether a position or dihedral
+ * is not finite. */
 static uint64_t body_check(int64_t nv, int64_t ne, int64_t n, const int64_t *order,
-                           const double *aligned, const double *alpha)
+                           const double *aligned, const double *alpha, int *nonfinite)
 {
-    check_lanes c = {{ES__FNV_OFFSET, ES__FNV_OFFSET, ES__FNV_OFFSET, ES__FNV_OFFSET}, 0};
-    check_words(&c, order, nv);
-    check_words(&c, aligned, 3 * nv * n);
-    check_words(&c, alpha, ne * n);
+    check_lanes c = {{ES__FNV_OFFSET, ES__FNV_OFFSET, ES__FNV_OFFSET, ES__FNV_OFFSET}, 0, 0};
+    check_words(&c, order, nv, 0);
+    check_words(&c, aligned, 3 * nv * n, 1);
+    check_words(&c, alpha, ne * n, 1);
     uint64_t h = ES__FNV_OFFSET;
     for (int k = 0; k < 4; k++) h = (h ^ c.h[k]) * ES__FNV_PRIME;
+    if (nonfinite) *nonfinite = c.nonfinite != 0;
     return h;
 }
 
@@ -185,14 +201,13 @@ es_status es__study_cache_load(es_ctx *ctx, es_store *s, uint64_t key, int64_t *
     const int64_t *map_ord = (const int64_t *)(head + CACHE_HEAD);
     double *aligned = (double *)(head + CACHE_HEAD + nv), *alpha = aligned + 3 * nv * n;
     const char *bad = NULL;
-    if (body_check(nv, ne, n, map_ord, aligned, alpha) != head[6])
+    int nonfinite = 0;
+    if (body_check(nv, ne, n, map_ord, aligned, alpha, &nonfinite) != head[6])
         bad = "does not match its check word (changed since it was written)";
     else if (!is_permutation(ctx, map_ord, nv, &rc))
         bad = rc == ES_OK ? "holds a vertex order that is not a permutation" : NULL;
-    for (int64_t i = 0; !bad && rc == ES_OK && i < 3 * nv * n; i++)
-        if (!isfinite(aligned[i])) bad = "holds values that are not finite";
-    for (int64_t i = 0; !bad && rc == ES_OK && i < ne * n; i++)
-        if (!isfinite(alpha[i])) bad = "holds values that are not finite";
+    else if (nonfinite)
+        bad = "holds values that are not finite";
     if (!bad && rc == ES_OK && !(ord = es__alloc_array(ctx, nv, sizeof *ord))) rc = ES_ENOMEM;
     if (bad || rc != ES_OK) {
         munmap(head, len);
@@ -219,7 +234,7 @@ void es__study_cache_save(es_ctx *ctx, es_store *s, uint64_t key, const int64_t 
     cache_path(s, path, sizeof path);
     es__study_rows_arrays(rows, &aligned, &alpha);
     uint64_t head[CACHE_HEAD] = {CACHE_MAGIC, CACHE_VERSION, key, (uint64_t)nv, (uint64_t)ne,
-                                 (uint64_t)n, body_check(nv, ne, n, order, aligned, alpha)};
+                                 (uint64_t)n, body_check(nv, ne, n, order, aligned, alpha, NULL)};
     /* a cache that cannot be written is no failure of the command: its
      * message goes to a context of its own and into the log */
     if (es_ctx_new(&quiet) != ES_OK) return;

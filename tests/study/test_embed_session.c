@@ -102,16 +102,18 @@ static uint64_t check_word(const unsigned char *body, size_t bytes)
     return h;
 }
 
-/* The vertex order's second entry made the first's, the check word
- * rewritten to match (so that only the permutation check can refuse it). */
-static void repeat_a_vertex(const char *path, long size)
+/* n bytes written at `at` (or, bytes NULL, the vertex order's second entry
+ * made the first's), the check word rewritten to match: so that only the
+ * checks after it (a permutation, finite values) can refuse the file. */
+static void change_and_recheck(const char *path, long size, long at, const void *bytes, size_t n)
 {
     unsigned char *b = malloc((size_t)size);
     FILE *f = fopen(path, "r+b");
     ES_CHECK(b && f && fread(b, 1, (size_t)size, f) == (size_t)size);
     if (b && f) {
         uint64_t check;
-        memcpy(b + 56 + 8, b + 56, 8);
+        if (bytes) memcpy(b + at, bytes, n);
+        else memcpy(b + 56 + 8, b + 56, 8);
         check = check_word(b + 56, (size_t)size - 56);
         memcpy(b + 48, &check, 8);
         rewind(f);
@@ -188,11 +190,20 @@ int main(void)
         embed_all(ctx, s, 1, got, nv);
         ES_CHECK(same(ref, got, 3 * n3) && strstr(cache_notes, "check word"));
     }
-    repeat_a_vertex(cache, size);                         /* not a permutation */
+    change_and_recheck(cache, size, 0, NULL, 0);          /* not a permutation */
     saw_cache_note = 0;
     embed_all(ctx, s, 1, got, nv);
     ES_CHECK_MSG(same(ref, got, 3 * n3) && strstr(cache_notes, "not a permutation"),
                  "notes: %s", cache_notes);
+    for (int k = 0; k < 2; k++) {   /* an infinity among the positions, a NaN among the
+                                       dihedrals, each under a matching check word */
+        const double v = k ? nan : INFINITY;
+        change_and_recheck(cache, size, k ? size - 8 : 56 + 8 * (long)nv + 8, &v, sizeof v);
+        saw_cache_note = 0;
+        embed_all(ctx, s, 1, got, nv);
+        ES_CHECK_MSG(same(ref, got, 3 * n3) && strstr(cache_notes, "not finite"), "notes: %s",
+                     cache_notes);
+    }
     ES_CHECK(truncate(cache, size / 2) == 0);             /* cut short */
     saw_cache_note = 0;
     embed_all(ctx, s, 1, got, nv);
