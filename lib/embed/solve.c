@@ -208,11 +208,6 @@ static es_status linear_stages(es_embedder *emb, const double *alpha, const doub
     return ES_OK;
 }
 
-/* Stage 4 from positions: xyz = start scaled to the target's sum, or, when
- * ext->start_auto and those positions are more than start_max_rms off the
- * lengths (a vertex blend of rows whose parts rotate far apart, e.g. two
- * poses of a cat: 6-8 %; a blend of faces: 0.7-2.2 %), the stages 2-3 mesh
- * of alpha if that is closer. */
 /* xyz = start scaled so that its lengths sum to `sum`; returns the RMS
  * ratio of its lengths against L. */
 static double scaled_start(const es_embedder *emb, const double *start, const double *L,
@@ -226,6 +221,11 @@ static double scaled_start(const es_embedder *emb, const double *start, const do
     return rms;
 }
 
+/* Stage 4 from positions: xyz = start scaled to the target's sum, or, when
+ * ext->start_auto and those positions are more than start_max_rms off the
+ * lengths (a vertex blend of rows whose parts rotate far apart, e.g. two
+ * poses of a cat: 6-8 %; a blend of faces: 0.7-2.2 %), the stages 2-3 mesh
+ * of alpha if that is closer. */
 static es_status positions_start(es_embedder *emb, const es__solve_ext *ext, const double *alpha,
                                  const double *L, double *xyz, es_embed_report *rep)
 {
