@@ -56,6 +56,10 @@ ES_API es_status es_ctx_join_parallel(es_ctx *ctx);
 ES_API int es_ctx_rank(const es_ctx *ctx);
 ES_API int es_ctx_nranks(const es_ctx *ctx);
 
+/* The contiguous share [*lo, *hi) of n items (rows, configurations) that
+ * this rank takes: the first n % P ranks take one more; 0 and n alone. */
+ES_API void es_ctx_share(const es_ctx *ctx, int64_t n, int64_t *lo, int64_t *hi);
+
 /* Wait for every rank of ctx's job (MPI_Barrier); ES_OK at once alone. */
 ES_API es_status es_ctx_barrier(es_ctx *ctx);
 
