@@ -178,7 +178,12 @@ es_status es__h5_append_rows(es_ctx *ctx, hid_t loc, const char *name, hid_t mty
     count[0] = (hsize_t)n;
     for (int k = 1; k < rank; k++) count[k] = dims[k];
     dims[0] += (hsize_t)n;
-    if (H5Dset_extent(ds, dims) < 0 || (fsp = H5Dget_space(ds)) < 0 ||
+    if (H5Dset_extent(ds, dims) < 0) {
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot append to dataset '%s'", name);
+        goto done;
+    }
+    if (!buf) goto done;   /* room only: the ranks write the rows (store_ranks.c) */
+    if ((fsp = H5Dget_space(ds)) < 0 ||
         H5Sselect_hyperslab(fsp, H5S_SELECT_SET, start, NULL, count, NULL) < 0 ||
         (msp = H5Screate_simple(rank, count, NULL)) < 0 ||
         H5Dwrite(ds, mtype, msp, fsp, H5P_DEFAULT, buf) < 0)

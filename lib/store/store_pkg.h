@@ -114,7 +114,8 @@ hid_t es__h5_open_ds_nocache(hid_t loc, const char *name);
  * d1 (x d2) elements of elem_bytes each. */
 es_status es__h5_create_rows(es_ctx *ctx, hid_t loc, const char *name, hid_t ftype, int rank,
                              hsize_t d1, hsize_t d2, size_t elem_bytes);
-/* Append n rows from buf (memory type mtype, the dataset's row shape). */
+/* Append n rows from buf (memory type mtype, the dataset's row shape);
+ * buf NULL: make room for them only (HDF5's fill value until written). */
 es_status es__h5_append_rows(es_ctx *ctx, hid_t loc, const char *name, hid_t mtype,
                              int64_t n, const void *buf);
 /* Write (replacing) a scalar int64, a scalar float64, a string, or a 1-D
