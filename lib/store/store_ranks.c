@@ -11,9 +11,9 @@
  * makes (chunked, unlimited rows, no filters): Debian 12's HDF5 1.10.8
  * writes chunked datasets collectively, and would filtered ones since
  * 1.10.2, but the store has no filters, so nothing of its format changes.
- * Rank 0 made room for the rows before (es__store_reserve_values), so no
- * rank changes a dataset's extent and the chunks are allocated
- * collectively by the writes. Only the working copy is written: the store
+ * Rank 0 made room for the rows before (es__store_reserve_values) and
+ * allocated their chunks (es__h5_allocate_rows says why), so no rank
+ * changes a dataset's extent or allocates: the ranks only overwrite. Only the working copy is written: the store
  * is published, or not, by rank 0's commit, as ever.
  */
 #include "store/store_pkg.h"
@@ -127,16 +127,18 @@ es_status es__store_ranks_write(es_ctx *ctx, es__store_ranks *h, int64_t row0, i
 {
     es_status rc = ES_OK;
     htri_t has_lengths;
-    /* every rank writes every dataset (collective), whatever its n */
+    /* every rank writes every dataset (collective), whatever its n, and
+     * none goes on to the next after a failure on any (it would wait) */
     H5E_BEGIN_TRY {
         has_lengths = H5Lexists(h->file, "/shapes/lengths", H5P_DEFAULT);
+        if (has_lengths > 0)
+            rc = es__par_agree(ctx, write_rows(ctx, h->file, "/shapes/lengths", row0, n, lengths));
         if (has_lengths > 0 && rc == ES_OK)
-            rc = write_rows(ctx, h->file, "/shapes/lengths", row0, n, lengths);
-        if (has_lengths > 0 && rc == ES_OK)
-            rc = write_rows(ctx, h->file, "/shapes/scales", row0, n, scales);
-        if (rc == ES_OK) rc = write_rows(ctx, h->file, "/shapes/positions", row0, n, xyz);
+            rc = es__par_agree(ctx, write_rows(ctx, h->file, "/shapes/scales", row0, n, scales));
+        if (rc == ES_OK)
+            rc = es__par_agree(ctx, write_rows(ctx, h->file, "/shapes/positions", row0, n, xyz));
     } H5E_END_TRY
-    return es__par_agree(ctx, rc);
+    return rc;
 }
 
 es_status es__store_ranks_close(es_ctx *ctx, es_store *s, es__store_ranks *h)

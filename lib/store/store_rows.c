@@ -500,7 +500,11 @@ es_status es__store_reserve_values(es_ctx *ctx, es_store *s, int64_t n)
               (rc = es__h5_append_rows(ctx, s->file, "/shapes/scales", H5T_NATIVE_DOUBLE, n,
                                        NULL)))) ||
             (rc = es__h5_append_rows(ctx, s->file, "/shapes/positions", H5T_NATIVE_DOUBLE, n,
-                                     NULL)))
+                                     NULL)) ||
+            (s->nedges > 0 &&
+             ((rc = es__h5_allocate_rows(ctx, s->file, "/shapes/lengths", s->nrows, n)) ||
+              (rc = es__h5_allocate_rows(ctx, s->file, "/shapes/scales", s->nrows, n)))) ||
+            (rc = es__h5_allocate_rows(ctx, s->file, "/shapes/positions", s->nrows, n)))
             s->broken = true;
     } H5E_END_TRY
     return rc;
