@@ -3,9 +3,10 @@
  *
  * A library built with -Dmpi=enabled (Open MPI and Debian's openmpi build of
  * HDF5) runs PCA (Gram, covariance and randomized routes: es_pca_fit, and
- * `mpirun -n P edgespace pca`) and the permutations of a linear model
- * (es_model_fit) on P processes ("ranks"); ingest and GPA are still one
- * process (datasets-spec/parallel.md says what runs where). Every rank runs the same program: a
+ * `mpirun -n P edgespace pca`), the permutations of a linear model
+ * (es_model_fit), GPA (es_gpa_align_ranks) and mesh ingest
+ * (es_ingest_manifest, es_ingest_files: collective parallel-HDF5 writes)
+ * on P processes ("ranks"); datasets-spec/parallel.md says what runs where. Every rank runs the same program: a
  * context joined to the job (es_ctx_join_parallel) makes those calls
  * collective, so every rank must make them, in the same order and with the
  * same arguments; each returns the same status on every rank, with the
