@@ -37,20 +37,6 @@ static int run_mpi(int P, const char *args, char *err, size_t n)
     return WIFEXITED(st) ? WEXITSTATUS(st) : 128;
 }
 
-static double maxdiff(const double *a, const double *b, int64_t n)
-{
-    double m = 0;
-    for (int64_t i = 0; i < n; i++) m = fmax(m, fabs(a[i] - b[i]));
-    return m;
-}
-
-static double maxabs(const double *a, int64_t n)
-{
-    double m = 0;
-    for (int64_t i = 0; i < n; i++) m = fmax(m, fabs(a[i]));
-    return m;
-}
-
 /* <kind>/<a>/<ds> and <kind>/<b>/<ds> hold the same numbers, to tol(k) of
  * their scale: datasets ds[0 .. nvec-1] are vectors, the rest matrices. */
 static void same_result(es_ctx *ctx, const char *kind, const char *a, const char *b,
@@ -76,9 +62,9 @@ static void same_result(es_ctx *ctx, const char *kind, const char *a, const char
         ES_CHECK_MSG(ma.data && mb.data && ma.rows == mb.rows && ma.cols == mb.cols && n > 0,
                      "%s vs %s: %s/%s shapes differ", a, b, kind, ds[k]);
         if (ma.data && mb.data && ma.rows == mb.rows && ma.cols == mb.cols) {
-            double t = tol[k] * maxabs(ma.data, n);
-            ES_CHECK_MSG(maxdiff(ma.data, mb.data, n) <= t, "%s vs %s: %s/%s differ by %g", a, b,
-                         kind, ds[k], maxdiff(ma.data, mb.data, n));
+            double t = tol[k] * es_test_maxabs(ma.data, n);
+            ES_CHECK_MSG(es_test_maxdiff(ma.data, mb.data, n) <= t, "%s vs %s: %s/%s differ by %g", a, b,
+                         kind, ds[k], es_test_maxdiff(ma.data, mb.data, n));
         }
         es_free(ctx, ma.data);
         es_free(ctx, mb.data);
@@ -138,7 +124,7 @@ static void same_gpa(es_ctx *ctx, const char *a, const char *b)
     int ok = la.data && lb.data && sa.data && sb.data && la.rows == lb.rows &&
              la.cols == lb.cols && sa.rows == sb.rows && sa.cols == sb.cols && sa.rows == la.cols;
     ES_CHECK_MSG(ok, "%s vs %s: the PCs' shapes differ", a, b);
-    double msc = ok ? maxabs(sa.data, sa.rows * sa.cols) : 0;   /* the scores' scale */
+    double msc = ok ? es_test_maxabs(sa.data, sa.rows * sa.cols) : 0;   /* the scores' scale */
     for (int64_t c = 0; ok && c < la.cols; c++) {
         double dot = 0, dl = 0, dsc = 0, ml = 0;
         for (int64_t v = 0; v < la.rows; v++) dot += ES_AT(la, v, c) * ES_AT(lb, v, c);

@@ -23,20 +23,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static double maxdiff(const double *a, const double *b, int64_t n)
-{
-    double m = 0;
-    for (int64_t i = 0; i < n; i++) m = fmax(m, fabs(a[i] - b[i]));
-    return m;
-}
-
-static double maxabs(const double *a, int64_t n)
-{
-    double m = 0;
-    for (int64_t i = 0; i < n; i++) m = fmax(m, fabs(a[i]));
-    return m;
-}
-
 /* n noisy copies of one random k x d template, each scaled, rotated about
  * a random axis and shifted (column-major k x d per column). */
 static double *make(int64_t k, int d, int64_t n, uint64_t seed)
@@ -89,14 +75,14 @@ static void check(es_ctx *job, es_ctx *alone, int64_t k, int d, int64_t n, int s
     ES_CHECK_MSG(fabs(ra.gss - rb.gss) <= 1e-12 * ra.gss && fabs(ra.rmsrho - rb.rmsrho) <= 1e-12 *
                  ra.rmsrho && fabs(ra.total_ss - rb.total_ss) <= 1e-12 * ra.total_ss,
                  "%s: report differs (gss %.17g vs %.17g)", what, ra.gss, rb.gss);
-    double dx = maxdiff(x + lo * kd, mine, kd * (hi - lo)), sx = maxabs(x, kd * n);
+    double dx = es_test_maxdiff(x + lo * kd, mine, kd * (hi - lo)), sx = es_test_maxabs(x, kd * n);
     ES_CHECK_MSG(dx <= 1e-12 * sx, "%s: aligned configurations differ by %g (scale %g)", what,
                  dx, sx);
     static const char *const names[] = {"mean", "size", "rho", "scale", "rotation", "centroid"};
     const int64_t off[] = {0, kd, kd + n, kd + 2 * n, kd + 3 * n, kd + (3 + d * d) * n, len};
     for (int q = 0; q < 6; q++) {
-        double dq = maxdiff(a + off[q], b + off[q], off[q + 1] - off[q]);
-        double sq = maxabs(a + off[q], off[q + 1] - off[q]);
+        double dq = es_test_maxdiff(a + off[q], b + off[q], off[q + 1] - off[q]);
+        double sq = es_test_maxabs(a + off[q], off[q + 1] - off[q]);
         ES_CHECK_MSG(dq <= 1e-12 * sq, "%s: %s differs by %g (scale %g)", what, names[q], dq, sq);
     }
     free(x);
