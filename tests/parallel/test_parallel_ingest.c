@@ -14,7 +14,7 @@
  * already in it (skipped: the rows after them move up); 24 meshes of 10,000
  * vertices appended in rounds of one row a rank (new chunks in a store that
  * has some: what parallel HDF5 got wrong when the ranks allocated them); a
- * corrupt mesh file
+ * warning on the last rank, said once by rank 0; a corrupt mesh file
  * in the last rank's share (every rank fails with its file and line; the
  * store is byte for byte as it was, and a new store is not made); and a
  * rank killed with SIGKILL while the ranks read and write (mpirun ends the
@@ -201,6 +201,26 @@ int main(int argc, char **argv)
                      text ? text : "(no output)");
         free(text);
         same_store(ctx, a0, ap);
+    }
+
+    /* a warning on the last rank (a mesh with two vertices in one place) is said by rank 0 */
+    {
+        enum { NU = 14, NV = 8 };
+        double xyz[3 * NU * NV];
+        int64_t faces[6 * NU * NV];
+        char z[900], mz[900], sz[900];
+        es_test_torus(NU, NV, 5, xyz, faces);
+        memcpy(xyz + 3, xyz, 3 * sizeof *xyz);
+        snprintf(z, sizeof z, "%s/z.obj", dir);
+        ES_CHECK(es_test_write_obj(z, NU * NV, xyz, 2 * NU * NV, faces) == 0);
+        snprintf(mz, sizeof mz, "%s/mz.csv", dir);
+        es_test_write_file(mz, "file\nt0.obj\nt1.obj\nt2.obj\nz.obj\n");
+        snprintf(sz, sizeof sz, "%s/warned.h5", dir);
+        ES_CHECK_MSG(run_ingest(2, sz, mz, "", err, sizeof err) == 0, "mpirun -n 2 ingest: %s",
+                     err);
+        char *w = strstr(err, "z.obj': 1 edge of length 0");
+        ES_CHECK_MSG(w && !strstr(w + 1, "z.obj': 1 edge of length 0"), "the last rank's "
+                     "warning is not said once: %s", err);
     }
 
     /* a corrupt mesh in the last rank's share: every rank fails, the store is unchanged */
