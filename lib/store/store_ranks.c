@@ -147,7 +147,7 @@ es_status es__store_ranks_close(es_ctx *ctx, es_store *s, es__store_ranks *h)
     H5E_BEGIN_TRY {
         if (h && h->file >= 0 && H5Fclose(h->file) < 0)
             rc = es__h5_fail(ctx, ES_EIO, "store: cannot close the working copy on the ranks");
-        if (es__par_rank(ctx) == 0 && s && s->work) {
+        if (es__par_rank(ctx) == 0 && s && s->work && s->file < 0) {
             hid_t fapl = es__h5_file_access();
             s->file = H5Fopen(s->work, H5F_ACC_RDWR, fapl);
             es__h5_close(fapl);
