@@ -104,7 +104,7 @@ static void finalize_mpi(void) { es_parallel_finalize(); }
 /* The commands that run on the ranks of an MPI job (datasets-spec/parallel.md). */
 static int runs_parallel(const char *verb)
 {
-    return !strcmp(verb, "pca") || !strcmp(verb, "model");
+    return !strcmp(verb, "pca") || !strcmp(verb, "model") || !strcmp(verb, "gpa") || !strcmp(verb, "ingest");
 }
 
 /* Started by mpirun (a library built with -Dmpi=enabled): the context joins
@@ -124,7 +124,7 @@ static int join_job(es_ctx *ctx, const char *verb)
         (!freopen("/dev/null", "w", stdout) || !freopen("/dev/null", "w", stderr)))
         return -1;
     if (es_ctx_nranks(ctx) > 1 && !runs_parallel(verb)) {
-        fprintf(stderr, "edgespace %s: does not run on the ranks of an MPI job yet (pca and model do); "
+        fprintf(stderr, "edgespace %s: does not run on the ranks of an MPI job yet (pca, model, gpa and ingest do); "
                 "run it as one process\n", verb);
         return -1;
     }

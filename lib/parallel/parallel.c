@@ -253,7 +253,8 @@ static es_status gather_impl(es_ctx *ctx, const double *mine, const int64_t *cou
     if ((rc = int_counts(ctx, p->size, counts, NULL, c, d)) == ES_OK) {
         err = everyone ? MPI_Allgatherv(mine, c[p->rank], MPI_DOUBLE, all, c, d, MPI_DOUBLE,
                                         p->comm)
-                       : MPI_Gatherv(mine, c[p->rank], MPI_DOUBLE, all, c, d, MPI_DOUBLE, 0,
+                       : MPI_Gatherv(p->rank == 0 && mine == all ? MPI_IN_PLACE : mine,
+                                     c[p->rank], MPI_DOUBLE, all, c, d, MPI_DOUBLE, 0,
                                      p->comm);
         if (err != MPI_SUCCESS) rc = mpi_fail(ctx, err, everyone ? "MPI_Allgatherv" : "MPI_Gatherv");
         else count(p, everyone ? p->size - 1 : p->rank != 0, (int64_t)c[p->rank] * 8 *
@@ -363,6 +364,11 @@ es_status es__par_alltoall(es_ctx *ctx, const double *send, const int64_t *send_
 
 int es_ctx_rank(const es_ctx *ctx) { return es__par_rank(ctx); }
 int es_ctx_nranks(const es_ctx *ctx) { return es__par_size(ctx); }
+
+void es_ctx_share(const es_ctx *ctx, int64_t n, int64_t *lo, int64_t *hi)
+{
+    es__par_split(n, es__par_size(ctx), es__par_rank(ctx), lo, hi);
+}
 
 void es_ctx_parallel_traffic(const es_ctx *ctx, int64_t *messages, int64_t *bytes)
 {

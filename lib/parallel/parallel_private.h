@@ -51,7 +51,8 @@ es_status es__par_bcast(es_ctx *ctx, void *buf, size_t bytes, int root);
 
 /* Rank q sends counts[q] doubles from mine; rank 0 receives them one rank
  * after another into all (sum of counts); counts is the same on every rank.
- * es__par_allgather does the same into every rank's all. */
+ * Rank 0's mine may be all itself (its part is then in place: it comes
+ * first). es__par_allgather does the same into every rank's all. */
 es_status es__par_gather(es_ctx *ctx, const double *mine, const int64_t *counts, double *all);
 es_status es__par_allgather(es_ctx *ctx, const double *mine, const int64_t *counts,
                             double *all);

@@ -20,10 +20,24 @@
  * a set of similar shapes has lambda_1 ~ n and lambda_2 << n, so a few steps
  * suffice).
  *
+ * On the ranks of an MPI job (es_gpa_align_ranks) each rank holds a
+ * contiguous share of the configurations. The sweep is Gauss-Seidel, so
+ * configuration i+1 is rotated onto a sum that already holds i's rotation:
+ * the work is sequential, and splitting it Jacobi-style would change the
+ * iterates and the result. Every pass that carries a running value from one
+ * configuration to the next (the sum, a sum of squares, the largest change)
+ * is a chain (below): the ranks take their shares in turn, each handing the
+ * running values on to all, so every rank adds the same numbers in the same
+ * order as one process and holds the very same bits; the result is the
+ * one-process result, bit for bit up to BLAS's own threading. What the
+ * ranks gain is memory (n/P configurations each) and reading; the per-
+ * configuration dots of the power iteration run side by side.
+ *
  * PCA of tangent coordinates: thin SVD of the centred data when small, else
  * the n x n Gram matrix (meshes: n << k*d) with loadings T V / sigma.
  */
 #include "procrustes/procrustes_pkg.h"
+#include "parallel/parallel_private.h"
 #include "edgespace/es_procrustes.h"
 
 #include <cblas.h>
@@ -45,17 +59,65 @@ typedef struct gpa_state {
     es_ctx *ctx;
     int64_t k, n, kd;
     int d;
-    es_mat x;
-    double *sum;     /* kd: sum of the (scaled) configurations */
+    int ranks, rank;   /* 1 and 0: every configuration is here */
+    int64_t lo, hi;    /* this rank's configurations [lo, hi) of 0 .. n-1 */
+    es_mat x;          /* configurations lo .. hi-1 */
+    double *sum;     /* kd + 1: sum of the (scaled) configurations, then a running max */
     double *norm2;   /* n: ||b_i X_i||^2, the norms including pending scales */
     double *pend;    /* n: pending scale b_i not yet multiplied into column i */
     double *phi;     /* n: Ten Berge eigenvector */
     double *work;    /* max(n*n, kd) */
     double *z;       /* n */
+    double *all;     /* rank 0 of several, exact scaling: every configuration (kd x n) */
     int64_t power_steps;
 } gpa_state;
 
-#define COL(st, j) ((st)->x.data + (int64_t)(j) * (st)->x.ld)
+#define COL(st, j) ((st)->x.data + ((int64_t)(j) - (st)->lo) * (st)->x.ld)
+
+/* One step of a chain: configuration j (this rank's) with the running values acc. */
+typedef es_status (*gpa_step)(gpa_state *st, int64_t j, double *acc, void *ud);
+
+/* step for j = 0 .. n-1 in order, carrying acc[0 .. m) from one to the
+ * next: alone a plain loop; on the ranks each rank runs its share in turn
+ * and broadcasts acc, so that the next rank continues from the very bits
+ * the previous one left (P broadcasts of m doubles). A failure is agreed
+ * on by all ranks after the pass: the lowest failing rank's first failure,
+ * which is the failure one process meets first. */
+static es_status chain(gpa_state *st, double *acc, int64_t m, gpa_step step, void *ud)
+{
+    es_status rc = ES_OK, brc;
+    for (int q = 0; q < st->ranks; q++) {
+        if (q == st->rank)
+            for (int64_t j = st->lo; j < st->hi && rc == ES_OK; j++) rc = step(st, j, acc, ud);
+        if (st->ranks > 1 && (brc = es__par_bcast(st->ctx, acc, (size_t)m * sizeof *acc, q)))
+            return brc;
+    }
+    return st->ranks > 1 ? es__par_agree(st->ctx, rc) : rc;
+}
+
+/* v holds per values for each of the n configurations, this rank's
+ * entries filled: afterwards every rank holds all of them. */
+static es_status gather_shares(gpa_state *st, double *v, int64_t per)
+{
+    int64_t *counts, lo, hi;
+    double *mine;
+    es_status rc;
+    if (st->ranks < 2) return ES_OK;
+    counts = es__alloc_array(st->ctx, st->ranks, sizeof *counts);
+    mine = es__alloc_array(st->ctx, (st->hi - st->lo) * per + 1, sizeof *mine);
+    rc = counts && mine ? ES_OK : ES_ENOMEM;
+    if ((rc = es__par_agree(st->ctx, rc)) == ES_OK) {
+        for (int q = 0; q < st->ranks; q++) {
+            es__par_split(st->n, st->ranks, q, &lo, &hi);
+            counts[q] = (hi - lo) * per;
+        }
+        memcpy(mine, v + st->lo * per, (size_t)((st->hi - st->lo) * per) * sizeof *mine);
+        rc = es__par_allgather(st->ctx, mine, counts, v);
+    }
+    es__free(st->ctx, counts);
+    es__free(st->ctx, mine);
+    return rc;
+}
 
 /* A = X^T (S - X) for one k x d configuration in a single pass (9 or 4
  * accumulators): the cross product with the mean of the others up to the
@@ -88,107 +150,156 @@ static void cross_with_others(int64_t k, int d, const double *x, const double *s
     a[6] = a02; a[7] = a12; a[8] = a22;
 }
 
-/* One Gauss-Seidel rotation sweep; returns the largest ||R - I||_F. A
- * pending scale b_i is applied in the same pass, so the Ten Berge step
- * costs no pass of its own. */
+typedef struct sweep_args { int allow_reflection; double *rot_acc; } sweep_args;
+
+/* Configuration i of a Gauss-Seidel rotation sweep: rotated onto the sum
+ * of the others, the sum s = acc[0 .. kd) updated at once, the largest
+ * ||R - I||_F so far in acc[kd]. A pending scale b_i is applied in the same
+ * pass, so the Ten Berge step costs no pass of its own. */
+static es_status sweep_one(gpa_state *st, int64_t i, double *s, void *ud)
+{
+    const sweep_args *sa = ud;
+    int64_t k = st->k;
+    int d = st->d;
+    double *xi = COL(st, i), a[9], r[9], b = st->pend[i];
+    es_status rc;
+    cross_with_others(k, d, xi, s, b, a);
+    if ((rc = es__procrustes_rotation(st->ctx, d, a, sa->allow_reflection, r, NULL)) != ES_OK)
+        return rc;
+    double c = 0;
+    for (int p = 0; p < d; p++)
+        for (int q = 0; q < d; q++) {
+            double e = r[p + q * d] - (p == q);
+            c += e * e;
+        }
+    c = sqrt(c);
+    if (c > s[st->kd]) s[st->kd] = c;
+    /* X_i <- b X_i R and S += X_i(new) - b X_i(old), one pass */
+    if (d == 2) {
+        for (int64_t v = 0; v < k; v++) {
+            double x0 = b * xi[v], x1 = b * xi[v + k];
+            double y0 = x0 * r[0] + x1 * r[1], y1 = x0 * r[2] + x1 * r[3];
+            s[v] += y0 - x0;
+            s[v + k] += y1 - x1;
+            xi[v] = y0;
+            xi[v + k] = y1;
+        }
+    } else {
+        for (int64_t v = 0; v < k; v++) {
+            double x0 = b * xi[v], x1 = b * xi[v + k], x2 = b * xi[v + 2 * k];
+            double y0 = x0 * r[0] + x1 * r[1] + x2 * r[2];
+            double y1 = x0 * r[3] + x1 * r[4] + x2 * r[5];
+            double y2 = x0 * r[6] + x1 * r[7] + x2 * r[8];
+            s[v] += y0 - x0;
+            s[v + k] += y1 - x1;
+            s[v + 2 * k] += y2 - x2;
+            xi[v] = y0;
+            xi[v + k] = y1;
+            xi[v + 2 * k] = y2;
+        }
+    }
+    st->pend[i] = 1.0;
+    /* cumulative rotation: aligned = x_centred * R_1 R_2 ... */
+    double *ra = sa->rot_acc + i * d * d, t[9];
+    for (int p = 0; p < d; p++)
+        for (int q = 0; q < d; q++) {
+            double acc = 0;
+            for (int l = 0; l < d; l++) acc += ra[p + l * d] * r[l + q * d];
+            t[p + q * d] = acc;
+        }
+    memcpy(ra, t, (size_t)(d * d) * sizeof *t);
+    return ES_OK;
+}
+
+/* One Gauss-Seidel rotation sweep; returns the largest ||R - I||_F. */
 static es_status rotation_sweep(gpa_state *st, int allow_reflection, double *rot_acc,
                                 double *change)
 {
-    int64_t k = st->k;
-    int d = st->d;
-    double *s = st->sum, maxc = 0;
-    for (int64_t i = 0; i < st->n; i++) {
-        double *xi = COL(st, i), a[9], r[9], b = st->pend[i];
-        es_status rc;
-        cross_with_others(k, d, xi, s, b, a);
-        if ((rc = es__procrustes_rotation(st->ctx, d, a, allow_reflection, r, NULL)) != ES_OK)
-            return rc;
-        double c = 0;
-        for (int p = 0; p < d; p++)
-            for (int q = 0; q < d; q++) {
-                double e = r[p + q * d] - (p == q);
-                c += e * e;
-            }
-        c = sqrt(c);
-        if (c > maxc) maxc = c;
-        /* X_i <- b X_i R and S += X_i(new) - b X_i(old), one pass */
-        if (d == 2) {
-            for (int64_t v = 0; v < k; v++) {
-                double x0 = b * xi[v], x1 = b * xi[v + k];
-                double y0 = x0 * r[0] + x1 * r[1], y1 = x0 * r[2] + x1 * r[3];
-                s[v] += y0 - x0;
-                s[v + k] += y1 - x1;
-                xi[v] = y0;
-                xi[v + k] = y1;
-            }
-        } else {
-            for (int64_t v = 0; v < k; v++) {
-                double x0 = b * xi[v], x1 = b * xi[v + k], x2 = b * xi[v + 2 * k];
-                double y0 = x0 * r[0] + x1 * r[1] + x2 * r[2];
-                double y1 = x0 * r[3] + x1 * r[4] + x2 * r[5];
-                double y2 = x0 * r[6] + x1 * r[7] + x2 * r[8];
-                s[v] += y0 - x0;
-                s[v + k] += y1 - x1;
-                s[v + 2 * k] += y2 - x2;
-                xi[v] = y0;
-                xi[v + k] = y1;
-                xi[v + 2 * k] = y2;
-            }
-        }
-        st->pend[i] = 1.0;
-        /* cumulative rotation: aligned = x_centred * R_1 R_2 ... */
-        double *ra = rot_acc + i * d * d, t[9];
-        for (int p = 0; p < d; p++)
-            for (int q = 0; q < d; q++) {
-                double acc = 0;
-                for (int l = 0; l < d; l++) acc += ra[p + l * d] * r[l + q * d];
-                t[p + q * d] = acc;
-            }
-        memcpy(ra, t, (size_t)(d * d) * sizeof *t);
+    sweep_args sa = {allow_reflection, rot_acc};
+    es_status rc;
+    st->sum[st->kd] = 0;
+    rc = chain(st, st->sum, st->kd + 1, sweep_one, &sa);
+    *change = st->sum[st->kd];
+    return rc;
+}
+
+static es_status flush_one(gpa_state *st, int64_t j, double *sum, void *ud)
+{
+    double *xj = COL(st, j), b = st->pend[j];
+    (void)ud;
+    for (int64_t v = 0; v < st->kd; v++) {
+        xj[v] *= b;
+        sum[v] += xj[v];
     }
-    *change = maxc;
     return ES_OK;
 }
 
 /* Multiply pending scales into the data and recompute the sum exactly. */
-static void flush_scales(gpa_state *st)
+static es_status flush_scales(gpa_state *st)
 {
+    es_status rc;
     memset(st->sum, 0, (size_t)st->kd * sizeof *st->sum);
-    for (int64_t j = 0; j < st->n; j++) {
-        double *xj = COL(st, j), b = st->pend[j];
-        for (int64_t v = 0; v < st->kd; v++) {
-            xj[v] *= b;
-            st->sum[v] += xj[v];
-        }
-        st->pend[j] = 1.0;
-    }
+    rc = chain(st, st->sum, st->kd, flush_one, NULL);
+    for (int64_t j = 0; j < st->n; j++) st->pend[j] = 1.0;
+    return rc;
 }
 
-/* Leading eigenvector of the cosine matrix from the explicit Gram matrix. */
+/* Leading eigenvector of the cosine matrix from the explicit Gram matrix;
+ * on the ranks rank 0 gathers the configurations (n^2 k d is small on
+ * this route), decomposes and broadcasts phi. */
 static es_status tenberge_exact(gpa_state *st)
 {
     int64_t n = st->n;
+    const double *xall = st->x.data;
+    int64_t ldx = st->x.ld;
     int ni, kdi, ldi, m;
-    es_status rc;
-    if ((rc = es__lapack_int(st->ctx, n, &ni)) != ES_OK ||
-        (rc = es__lapack_int(st->ctx, st->kd, &kdi)) != ES_OK ||
-        (rc = es__lapack_int(st->ctx, st->x.ld, &ldi)) != ES_OK)
-        return rc;
-    double *g = st->work, w[1];
-    cblas_dsyrk(CblasColMajor, CblasUpper, CblasTrans, ni, kdi, 1.0, st->x.data, ldi, 0.0, g,
-                ni);
-    for (int64_t j = 0; j < n; j++)
-        for (int64_t i = 0; i <= j; i++)
-            g[i + j * n] /= sqrt(st->norm2[i] * st->norm2[j]);
-    int *isuppz = es__alloc_array(st->ctx, 2, sizeof *isuppz);
-    if (!isuppz) return ES_ENOMEM;
-    lapack_int info = LAPACKE_dsyevr(LAPACK_COL_MAJOR, 'V', 'I', 'U', ni, g, ni, 0, 0, ni, ni,
-                                     0.0, &m, w, st->phi, ni, isuppz);
-    es__free(st->ctx, isuppz);
-    if (info != 0 || m != 1)
-        ES_FAIL(st->ctx, ES_ENUMERIC, "gpa: eigen-decomposition for Ten Berge scaling failed "
-                "(info %d)", (int)info);
-    for (int64_t j = 0; j < n; j++) st->phi[j] = fabs(st->phi[j]);
+    es_status rc = ES_OK;
+    if (st->ranks > 1) {
+        int64_t *counts = es__alloc_array(st->ctx, st->ranks, sizeof *counts), lo, hi;
+        if ((rc = es__par_agree(st->ctx, counts ? ES_OK : ES_ENOMEM)) != ES_OK) {
+            es__free(st->ctx, counts);
+            return rc;
+        }
+        for (int q = 0; q < st->ranks; q++) {
+            es__par_split(n, st->ranks, q, &lo, &hi);
+            counts[q] = (hi - lo) * st->kd;
+        }
+        rc = es__par_gather(st->ctx, st->x.data, counts, st->all);
+        es__free(st->ctx, counts);
+        if (rc) return rc;
+        xall = st->all;
+        ldx = st->kd;
+    }
+    if (st->rank == 0) {
+        if ((rc = es__lapack_int(st->ctx, n, &ni)) != ES_OK ||
+            (rc = es__lapack_int(st->ctx, st->kd, &kdi)) != ES_OK ||
+            (rc = es__lapack_int(st->ctx, ldx, &ldi)) != ES_OK)
+            goto agree;
+        double *g = st->work, w[1];
+        cblas_dsyrk(CblasColMajor, CblasUpper, CblasTrans, ni, kdi, 1.0, xall, ldi, 0.0, g, ni);
+        for (int64_t j = 0; j < n; j++)
+            for (int64_t i = 0; i <= j; i++)
+                g[i + j * n] /= sqrt(st->norm2[i] * st->norm2[j]);
+        int *isuppz = es__alloc_array(st->ctx, 2, sizeof *isuppz);
+        if (!isuppz) { rc = ES_ENOMEM; goto agree; }
+        lapack_int info = LAPACKE_dsyevr(LAPACK_COL_MAJOR, 'V', 'I', 'U', ni, g, ni, 0, 0, ni,
+                                         ni, 0.0, &m, w, st->phi, ni, isuppz);
+        es__free(st->ctx, isuppz);
+        if (info != 0 || m != 1)
+            rc = es__fail(st->ctx, ES_ENUMERIC, "gpa: eigen-decomposition for Ten Berge "
+                          "scaling failed (info %d)", (int)info);
+        for (int64_t j = 0; j < n; j++) st->phi[j] = fabs(st->phi[j]);
+    }
+agree:
+    if (st->ranks < 2) return rc;
+    if ((rc = es__par_agree(st->ctx, rc)) != ES_OK) return rc;
+    return es__par_bcast(st->ctx, st->phi, (size_t)n * sizeof *st->phi, 0);
+}
+
+static es_status power_axpy(gpa_state *st, int64_t j, double *y, void *ud)
+{
+    (void)ud;
+    cblas_daxpy((int)st->kd, st->phi[j] / sqrt(st->norm2[j]), COL(st, j), 1, y, 1);
     return ES_OK;
 }
 
@@ -199,26 +310,27 @@ static es_status tenberge_exact(gpa_state *st)
  * the first step costs one pass and later ones two. Stops when phi moves by
  * less than 0.1 tol / sqrt(n) (enough for scale changes below tol/10) or
  * 1e-15. On return work holds y for the returned phi, so the scaled sum is
- * sqrt(total) * y. */
+ * sqrt(total) * y. On the ranks y is a chain and each rank takes the dots
+ * of its own configurations. */
 static es_status tenberge_power(gpa_state *st, double total, double tol)
 {
     int64_t n = st->n, kd = st->kd;
     double *y = st->work, *z = st->z, *phi = st->phi;
     double stop = fmax(1e-15, 0.1 * tol / sqrt((double)n));
+    es_status rc;
     for (int64_t j = 0; j < n; j++) phi[j] = sqrt(st->norm2[j] / total);
     for (int64_t v = 0; v < kd; v++) y[v] = st->sum[v] / sqrt(total);
     for (int it = 0; it < 500; it++) {
         if (it > 0) {
             memset(y, 0, (size_t)kd * sizeof *y);
-            for (int64_t j = 0; j < n; j++)
-                cblas_daxpy((int)kd, phi[j] / sqrt(st->norm2[j]), COL(st, j), 1, y, 1);
+            if ((rc = chain(st, y, kd, power_axpy, NULL)) != ES_OK) return rc;
         }
         st->power_steps++;
         double nz = 0, diff = 0;
-        for (int64_t j = 0; j < n; j++) {
+        for (int64_t j = st->lo; j < st->hi; j++)
             z[j] = cblas_ddot((int)kd, COL(st, j), 1, y, 1) / sqrt(st->norm2[j]);
-            nz += z[j] * z[j];
-        }
+        if ((rc = gather_shares(st, z, 1)) != ES_OK) return rc;
+        for (int64_t j = 0; j < n; j++) nz += z[j] * z[j];
         nz = sqrt(nz);
         if (!(nz > 0) || !isfinite(nz))
             ES_FAIL(st->ctx, ES_ENUMERIC, "gpa: Ten Berge power iteration broke down");
@@ -233,7 +345,8 @@ static es_status tenberge_power(gpa_state *st, double total, double tol)
 }
 
 /* Ten Berge scaling step: pending scales beta_i, keeping the total sum of
- * squares; the sum of the scaled set is set up for the next sweep. */
+ * squares; the sum of the scaled set is set up for the next sweep. Every
+ * rank computes every beta (phi is the same on all). */
 static es_status scaling_step(gpa_state *st, double total, double tol, double *scale_acc,
                               double *change, int exact)
 {
@@ -258,7 +371,7 @@ static es_status scaling_step(gpa_state *st, double total, double tol, double *s
         maxc = fmax(maxc, fabs(b - 1.0));
     }
     if (exact) {
-        flush_scales(st);
+        if ((rc = flush_scales(st)) != ES_OK) return rc;
     } else {
         for (int64_t v = 0; v < kd; v++) st->sum[v] = sqrt(total) * st->work[v];
     }
@@ -266,24 +379,93 @@ static es_status scaling_step(gpa_state *st, double total, double tol, double *s
     return ES_OK;
 }
 
-es_status es_gpa_align(es_ctx *ctx, int64_t k, int d, es_mat x, const es_gpa_opts *opts,
-                       es_gpa_out *out, es_gpa_report *report)
+typedef struct centre_args { es_gpa_out *out; } centre_args;
+
+/* Configuration j centred: its centroid and size recorded, its sum of
+ * squares added to acc[kd] (the total) and its coordinates to the sum. */
+static es_status centre_one(gpa_state *st, int64_t j, double *acc, void *ud)
+{
+    es_gpa_out *out = ((centre_args *)ud)->out;
+    int64_t k = st->k;
+    int d = st->d;
+    double *xj = COL(st, j), c[3], ss = 0;
+    for (int q = 0; q < d; q++) {
+        double s = 0;
+        for (int64_t v = 0; v < k; v++) s += xj[v + q * k];
+        c[q] = s / (double)k;
+        for (int64_t v = 0; v < k; v++) {
+            xj[v + q * k] -= c[q];
+            ss += xj[v + q * k] * xj[v + q * k];
+            acc[v + q * k] += xj[v + q * k];
+        }
+    }
+    if (!isfinite(ss))
+        ES_FAIL(st->ctx, ES_EINVAL, "gpa: configuration %lld has a non-finite coordinate",
+                (long long)j);
+    if (!(ss > 0))
+        ES_FAIL(st->ctx, ES_EINVAL, "gpa: configuration %lld has zero centroid size (all %lld "
+                "points coincide)", (long long)j, (long long)k);
+    if (out && out->centroid) memcpy(out->centroid + j * d, c, (size_t)d * sizeof *c);
+    if (out && out->size) out->size[j] = sqrt(ss);
+    st->norm2[j] = ss;
+    acc[st->kd] += ss;
+    return ES_OK;
+}
+
+typedef struct fit_args { const double *mean; double msz; int allow_reflection; double *rho; } fit_args;
+
+/* Configuration j's part of GSS (acc[0]) and of the sum of rho^2 (acc[1]). */
+static es_status fit_one(gpa_state *st, int64_t j, double *acc, void *ud)
+{
+    const fit_args *fa = ud;
+    const double *xj = COL(st, j), *mean = fa->mean;
+    double a[9], r = 0, nx = 0;
+    es_status rc;
+    for (int64_t v = 0; v < st->kd; v++) {
+        acc[0] += (xj[v] - mean[v]) * (xj[v] - mean[v]);
+        nx += xj[v] * xj[v];
+    }
+    if (fa->msz > 0) {
+        es__procrustes_cross(st->k, st->d, xj, mean, a);
+        if ((rc = es__procrustes_rho(st->ctx, st->d, a, sqrt(nx), fa->msz, fa->allow_reflection,
+                                     &r)) != ES_OK)
+            return rc;
+    } else {
+        r = M_PI / 2;
+    }
+    acc[1] += r * r;
+    if (fa->rho) fa->rho[j] = r;
+    return ES_OK;
+}
+
+/* The work of es_gpa_align and es_gpa_align_ranks: n configurations in all,
+ * x holding [lo, hi) of them; ranks 1: all here, no messages. */
+static es_status gpa_run(es_ctx *ctx, int64_t k, int d, int64_t n, int ranks, es_mat x,
+                         const es_gpa_opts *opts, es_gpa_out *out, es_gpa_report *report)
 {
     es_gpa_opts o;
     es_gpa_report rep;
     gpa_state st;
     es_status rc = ES_OK;
-    int64_t kd, n = x.cols, nn;
+    int64_t kd, nn;
     double *rot_acc = NULL, *scale_acc = NULL, *buf = NULL;
 
     if (opts) o = *opts; else es_gpa_opts_init(&o);
     memset(&rep, 0, sizeof rep);
     if (report) *report = rep;
+    memset(&st, 0, sizeof st);
+    st.ranks = ranks;
+    st.rank = ranks > 1 ? es__par_rank(ctx) : 0;
+    st.lo = 0;
+    st.hi = n;
+    if (ranks > 1) es__par_split(n, ranks, st.rank, &st.lo, &st.hi);
     if (d != 2 && d != 3) ES_FAIL(ctx, ES_EINVAL, "gpa: dimension %d is not 2 or 3", d);
-    if (k < 1 || !es__mul_i64(k, d, &kd) || x.rows != kd || x.ld < kd)
-        ES_FAIL(ctx, ES_EINVAL, "gpa: a %lld x %lld matrix (ld %lld) does not hold %lld x %d "
-                "configurations", (long long)x.rows, (long long)x.cols, (long long)x.ld,
-                (long long)k, d);
+    if (k < 1 || !es__mul_i64(k, d, &kd) || x.rows != kd || x.ld < kd ||
+        x.cols != st.hi - st.lo || (ranks > 1 && x.ld != kd))
+        ES_FAIL(ctx, ES_EINVAL, "gpa: a %lld x %lld matrix (ld %lld) does not hold %lld "
+                "configurations of %lld x %d%s", (long long)x.rows, (long long)x.cols,
+                (long long)x.ld, (long long)(st.hi - st.lo), (long long)k, d,
+                ranks > 1 ? " (this rank's share, ld = k d)" : "");
     if (n < 2) ES_FAIL(ctx, ES_EINVAL, "gpa: needs at least 2 configurations, got %lld",
                        (long long)n);
     if (!(o.tol >= 0) || o.max_iter < 1)
@@ -293,56 +475,41 @@ es_status es_gpa_align(es_ctx *ctx, int64_t k, int d, es_mat x, const es_gpa_opt
     if (kd > INT32_MAX) ES_FAIL(ctx, ES_ERANGE, "gpa: %lld coordinates per configuration exceed "
                                 "BLAS's int", (long long)kd);
 
-    memset(&st, 0, sizeof st);
     st.ctx = ctx; st.k = k; st.d = d; st.n = n; st.kd = kd; st.x = x;
-    /* one block: sum kd, work max(kd, n*n) (n*n only for the explicit Gram
-     * matrix), norm2, pend, phi, z, scale n each, rot d*d*n */
+    /* one block: sum kd + 1, work max(kd, n*n) (n*n only for the explicit
+     * Gram matrix), norm2, pend, phi, z, scale n each, rot d*d*n; rank 0 of
+     * several on the exact route also every configuration */
     int exact = o.scale && (double)n * (double)n * (double)kd <= GRAM_LIMIT;
-    int64_t nwork = exact && nn > kd ? nn : kd, total_len = kd + nwork + 5 * n + (int64_t)d * d * n;
+    int64_t nwork = exact && nn > kd ? nn : kd;
+    int64_t nall = exact && ranks > 1 && st.rank == 0 ? n * kd : 0;
+    int64_t total_len = kd + 1 + nwork + 5 * n + (int64_t)d * d * n + nall;
     buf = es__alloc_array(ctx, total_len, sizeof *buf);
-    if (!buf) return ES_ENOMEM;
+    if (ranks > 1) rc = es__par_agree(ctx, buf ? ES_OK : ES_ENOMEM);
+    if (!buf || rc) { rc = rc ? rc : ES_ENOMEM; goto done; }
     st.sum = buf;
-    st.work = st.sum + kd;
+    st.work = st.sum + kd + 1;
     st.norm2 = st.work + nwork;
     st.pend = st.norm2 + n;
     st.phi = st.pend + n;
     st.z = st.phi + n;
     scale_acc = st.z + n;
     rot_acc = scale_acc + n;
+    st.all = nall ? rot_acc + (int64_t)d * d * n : NULL;
 
     /* centre, record centroids and sizes, check for degenerate input */
-    double total = 0;
-    memset(st.sum, 0, (size_t)kd * sizeof *st.sum);
     for (int64_t j = 0; j < n; j++) {
-        double *xj = COL(&st, j), c[3], ss = 0;
-        for (int q = 0; q < d; q++) {
-            double acc = 0;
-            for (int64_t v = 0; v < k; v++) acc += xj[v + q * k];
-            c[q] = acc / (double)k;
-            for (int64_t v = 0; v < k; v++) {
-                xj[v + q * k] -= c[q];
-                ss += xj[v + q * k] * xj[v + q * k];
-                st.sum[v + q * k] += xj[v + q * k];
-            }
-        }
-        if (!isfinite(ss)) {
-            rc = es__fail(ctx, ES_EINVAL, "gpa: configuration %lld has a non-finite coordinate",
-                          (long long)j);
-            goto done;
-        }
-        if (!(ss > 0)) {
-            rc = es__fail(ctx, ES_EINVAL, "gpa: configuration %lld has zero centroid size (all "
-                          "%lld points coincide)", (long long)j, (long long)k);
-            goto done;
-        }
-        if (out && out->centroid) memcpy(out->centroid + j * d, c, (size_t)d * sizeof *c);
-        if (out && out->size) out->size[j] = sqrt(ss);
-        st.norm2[j] = ss;
-        total += ss;
         scale_acc[j] = 1.0;
         st.pend[j] = 1.0;
         for (int q = 0; q < d * d; q++) rot_acc[j * d * d + q] = q % (d + 1) == 0;
     }
+    memset(st.sum, 0, (size_t)(kd + 1) * sizeof *st.sum);
+    centre_args ca = {out};
+    if ((rc = chain(&st, st.sum, kd + 1, centre_one, &ca)) != ES_OK ||
+        (rc = gather_shares(&st, st.norm2, 1)) != ES_OK ||
+        (out && out->size && (rc = gather_shares(&st, out->size, 1)) != ES_OK) ||
+        (out && out->centroid && (rc = gather_shares(&st, out->centroid, d)) != ES_OK))
+        goto done;
+    double total = st.sum[kd];
     rep.total_ss = total;
 
     for (rep.iterations = 1; rep.iterations <= o.max_iter; rep.iterations++) {
@@ -359,35 +526,22 @@ es_status es_gpa_align(es_ctx *ctx, int64_t k, int d, es_mat x, const es_gpa_opt
     }
     if (rep.iterations > o.max_iter) rep.iterations = o.max_iter;
     es__progress(ctx, "gpa", o.max_iter, o.max_iter);
-    flush_scales(&st);   /* also recomputes the sum without accumulated rounding */
+    /* also recomputes the sum without accumulated rounding */
+    if ((rc = flush_scales(&st)) != ES_OK) goto done;
 
     /* mean, GSS and rho */
-    double *mean = st.work, msz = 0, gss = 0, sr = 0;
+    double *mean = st.work, msz = 0, acc[2] = {0, 0};
     for (int64_t v = 0; v < kd; v++) {
         mean[v] = st.sum[v] / (double)n;
         msz += mean[v] * mean[v];
     }
-    msz = sqrt(msz);
-    for (int64_t j = 0; j < n; j++) {
-        const double *xj = COL(&st, j);
-        double a[9], r = 0, nx = 0;
-        for (int64_t v = 0; v < kd; v++) {
-            gss += (xj[v] - mean[v]) * (xj[v] - mean[v]);
-            nx += xj[v] * xj[v];
-        }
-        if (msz > 0) {
-            es__procrustes_cross(k, d, xj, mean, a);
-            if ((rc = es__procrustes_rho(ctx, d, a, sqrt(nx), msz, o.allow_reflection, &r)) !=
-                ES_OK)
-                goto done;
-        } else {
-            r = M_PI / 2;
-        }
-        sr += r * r;
-        if (out && out->rho) out->rho[j] = r;
-    }
-    rep.gss = gss;
-    rep.rmsrho = sqrt(sr / (double)n);
+    fit_args fa = {mean, sqrt(msz), o.allow_reflection, out ? out->rho : NULL};
+    if ((rc = chain(&st, acc, 2, fit_one, &fa)) != ES_OK ||
+        (out && out->rho && (rc = gather_shares(&st, out->rho, 1)) != ES_OK) ||
+        (rc = gather_shares(&st, rot_acc, (int64_t)d * d)) != ES_OK)
+        goto done;
+    rep.gss = acc[0];
+    rep.rmsrho = sqrt(acc[1] / (double)n);
     if (out && out->mean) memcpy(out->mean, mean, (size_t)kd * sizeof *mean);
     if (out && out->scale) memcpy(out->scale, scale_acc, (size_t)n * sizeof *scale_acc);
     if (out && out->rot) memcpy(out->rot, rot_acc, (size_t)(d * d * n) * sizeof *rot_acc);
@@ -399,6 +553,18 @@ done:
     if (report) *report = rep;
     es__free(ctx, buf);
     return rc;
+}
+
+es_status es_gpa_align(es_ctx *ctx, int64_t k, int d, es_mat x, const es_gpa_opts *opts,
+                       es_gpa_out *out, es_gpa_report *report)
+{
+    return gpa_run(ctx, k, d, x.cols, 1, x, opts, out, report);
+}
+
+es_status es_gpa_align_ranks(es_ctx *ctx, int64_t k, int d, int64_t n, es_mat x,
+                             const es_gpa_opts *opts, es_gpa_out *out, es_gpa_report *report)
+{
+    return gpa_run(ctx, k, d, n, es__par_size(ctx), x, opts, out, report);
 }
 
 es_status es_gpa_tangent(es_ctx *ctx, int64_t k, int d, es_mat aligned, const double *mean,

@@ -178,7 +178,12 @@ es_status es__h5_append_rows(es_ctx *ctx, hid_t loc, const char *name, hid_t mty
     count[0] = (hsize_t)n;
     for (int k = 1; k < rank; k++) count[k] = dims[k];
     dims[0] += (hsize_t)n;
-    if (H5Dset_extent(ds, dims) < 0 || (fsp = H5Dget_space(ds)) < 0 ||
+    if (H5Dset_extent(ds, dims) < 0) {
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot append to dataset '%s'", name);
+        goto done;
+    }
+    if (!buf) goto done;   /* room only: the ranks write the rows (store_ranks.c) */
+    if ((fsp = H5Dget_space(ds)) < 0 ||
         H5Sselect_hyperslab(fsp, H5S_SELECT_SET, start, NULL, count, NULL) < 0 ||
         (msp = H5Screate_simple(rank, count, NULL)) < 0 ||
         H5Dwrite(ds, mtype, msp, fsp, H5P_DEFAULT, buf) < 0)
@@ -186,6 +191,43 @@ es_status es__h5_append_rows(es_ctx *ctx, hid_t loc, const char *name, hid_t mty
 done:
     es__h5_close(msp);
     es__h5_close(fsp);
+    es__h5_close(ds);
+    return rc;
+}
+
+es_status es__h5_allocate_rows(es_ctx *ctx, hid_t loc, const char *name, int64_t row0,
+                               int64_t n)
+{
+    hsize_t cd[3] = {1, 1, 1}, start[3] = {0, 0, 0}, stride[3] = {1, 1, 1}, count[3] = {1, 1, 1};
+    hid_t ds = -1, dcpl = -1, fsp = -1, msp = -1;
+    double *zeros = NULL;
+    es_status rc = ES_OK;
+    int rank;
+    if (n <= 0) return ES_OK;
+    if ((ds = es__h5_open_ds_nocache(loc, name)) < 0 || (dcpl = H5Dget_create_plist(ds)) < 0 ||
+        (fsp = H5Dget_space(ds)) < 0 || (rank = H5Sget_simple_extent_ndims(fsp)) < 1 ||
+        rank > 3 || H5Pget_chunk(dcpl, rank, cd) != rank || cd[0] < 1) {
+        rc = es__h5_fail(ctx, ES_EFORMAT, "store: cannot open dataset '%s'", name);
+        goto done;
+    }
+    /* the chunk holding row0 has rows before it (allocated) unless row0 starts one */
+    start[0] = ((hsize_t)row0 + cd[0] - 1) / cd[0] * cd[0];
+    if (start[0] >= (hsize_t)(row0 + n)) goto done;
+    stride[0] = cd[0];
+    count[0] = ((hsize_t)(row0 + n) - start[0] + cd[0] - 1) / cd[0];
+    if (!(zeros = es__alloc_array(ctx, (int64_t)count[0], sizeof *zeros))) {
+        rc = ES_ENOMEM;
+        goto done;
+    }
+    if (H5Sselect_hyperslab(fsp, H5S_SELECT_SET, start, stride, count, NULL) < 0 ||
+        (msp = H5Screate_simple(1, count, NULL)) < 0 ||
+        H5Dwrite(ds, H5T_NATIVE_DOUBLE, msp, fsp, H5P_DEFAULT, zeros) < 0)
+        rc = es__h5_fail(ctx, ES_EIO, "store: cannot make room in dataset '%s'", name);
+done:
+    es__free(ctx, zeros);
+    es__h5_close(msp);
+    es__h5_close(fsp);
+    es__h5_close(dcpl);
     es__h5_close(ds);
     return rc;
 }

@@ -119,9 +119,19 @@ hid_t es__h5_open_ds_nocache(hid_t loc, const char *name);
  * d1 (x d2) elements of elem_bytes each. */
 es_status es__h5_create_rows(es_ctx *ctx, hid_t loc, const char *name, hid_t ftype, int rank,
                              hsize_t d1, hsize_t d2, size_t elem_bytes);
-/* Append n rows from buf (memory type mtype, the dataset's row shape). */
+/* Append n rows from buf (memory type mtype, the dataset's row shape);
+ * buf NULL: make room for them only (HDF5's fill value until written). */
 es_status es__h5_append_rows(es_ctx *ctx, hid_t loc, const char *name, hid_t mtype,
                              int64_t n, const void *buf);
+/* Allocate every chunk of rows [row0, row0 + n) of a rows dataset not
+ * allocated yet, by writing one 0 into each (the rest is HDF5's fill value
+ * 0 too). Parallel HDF5 1.10.8 allocates all chunks of a dataset at a
+ * parallel write only when it has none; in one that has some, each rank
+ * allocated the new ones at addresses of its own and wrote over other
+ * objects (/topology/edges). So rank 0 allocates them before the ranks
+ * write (store_ranks.c), which then only overwrite. */
+es_status es__h5_allocate_rows(es_ctx *ctx, hid_t loc, const char *name, int64_t row0,
+                               int64_t n);
 /* Write (replacing) a scalar int64, a scalar float64, a string, or a 1-D
  * string attribute. */
 es_status es__h5_write_attr_i64(es_ctx *ctx, hid_t obj, const char *key, int64_t v);

@@ -10,6 +10,7 @@
  * handle broken so the half-written working copy is never published.
  */
 #include "store/store_pkg.h"
+#include "store/store_private.h"
 #include "core/suggest.h"
 
 #include <math.h>
@@ -316,12 +317,15 @@ static es_status check_values(es_ctx *ctx, const es_store *s, const es_store_row
  * a map of the batch's own (keys borrowed from r->ids): linear in the rows,
  * where comparing each new id with every stored and new one took over a
  * minute for 10^5 rows. */
-static es_status validate_rows(es_ctx *ctx, const es_store *s, const es_store_rows *r)
+/* written: the values are in the store already (es__store_append_written) */
+static es_status validate_rows(es_ctx *ctx, const es_store *s, const es_store_rows *r,
+                               bool written)
 {
     const bool lens = s->nedges > 0;   /* a store without edges ignores lengths/scales */
     es__strmap batch;
     es_status rc = ES_OK;
-    if (r->n < 0 || (r->n > 0 && (!r->ids || (lens && (!r->lengths || !r->scales)) || !r->xyz)) ||
+    if (r->n < 0 || (r->n > 0 && (!r->ids || (!written && ((lens && (!r->lengths ||
+                                                                      !r->scales)) || !r->xyz)))) ||
         r->ncols < 0 || (r->ncols > 0 && (!r->colnames || (r->n > 0 && !r->labels))))
         ES_FAIL(ctx, ES_EINVAL, "store: incomplete rows to append");
     /* the column list is one attribute (64 KiB at most in HDF5's compact
@@ -359,7 +363,7 @@ static es_status validate_rows(es_ctx *ctx, const es_store *s, const es_store_ro
             rc = es__fail(ctx, ES_EEXIST, "store: id '%s' exists already in '%s'", id, s->path);
         else if ((rc = es__strmap_put(ctx, &batch, id, i, &first)) == ES_OK && first >= 0)
             rc = es__fail(ctx, ES_EEXIST, "store: id '%s' is given twice", id);
-        else if (rc == ES_OK)
+        else if (rc == ES_OK && !written)
             rc = check_values(ctx, s, r, i);
     }
     es__strmap_clear(ctx, &batch);
@@ -393,13 +397,13 @@ static es_status add_columns(es_ctx *ctx, es_store *s, const es_store_rows *r, h
     return es__h5_write_attr_strs(ctx, g, "columns", (const char *const *)s->colnames, s->ncols);
 }
 
-static es_status append_impl(es_ctx *ctx, es_store *s, const es_store_rows *r)
+static es_status append_impl(es_ctx *ctx, es_store *s, const es_store_rows *r, bool written)
 {
     es_status rc;
     hid_t t = -1, g = -1;
     const char **tmp = NULL;
     int64_t n = r->n, n0 = s->nrows;
-    if ((rc = validate_rows(ctx, s, r))) return rc;
+    if ((rc = validate_rows(ctx, s, r, written))) return rc;
     if (n == 0 && r->ncols == 0) return ES_OK;
     if ((rc = es__store_begin_write(s))) return rc;
     if ((rc = es__store_reserve_rows(s, n0 + n))) return rc;
@@ -411,12 +415,12 @@ static es_status append_impl(es_ctx *ctx, es_store *s, const es_store_rows *r)
     if ((rc = add_columns(ctx, s, r, g, t))) goto done;
     if ((rc = es__store_reserve_rows(s, n0 + n))) goto done;
     if (n == 0) goto done;
-    if ((s->nedges > 0 &&
+    if (!written && ((s->nedges > 0 &&
          ((rc = es__h5_append_rows(ctx, s->file, "/shapes/lengths", H5T_NATIVE_DOUBLE, n,
                                    r->lengths)) ||
           (rc = es__h5_append_rows(ctx, s->file, "/shapes/scales", H5T_NATIVE_DOUBLE, n,
                                    r->scales)))) ||
-        (rc = es__h5_append_rows(ctx, s->file, "/shapes/positions", H5T_NATIVE_DOUBLE, n, r->xyz)))
+        (rc = es__h5_append_rows(ctx, s->file, "/shapes/positions", H5T_NATIVE_DOUBLE, n, r->xyz))))
         goto done;
     if (!(tmp = es__alloc_array(ctx, n, sizeof *tmp))) { rc = ES_ENOMEM; goto done; }
     for (int64_t i = 0; i < n; i++)
@@ -474,7 +478,35 @@ es_status es_store_append(es_ctx *ctx, es_store *store, const es_store_rows *row
 {
     es_status rc;
     if (!store || !rows) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument to es_store_append");
-    H5E_BEGIN_TRY { rc = append_impl(ctx, store, rows); } H5E_END_TRY
+    H5E_BEGIN_TRY { rc = append_impl(ctx, store, rows, false); } H5E_END_TRY
+    return rc;
+}
+
+es_status es__store_append_written(es_ctx *ctx, es_store *s, const es_store_rows *r)
+{
+    es_status rc;
+    H5E_BEGIN_TRY { rc = append_impl(ctx, s, r, true); } H5E_END_TRY
+    return rc;
+}
+
+es_status es__store_reserve_values(es_ctx *ctx, es_store *s, int64_t n)
+{
+    es_status rc;
+    if ((rc = es__store_begin_write(s))) return rc;
+    H5E_BEGIN_TRY {
+        if ((s->nedges > 0 &&
+             ((rc = es__h5_append_rows(ctx, s->file, "/shapes/lengths", H5T_NATIVE_DOUBLE, n,
+                                       NULL)) ||
+              (rc = es__h5_append_rows(ctx, s->file, "/shapes/scales", H5T_NATIVE_DOUBLE, n,
+                                       NULL)))) ||
+            (rc = es__h5_append_rows(ctx, s->file, "/shapes/positions", H5T_NATIVE_DOUBLE, n,
+                                     NULL)) ||
+            (s->nedges > 0 &&
+             ((rc = es__h5_allocate_rows(ctx, s->file, "/shapes/lengths", s->nrows, n)) ||
+              (rc = es__h5_allocate_rows(ctx, s->file, "/shapes/scales", s->nrows, n)))) ||
+            (rc = es__h5_allocate_rows(ctx, s->file, "/shapes/positions", s->nrows, n)))
+            s->broken = true;
+    } H5E_END_TRY
     return rc;
 }
 

@@ -6,8 +6,14 @@
  * into a small buffer and transposed into its column of one k*d x n matrix:
  * the only large allocation, the size of the coordinates. Planar rows
  * (z = 0 everywhere, as ingested 2D landmarks are) are analysed in 2D.
+ *
+ * On the ranks of an MPI job each rank reads and aligns its contiguous
+ * share of the rows (es_gpa_align_ranks); the aligned shares are gathered
+ * on rank 0, which alone takes the PCA of the tangent coordinates (its
+ * n x n Gram matrix needs every pair of rows) and writes the result.
  */
 #include "core/core_private.h"
+#include "parallel/parallel_private.h"
 #include "edgespace/es_study.h"
 
 #include <math.h>
@@ -34,36 +40,48 @@ es_status es_study_gpa(es_ctx *ctx, es_store *store, const char *name, const int
     es_status rc = ES_OK;
     gpa_bufs b;
     int64_t n = nrows < 0 ? es_store_nrows(store) : nrows, k = es_store_nverts(store);
+    int64_t lo, hi;
+    const int ranks = es__par_size(ctx), writer = es__par_rank(ctx) == 0;
     memset(&b, 0, sizeof b);
     memset(&rep, 0, sizeof rep);
     if (opts) o = *opts; else es_gpa_opts_init(&o);
-    if (!name || !*name || strchr(name, '/'))
-        ES_FAIL(ctx, ES_EINVAL, "gpa: result name '%s' is empty or has '/'", name ? name : "");
-    if ((rc = es_store_result_check(ctx, store, "gpa", name)) != ES_OK) return rc;
+    if (writer && (!name || !*name || strchr(name, '/')))
+        rc = es__fail(ctx, ES_EINVAL, "gpa: result name '%s' is empty or has '/'",
+                      name ? name : "");
+    else if (writer) rc = es_store_result_check(ctx, store, "gpa", name);
+    if ((rc = es__par_agree(ctx, rc)) != ES_OK) return rc;
     if (n < 2) ES_FAIL(ctx, ES_EINVAL, "gpa: needs at least 2 rows, got %lld", (long long)n);
     if (k < 1) ES_FAIL(ctx, ES_EINVAL, "gpa: the store has no vertices");
+    es__par_split(n, ranks, es__par_rank(ctx), &lo, &hi);
 
-    /* positions -> 3D configurations, and whether every z is 0 */
+    /* positions -> 3D configurations (this rank's rows; rank 0's buffer
+     * holds all n, its own first, for the gathering), and whether every z
+     * is 0 (in every rank's rows) */
     int64_t kd3 = 3 * k;
-    b.x = es__alloc_array(ctx, kd3 * n, sizeof *b.x);
+    b.x = es__alloc_array(ctx, kd3 * (writer ? n : hi - lo), sizeof *b.x);
     b.row = es__alloc_array(ctx, kd3, sizeof *b.row);
-    if (!b.x || !b.row) { rc = ES_ENOMEM; goto done; }
-    int planar = 1;
-    for (int64_t j = 0; j < n; j++) {
+    int64_t nonplanar = 0;
+    rc = b.x && b.row ? ES_OK : ES_ENOMEM;
+    for (int64_t j = lo; j < hi && rc == ES_OK; j++) {
         int64_t r = rows ? rows[j] : j;
+        double *xj = b.x + (j - lo) * kd3;
         if (r < 0 || r >= es_store_nrows(store)) {
             rc = es__fail(ctx, ES_ERANGE, "gpa: row %lld out of range", (long long)r);
-            goto done;
+            break;
         }
-        if ((rc = es_store_read_positions(ctx, store, r, b.row)) != ES_OK) goto done;
-        es_procrustes_from_xyz(k, b.row, b.x + j * kd3);
-        for (int64_t v = 0; v < k && planar; v++) planar = b.x[j * kd3 + 2 * k + v] == 0.0;
-        if ((rc = es__progress(ctx, "reading positions", j + 1, n))) goto done;
+        if ((rc = es_store_read_positions(ctx, store, r, b.row)) != ES_OK) break;
+        es_procrustes_from_xyz(k, b.row, xj);
+        for (int64_t v = 0; v < k && !nonplanar; v++) nonplanar = xj[2 * k + v] != 0.0;
+        rc = es__progress(ctx, "reading positions", j - lo + 1, hi - lo);
     }
-    int d = planar ? 2 : 3;
+    if ((rc = es__par_agree(ctx, rc)) != ES_OK ||
+        (rc = es__par_max_i64(ctx, &nonplanar, 1)) != ES_OK)
+        goto done;
+    int d = nonplanar ? 3 : 2;
     int64_t kd = k * d;
-    if (planar)   /* drop the z-block: configuration j moves to j * 2k */
-        for (int64_t j = 0; j < n; j++) memmove(b.x + j * kd, b.x + j * kd3, (size_t)kd * sizeof *b.x);
+    if (!nonplanar)   /* drop the z-block: configuration j moves to j * 2k */
+        for (int64_t j = 0; j < hi - lo; j++)
+            memmove(b.x + j * kd, b.x + j * kd3, (size_t)kd * sizeof *b.x);
     es__free(ctx, b.row);
     b.row = NULL;
 
@@ -71,16 +89,29 @@ es_status es_study_gpa(es_ctx *ctx, es_store *store, const char *name, const int
     b.size = es__alloc_array(ctx, 3 * n, sizeof *b.size);
     b.rot = es__alloc_array(ctx, (int64_t)d * d * n, sizeof *b.rot);
     b.cen = es__alloc_array(ctx, (int64_t)d * n, sizeof *b.cen);
-    if (!b.mean || !b.size || !b.rot || !b.cen) { rc = ES_ENOMEM; goto done; }
+    rc = b.mean && b.size && b.rot && b.cen ? ES_OK : ES_ENOMEM;
+    if ((rc = es__par_agree(ctx, rc)) != ES_OK) goto done;
     b.rho = b.size + n;
     b.scale = b.rho + n;
     es_gpa_out out = {b.mean, b.size, b.rho, b.scale, b.rot, b.cen};
     es_mat xm = {b.x, kd, n, kd};
-    rc = es_gpa_align(ctx, k, d, xm, &o, &out, &rep);
+    rc = es_gpa_align_ranks(ctx, k, d, n, (es_mat){b.x, kd, hi - lo, kd}, &o, &out, &rep);
     if (rc != ES_OK && rc != ES_ENOCONV) goto done;
     if (rc == ES_ENOCONV) {
         es__warn(ctx, "%s", es_ctx_errmsg(ctx));
         rc = ES_OK;
+    }
+    if (ranks > 1) {   /* the aligned shares onto rank 0, its own in place */
+        int64_t *counts = es__alloc_array(ctx, ranks, sizeof *counts), a, e;
+        if ((rc = es__par_agree(ctx, counts ? ES_OK : ES_ENOMEM)) == ES_OK) {
+            for (int q = 0; q < ranks; q++) {
+                es__par_split(n, ranks, q, &a, &e);
+                counts[q] = (e - a) * kd;
+            }
+            rc = es__par_gather(ctx, b.x, counts, b.x);
+        }
+        es__free(ctx, counts);
+        if (rc != ES_OK || !writer) goto done;   /* the rest is rank 0's */
     }
 
     /* PCA of residual tangent coordinates; the tangent matrix is a second

@@ -1,5 +1,6 @@
 /* tests/common/es_test.c — see es_test.h. */
 #include "es_test.h"
+#include <math.h>
 
 #include <sys/stat.h>
 
@@ -30,4 +31,18 @@ const char *es_test_shared_path(const char *sub, char *buf, size_t n)
     if (!data) return NULL;
     snprintf(buf, n, "%s/../%s", data, sub);
     return stat(buf, &st) == 0 ? buf : NULL;
+}
+
+double es_test_maxdiff(const double *a, const double *b, int64_t n)
+{
+    double m = 0;
+    for (int64_t i = 0; i < n; i++) m = fmax(m, fabs(a[i] - b[i]));
+    return m;
+}
+
+double es_test_maxabs(const double *a, int64_t n)
+{
+    double m = 0;
+    for (int64_t i = 0; i < n; i++) m = fmax(m, fabs(a[i]));
+    return m;
 }

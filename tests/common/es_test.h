@@ -63,4 +63,9 @@ const char *es_test_shared_data(void);
 /* Path of ../shared/<sub> or NULL if absent. */
 const char *es_test_shared_path(const char *sub, char *buf, size_t n);
 
+/* max_i |a[i] - b[i]| and max_i |a[i]| over n values (0 for n = 0): the
+ * scale a result is compared to. */
+double es_test_maxdiff(const double *a, const double *b, int64_t n);
+double es_test_maxabs(const double *a, int64_t n);
+
 #endif

@@ -4,7 +4,9 @@
  * randomized route, at P = 2 and 4; `mpirun -n P edgespace model` the same
  * ANOVA table (SS, F and every permuted F to 1e-12, p-values equal:
  * permutation b is drawn alike on every rank) with its pairwise table,
- * and its CSV; the store file itself is untouched
+ * and its CSV; `mpirun -n P edgespace gpa` the one-process GPA (aligned
+ * configurations, mean, scales, rotations, rho and the PCs to 1e-12); the
+ * store file itself is untouched
  * (results live beside it), a taken name is refused by all ranks with one
  * message, and a command that does not run on ranks yet says so.
  *
@@ -35,20 +37,6 @@ static int run_mpi(int P, const char *args, char *err, size_t n)
     return WIFEXITED(st) ? WEXITSTATUS(st) : 128;
 }
 
-static double maxdiff(const double *a, const double *b, int64_t n)
-{
-    double m = 0;
-    for (int64_t i = 0; i < n; i++) m = fmax(m, fabs(a[i] - b[i]));
-    return m;
-}
-
-static double maxabs(const double *a, int64_t n)
-{
-    double m = 0;
-    for (int64_t i = 0; i < n; i++) m = fmax(m, fabs(a[i]));
-    return m;
-}
-
 /* <kind>/<a>/<ds> and <kind>/<b>/<ds> hold the same numbers, to tol(k) of
  * their scale: datasets ds[0 .. nvec-1] are vectors, the rest matrices. */
 static void same_result(es_ctx *ctx, const char *kind, const char *a, const char *b,
@@ -74,9 +62,9 @@ static void same_result(es_ctx *ctx, const char *kind, const char *a, const char
         ES_CHECK_MSG(ma.data && mb.data && ma.rows == mb.rows && ma.cols == mb.cols && n > 0,
                      "%s vs %s: %s/%s shapes differ", a, b, kind, ds[k]);
         if (ma.data && mb.data && ma.rows == mb.rows && ma.cols == mb.cols) {
-            double t = tol[k] * maxabs(ma.data, n);
-            ES_CHECK_MSG(maxdiff(ma.data, mb.data, n) <= t, "%s vs %s: %s/%s differ by %g", a, b,
-                         kind, ds[k], maxdiff(ma.data, mb.data, n));
+            double t = tol[k] * es_test_maxabs(ma.data, n);
+            ES_CHECK_MSG(es_test_maxdiff(ma.data, mb.data, n) <= t, "%s vs %s: %s/%s differ by %g", a, b,
+                         kind, ds[k], es_test_maxdiff(ma.data, mb.data, n));
         }
         es_free(ctx, ma.data);
         es_free(ctx, mb.data);
@@ -103,6 +91,58 @@ static void same_model(es_ctx *ctx, const char *a, const char *b)
     static const char *const ds[] = {"ss", "f", "z", "p", "coefficients", "f_perm", "lsmeans"};
     static const double tol[] = {1e-12, 1e-12, 1e-12, 0, 1e-12, 1e-12, 1e-12};
     same_result(ctx, "model", a, b, ds, 7, 4, tol);
+}
+
+/* gpa/<a> and gpa/<b> agree to 1e-12 of their scale (the ranks run the
+ * sweep's additions in one process's order: equal but for BLAS's own
+ * threading). The PCs are compared component by component up to sign:
+ * their convention (the largest-magnitude loading positive) meets a tie on
+ * these symmetric tori (two loadings equal in magnitude to 1e-15), where a
+ * rounding-level difference flips a component, in one process too.
+ * Loadings to 1e-9 as same_pca's components (unit vectors; PCs 7 and 8 of
+ * these tori, sdev 1e-3 beside 1.06, move by 5e-13 with a 3e-15 change of
+ * the aligned set), scores to 1e-12 of all scores' scale. */
+static void same_gpa(es_ctx *ctx, const char *a, const char *b)
+{
+    static const char *const ds[] = {"mean", "size", "rho", "scale", "pc_sdev", "aligned",
+                                     "rotation", "centroid"};
+    static const double tol[] = {1e-12, 1e-12, 1e-12, 1e-12, 1e-12, 1e-12, 1e-12, 1e-12};
+    same_result(ctx, "gpa", a, b, ds, 8, 5, tol);
+    es_store *s = NULL;
+    es_mat la = {0}, lb = {0}, sa = {0}, sb = {0};   /* loadings kd x npc, scores npc x n */
+    char p[4][200];
+    snprintf(p[0], 200, "gpa/%s/pc_loadings", a);
+    snprintf(p[1], 200, "gpa/%s/pc_loadings", b);
+    snprintf(p[2], 200, "gpa/%s/pc_scores", a);
+    snprintf(p[3], 200, "gpa/%s/pc_scores", b);
+    ES_CHECK_OK(ctx, es_store_open(ctx, store, ES_STORE_READ, &s));
+    if (!s) return;
+    ES_CHECK_OK(ctx, es_store_get_matrix(ctx, s, p[0], &la));
+    ES_CHECK_OK(ctx, es_store_get_matrix(ctx, s, p[1], &lb));
+    ES_CHECK_OK(ctx, es_store_get_matrix(ctx, s, p[2], &sa));
+    ES_CHECK_OK(ctx, es_store_get_matrix(ctx, s, p[3], &sb));
+    int ok = la.data && lb.data && sa.data && sb.data && la.rows == lb.rows &&
+             la.cols == lb.cols && sa.rows == sb.rows && sa.cols == sb.cols && sa.rows == la.cols;
+    ES_CHECK_MSG(ok, "%s vs %s: the PCs' shapes differ", a, b);
+    double msc = ok ? es_test_maxabs(sa.data, sa.rows * sa.cols) : 0;   /* the scores' scale */
+    for (int64_t c = 0; ok && c < la.cols; c++) {
+        double dot = 0, dl = 0, dsc = 0, ml = 0;
+        for (int64_t v = 0; v < la.rows; v++) dot += ES_AT(la, v, c) * ES_AT(lb, v, c);
+        double sg = dot < 0 ? -1.0 : 1.0;
+        for (int64_t v = 0; v < la.rows; v++) {
+            dl = fmax(dl, fabs(ES_AT(la, v, c) - sg * ES_AT(lb, v, c)));
+            ml = fmax(ml, fabs(ES_AT(la, v, c)));
+        }
+        for (int64_t j = 0; j < sa.cols; j++)
+            dsc = fmax(dsc, fabs(ES_AT(sa, c, j) - sg * ES_AT(sb, c, j)));
+        ES_CHECK_MSG(dl <= 1e-9 * ml && dsc <= 1e-12 * msc, "%s vs %s: PC %lld differs by %g "
+                     "(loadings), %g (scores)", a, b, (long long)(c + 1), dl, dsc);
+    }
+    es_free(ctx, la.data);
+    es_free(ctx, lb.data);
+    es_free(ctx, sa.data);
+    es_free(ctx, sb.data);
+    es_store_close(s);
 }
 
 int main(int argc, char **argv)
@@ -176,6 +216,21 @@ int main(int argc, char **argv)
         /* the name is taken now: refused once, before any permutation */
         ES_CHECK_MSG(run_mpi(P, args, err, sizeof err) != 0 && strstr(err, "exists already"),
                      "mpirun -n %d model again: %s", P, err);
+        char *first = strstr(err, "exists already");
+        ES_CHECK_MSG(first && !strstr(first + 1, "exists already"), "the refusal is not said "
+                     "once: %s", err);
+    }
+    /* gpa: every rank reads and aligns its share, rank 0 takes the PCA and stores */
+    ES_RUN(&r, dir, "gpa", store, "--name", "serial");
+    ES_CHECK_MSG(r.status == 0, "%s", r.err);
+    for (int P = 2; P <= 4; P += 2) {
+        snprintf(args, sizeof args, "gpa '%s' --name np%d", store, P);
+        ES_CHECK_MSG(run_mpi(P, args, err, sizeof err) == 0, "mpirun -n %d gpa: %s", P, err);
+        char name[32];
+        snprintf(name, sizeof name, "np%d", P);
+        same_gpa(ctx, "serial", name);
+        ES_CHECK_MSG(run_mpi(P, args, err, sizeof err) != 0 && strstr(err, "exists already"),
+                     "mpirun -n %d gpa again: %s", P, err);
         char *first = strstr(err, "exists already");
         ES_CHECK_MSG(first && !strstr(first + 1, "exists already"), "the refusal is not said "
                      "once: %s", err);

@@ -61,20 +61,6 @@ static es_status read_rows(es_ctx *ctx, const es_source *src, int64_t row0, int6
     return ES_OK;
 }
 
-static double maxabs(const double *a, int64_t n)
-{
-    double m = 0;
-    for (int64_t i = 0; i < n; i++) m = fmax(m, fabs(a[i]));
-    return m;
-}
-
-static double maxdiff(const double *a, const double *b, int64_t n)
-{
-    double m = 0;
-    for (int64_t i = 0; i < n; i++) m = fmax(m, fabs(a[i] - b[i]));
-    return m;
-}
-
 /* The fit on the job agrees with the fit alone. */
 static void same_fit(const es_pca *a, const es_pca *b, const char *what)
 {
@@ -85,17 +71,17 @@ static void same_fit(const es_pca *a, const es_pca *b, const char *what)
     double tol = 1e-12;
     ES_CHECK_MSG(fabs(a->total_variance - b->total_variance) <= tol * b->total_variance,
                  "%s: total variance %.17g vs %.17g", what, a->total_variance, b->total_variance);
-    ES_CHECK_MSG(maxdiff(a->eigenvalues, b->eigenvalues, K) <= tol * maxabs(b->eigenvalues, K),
-                 "%s: eigenvalues differ by %g", what, maxdiff(a->eigenvalues, b->eigenvalues, K));
-    ES_CHECK_MSG(maxdiff(a->mean, b->mean, E) <= tol * maxabs(b->mean, E), "%s: mean", what);
+    ES_CHECK_MSG(es_test_maxdiff(a->eigenvalues, b->eigenvalues, K) <= tol * es_test_maxabs(b->eigenvalues, K),
+                 "%s: eigenvalues differ by %g", what, es_test_maxdiff(a->eigenvalues, b->eigenvalues, K));
+    ES_CHECK_MSG(es_test_maxdiff(a->mean, b->mean, E) <= tol * es_test_maxabs(b->mean, E), "%s: mean", what);
     /* components and scores: the well-separated leading ones (the noise
      * floor's eigenvectors are not determined to 1e-12 by any order) */
     int64_t k_sep = K < 5 ? K : 5;
-    ES_CHECK_MSG(maxdiff(a->components, b->components, E * k_sep) <= 1e-9,
+    ES_CHECK_MSG(es_test_maxdiff(a->components, b->components, E * k_sep) <= 1e-9,
                  "%s: components differ by %g", what,
-                 maxdiff(a->components, b->components, E * k_sep));
-    ES_CHECK_MSG(maxdiff(a->scores, b->scores, N * k_sep) <= 1e-12 * maxabs(b->scores, N * k_sep) + 1e-15,
-                 "%s: scores differ by %g", what, maxdiff(a->scores, b->scores, N * k_sep));
+                 es_test_maxdiff(a->components, b->components, E * k_sep));
+    ES_CHECK_MSG(es_test_maxdiff(a->scores, b->scores, N * k_sep) <= 1e-12 * es_test_maxabs(b->scores, N * k_sep) + 1e-15,
+                 "%s: scores differ by %g", what, es_test_maxdiff(a->scores, b->scores, N * k_sep));
 }
 
 static void check_route(es_ctx *job, es_ctx *alone, data *d, es_pca_method m, int64_t K,
@@ -171,8 +157,8 @@ int main(int argc, char **argv)
             for (int64_t t = 0; t < ma->nterms; t++)
                 ES_CHECK_MSG(mj->pval[t] == ma->pval[t], "model term %lld: p %.17g vs %.17g",
                              (long long)t, mj->pval[t], ma->pval[t]);
-            ES_CHECK_MSG(maxdiff(mj->ssperm, ma->ssperm, n) <= 1e-12 * maxabs(ma->ssperm, n),
-                         "model: permutation SS differ by %g", maxdiff(mj->ssperm, ma->ssperm, n));
+            ES_CHECK_MSG(es_test_maxdiff(mj->ssperm, ma->ssperm, n) <= 1e-12 * es_test_maxabs(ma->ssperm, n),
+                         "model: permutation SS differ by %g", es_test_maxdiff(mj->ssperm, ma->ssperm, n));
         }
         es_model_free(mj);
         es_model_free(ma);

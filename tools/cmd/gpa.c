@@ -15,7 +15,8 @@ static const char usage[] =
     "rows of STORE, with the PCA of the tangent coordinates; conventions of R's\n"
     "shapes::procGPA. Results go to /analysis/gpa/NAME in the store (aligned\n"
     "configurations, mean, centroid sizes, rho, rotations, scales, PCs) with the\n"
-    "options and convergence. Planar data (z = 0) are analysed in 2D.\n"
+    "options and convergence. Planar data (z = 0) are analysed in 2D. Under\n"
+    "mpirun -n P (the MPI build) each rank reads and aligns a share of the rows.\n"
     "\n"
     "  -n, --name NAME         result name (required)\n"
     "      --no-scale          partial GPA: rotation and translation only\n"
@@ -81,10 +82,18 @@ int cmd_gpa(int argc, char **argv)
     int64_t *rows = NULL, nrows = -1;
     es_gpa_report rep;
     char *cmd = cli_command_line(argc, argv);
-    es_status rc = es_store_open(ctx, argv[optind], wmode, &s);
+    /* on the ranks of an MPI job every rank reads and aligns its share of
+     * the rows, rank 0 alone writes; a refusal before the fit (a taken
+     * name) and the outcome are agreed on by all */
+    const int writer = es_ctx_rank(ctx) == 0;
+    es_status rc = es_store_open(ctx, argv[optind], writer ? wmode : ES_STORE_READ, &s);
     if (rc == ES_OK && where && *where) rc = es_store_select(ctx, s, where, &rows, &nrows);
-    if (rc == ES_OK) rc = es_study_gpa(ctx, s, name, rows, nrows, &o, npc, cmd, &rep);
-    if (rc == ES_OK) rc = es_store_commit(ctx, s);
+    if (rc == ES_OK && writer) rc = es_store_result_check(ctx, s, "gpa", name);
+    rc = es_ctx_agree(ctx, rc);
+    if (rc == ES_OK)
+        rc = es_study_gpa(ctx, s, writer ? name : NULL, rows, nrows, &o, npc, cmd, &rep);
+    if (rc == ES_OK && writer) rc = es_store_commit(ctx, s);
+    rc = es_ctx_agree(ctx, rc);
     if (rc != ES_OK) {
         cli_fail("gpa", ctx, rc);
         es_store_abort(s);

@@ -16,6 +16,8 @@ static const char usage[] =
     "is written to a working copy that replaces STORE only when every input is\n"
     "in: on any error (or if killed) the store is left exactly as it was.\n"
     "Inputs whose id and content are in the store already are skipped.\n"
+    "Under mpirun -n P (the MPI build) each rank reads a share of the inputs and\n"
+    "the ranks write the store together (parallel HDF5); the store is the same.\n"
     "\n"
     "      --manifest CSV  CSV with a 'file' column (paths relative to the CSV),\n"
     "                      an optional 'id' column and any label columns\n"

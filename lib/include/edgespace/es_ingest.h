@@ -94,7 +94,12 @@ typedef struct es_ingest_report {
 } es_ingest_report;
 
 /* Ingest the meshes of a manifest (labels from its columns) into the store
- * at store_path. opts NULL: defaults. report may be NULL. */
+ * at store_path. opts NULL: defaults. report may be NULL. On a context
+ * joined to an MPI job (es_parallel.h) this and es_ingest_files are
+ * collective: each rank reads its share of the meshes and the values are
+ * written with collective parallel-HDF5 writes; the store is the one a
+ * single process makes, the report and status the same on every rank
+ * (datasets-spec/parallel.md). */
 ES_API es_status es_ingest_manifest(es_ctx *ctx, const char *store_path,
                                     const char *manifest_path, const es_ingest_opts *opts,
                                     es_ingest_report *report);

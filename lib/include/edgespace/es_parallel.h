@@ -3,9 +3,10 @@
  *
  * A library built with -Dmpi=enabled (Open MPI and Debian's openmpi build of
  * HDF5) runs PCA (Gram, covariance and randomized routes: es_pca_fit, and
- * `mpirun -n P edgespace pca`) and the permutations of a linear model
- * (es_model_fit) on P processes ("ranks"); ingest and GPA are still one
- * process (datasets-spec/parallel.md says what runs where). Every rank runs the same program: a
+ * `mpirun -n P edgespace pca`), the permutations of a linear model
+ * (es_model_fit), GPA (es_gpa_align_ranks) and mesh ingest
+ * (es_ingest_manifest, es_ingest_files: collective parallel-HDF5 writes)
+ * on P processes ("ranks"); datasets-spec/parallel.md says what runs where. Every rank runs the same program: a
  * context joined to the job (es_ctx_join_parallel) makes those calls
  * collective, so every rank must make them, in the same order and with the
  * same arguments; each returns the same status on every rank, with the
@@ -55,6 +56,10 @@ ES_API es_status es_ctx_join_parallel(es_ctx *ctx);
  * context not joined to one. */
 ES_API int es_ctx_rank(const es_ctx *ctx);
 ES_API int es_ctx_nranks(const es_ctx *ctx);
+
+/* The contiguous share [*lo, *hi) of n items (rows, configurations) that
+ * this rank takes: the first n % P ranks take one more; 0 and n alone. */
+ES_API void es_ctx_share(const es_ctx *ctx, int64_t n, int64_t *lo, int64_t *hi);
 
 /* Wait for every rank of ctx's job (MPI_Barrier); ES_OK at once alone. */
 ES_API es_status es_ctx_barrier(es_ctx *ctx);

@@ -121,6 +121,21 @@ ES_API es_status es_gpa_align(es_ctx *ctx, int64_t k, int d, es_mat x,
                               const es_gpa_opts *opts, es_gpa_out *out,
                               es_gpa_report *report);
 
+/* es_gpa_align on the ranks of ctx's job (es_parallel.h; collective: every
+ * rank calls it with the same k, d, n and options): n configurations in
+ * all, of which x (k*d x m, ld = k*d) holds this rank's contiguous share
+ * (es_ctx_share(ctx, n, ...): m = hi - lo), aligned in place. out's arrays
+ * are for all n and every rank receives all of them; the report is the
+ * same on every rank. The sweep is sequential (Gauss-Seidel), so the ranks
+ * take their shares in turn and hand the running sum on: the result is
+ * one process's to rounding (the same additions in the same order).
+ * Memory: each rank its share, rank 0 on the exact Ten Berge route (n^2 k d
+ * <= 2e8) every configuration. On a context that is alone it is
+ * es_gpa_align. */
+ES_API es_status es_gpa_align_ranks(es_ctx *ctx, int64_t k, int d, int64_t n, es_mat x,
+                                    const es_gpa_opts *opts, es_gpa_out *out,
+                                    es_gpa_report *report);
+
 typedef enum es_tangent {
     ES_TANGENT_RESIDUAL = 0, /* aligned - mean (procGPA's default "residual") */
     ES_TANGENT_PARTIAL = 1   /* orthogonal projection at the unit-size mean */

@@ -218,7 +218,11 @@ ES_API const char *es_study_result_tables(const char *kind, char *buf, size_t n)
  * landmarks) are analysed in 2D (dim 2), so that a 3D rotation cannot act
  * as a reflection. npc <= 0: min(10, n - 1). Memory: the positions of the
  * rows (n x 3V doubles) once. The store must be open for writing; the
- * caller commits (es_store_commit / es_store_close). report may be NULL. */
+ * caller commits (es_store_commit / es_store_close). report may be NULL.
+ * On a context joined to an MPI job it is collective: every rank reads and
+ * aligns its share of the rows (es_gpa_align_ranks; the others may open the
+ * store read-only and pass name NULL), rank 0 gathers them, takes the PCA
+ * and writes; each rank holds 3V x n/P doubles, rank 0 all n. */
 ES_API es_status es_study_gpa(es_ctx *ctx, es_store *store, const char *name,
                                   const int64_t *rows, int64_t nrows, const es_gpa_opts *opts,
                                   int64_t npc, const char *command, es_gpa_report *report);

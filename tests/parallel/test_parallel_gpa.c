@@ -1,0 +1,130 @@
+/* tests/parallel/test_parallel_gpa.c — generalized Procrustes analysis on the
+ * ranks of an MPI job (es_gpa_align_ranks) gives the one-process result. Run
+ * under `mpirun -n 2` and `-n 4` by the -Dmpi=enabled build
+ * (tests/parallel/meson.build); alone in the default build, where
+ * es_gpa_align_ranks is es_gpa_align.
+ *
+ * Every rank makes the same seeded configurations; the oracle is es_gpa_align
+ * (the serial code, itself checked against R's shapes::procGPA in
+ * tests/procrustes) on every configuration, run on each rank with a context
+ * that is not joined to the job. The joined context aligns only this rank's
+ * share. Compared to 1e-12 of their scale: the rank's aligned
+ * configurations, the mean, scales, rotations, rho, sizes, centroids and the
+ * report (iterations, GSS, rmsrho), for full GPA on the exact Ten Berge route
+ * (n^2 k d small: rank 0 decomposes), full GPA on the power-iteration route
+ * (n^2 k d > 2e8: each rank takes its dots), partial GPA, and planar data;
+ * 61 and 203 configurations do not split evenly. A configuration of zero
+ * size on the last rank fails the fit on every rank with its message. */
+#include "edgespace/edgespace.h"
+#include "es_test.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* n noisy copies of one random k x d template, each scaled, rotated about
+ * a random axis and shifted (column-major k x d per column). */
+static double *make(int64_t k, int d, int64_t n, uint64_t seed)
+{
+    es_rng rng;
+    int64_t kd = k * d;
+    double *x = malloc((size_t)(kd * n) * sizeof *x), *t = malloc((size_t)kd * sizeof *t);
+    es_rng_init(&rng, seed);
+    for (int64_t v = 0; v < kd; v++) t[v] = es_rng_normal(&rng);
+    for (int64_t j = 0; j < n; j++) {
+        double a = es_rng_normal(&rng), s = 1.0 + 0.2 * es_rng_uniform(&rng);
+        double c = cos(a), sn = sin(a), sh[3];
+        for (int q = 0; q < d; q++) sh[q] = es_rng_normal(&rng);
+        for (int64_t v = 0; v < k; v++) {
+            double p[3];
+            for (int q = 0; q < d; q++) p[q] = t[v + q * k] + 0.05 * es_rng_normal(&rng);
+            double r0 = c * p[0] - sn * p[1], r1 = sn * p[0] + c * p[1];
+            x[j * kd + v] = s * r0 + sh[0];
+            x[j * kd + v + k] = s * r1 + sh[1];
+            if (d == 3) x[j * kd + v + 2 * k] = s * p[2] + sh[2];
+        }
+    }
+    free(t);
+    return x;
+}
+
+static void check(es_ctx *job, es_ctx *alone, int64_t k, int d, int64_t n, int scale,
+                  const char *what)
+{
+    const int64_t kd = k * d;
+    int64_t lo, hi;
+    es_gpa_opts o;
+    es_gpa_opts_init(&o);
+    o.scale = scale;
+    es_ctx_share(job, n, &lo, &hi);
+    double *x = make(k, d, n, 7 + (uint64_t)n), *mine = malloc((size_t)(kd * (hi - lo) + 1) * 8);
+    memcpy(mine, x + lo * kd, (size_t)(kd * (hi - lo)) * sizeof *x);
+    /* one block per side: mean kd, size, rho, scale n, rot d*d*n, centroid d*n */
+    int64_t len = kd + (3 + d * d + d) * n;
+    double *a = calloc((size_t)len, 8), *b = calloc((size_t)len, 8);
+    es_gpa_out oa = {a, a + kd, a + kd + n, a + kd + 2 * n, a + kd + 3 * n, a + kd + (3 + d * d) * n};
+    es_gpa_out ob = {b, b + kd, b + kd + n, b + kd + 2 * n, b + kd + 3 * n, b + kd + (3 + d * d) * n};
+    es_gpa_report ra, rb;
+    ES_CHECK_OK(alone, es_gpa_align(alone, k, d, (es_mat){x, kd, n, kd}, &o, &oa, &ra));
+    ES_CHECK_OK(job, es_gpa_align_ranks(job, k, d, n, (es_mat){mine, kd, hi - lo, kd}, &o, &ob,
+                                        &rb));
+    ES_CHECK_MSG(ra.iterations == rb.iterations && ra.converged && rb.converged,
+                 "%s: %lld vs %lld iterations", what, (long long)ra.iterations,
+                 (long long)rb.iterations);
+    ES_CHECK_MSG(fabs(ra.gss - rb.gss) <= 1e-12 * ra.gss && fabs(ra.rmsrho - rb.rmsrho) <= 1e-12 *
+                 ra.rmsrho && fabs(ra.total_ss - rb.total_ss) <= 1e-12 * ra.total_ss,
+                 "%s: report differs (gss %.17g vs %.17g)", what, ra.gss, rb.gss);
+    double dx = es_test_maxdiff(x + lo * kd, mine, kd * (hi - lo)), sx = es_test_maxabs(x, kd * n);
+    ES_CHECK_MSG(dx <= 1e-12 * sx, "%s: aligned configurations differ by %g (scale %g)", what,
+                 dx, sx);
+    static const char *const names[] = {"mean", "size", "rho", "scale", "rotation", "centroid"};
+    const int64_t off[] = {0, kd, kd + n, kd + 2 * n, kd + 3 * n, kd + (3 + d * d) * n, len};
+    for (int q = 0; q < 6; q++) {
+        double dq = es_test_maxdiff(a + off[q], b + off[q], off[q + 1] - off[q]);
+        double sq = es_test_maxabs(a + off[q], off[q + 1] - off[q]);
+        ES_CHECK_MSG(dq <= 1e-12 * sq, "%s: %s differs by %g (scale %g)", what, names[q], dq, sq);
+    }
+    free(x);
+    free(mine);
+    free(a);
+    free(b);
+}
+
+int main(int argc, char **argv)
+{
+    ES_TEST_BEGIN();
+    es_ctx *job = NULL, *alone = NULL;
+    ES_CHECK(es_ctx_new(&job) == ES_OK && es_ctx_new(&alone) == ES_OK);
+    ES_CHECK_OK(job, es_parallel_init(job, &argc, &argv));
+    ES_CHECK_OK(job, es_ctx_join_parallel(job));
+    const int P = es_ctx_nranks(job), me = es_ctx_rank(job);
+    if (me == 0) printf("parallel gpa: %d rank(s)\n", P);
+
+    check(job, alone, 40, 3, 61, 1, "full, exact scaling");
+    check(job, alone, 40, 3, 61, 0, "partial");
+    check(job, alone, 25, 2, 61, 1, "planar, full");
+    check(job, alone, 1700, 3, 203, 1, "full, power-iteration scaling");   /* 203^2 5100 > 2e8 */
+
+    /* a configuration of zero size in the last rank's share: every rank fails with its message */
+    {
+        const int64_t k = 10, kd = 30, n = 13;
+        int64_t lo, hi;
+        es_ctx_share(job, n, &lo, &hi);
+        double *x = make(k, 3, n, 3);
+        for (int64_t v = 0; v < kd; v++) x[(n - 1) * kd + v] = 1.0;
+        ES_CHECK_FAILS(job, es_gpa_align_ranks(job, k, 3, n, (es_mat){x + lo * kd, kd, hi - lo, kd},
+                                               NULL, NULL, NULL),
+                       ES_EINVAL, "configuration 12 has zero centroid size");
+        free(x);
+    }
+    int64_t msgs = 0, bytes = 0;
+    es_ctx_parallel_traffic(job, &msgs, &bytes);
+    ES_CHECK(P == 1 ? msgs == 0 : msgs > 0);
+    if (me == 0) printf("rank 0 sent %lld messages, %lld bytes\n", (long long)msgs, (long long)bytes);
+    es_ctx_free(job);
+    es_ctx_free(alone);
+    int failed = es_test_failures;
+    es_parallel_finalize();
+    return failed ? 1 : 0;
+}
