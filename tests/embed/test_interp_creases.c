@@ -12,8 +12,12 @@
  * lengths as the weighted mean of sum-normalized lengths at the weighted
  * mean scale (edge-length-interpolation eq. 12). And where the frame is an
  * input itself (weight 1 on it) the guard must cost nothing: the input
- * comes back.
+ * comes back. The band term itself (bending.c): its value is the weighted
+ * squared distance of each angle from its band, and its gradient that of
+ * central differences of the value.
  */
+#define ES_MODULE_EMBED   /* the module's own test: its package header too */
+#include "embed/embed_pkg.h"
 #include "es_test.h"
 
 #include <edgespace/edgespace.h>
@@ -149,6 +153,53 @@ static void measure(const es_mesh *m, const double *const *in, const double *w, 
     free(a), free(most), free(l), free(t);
 }
 
+/* The band term on the bent tube x: bands around its own angles, shifted
+ * so that about a third of the edges lie below, a third above and a third
+ * inside; the value against its definition, the half-gradient that
+ * es__bend_assemble adds against central differences of the value. */
+static void check_band_term(es_ctx *ctx, es_embedder *emb, const es_mesh *m, const double *x)
+{
+    int64_t ne = es_mesh_nedges(m), nv = es_mesh_nverts(m);
+    double *a = malloc(sizeof(double) * (size_t)ne), *g = calloc((size_t)(3 * nv), sizeof(double));
+    double *l = malloc(sizeof(double) * (size_t)ne), *xx = malloc(sizeof(double) * (size_t)(3 * nv));
+    ES_CHECK_OK(ctx, es__bend_work(emb));
+    ES_CHECK_OK(ctx, es__embedder_need(emb, ES__NEED_H3));
+    ES_CHECK_OK(ctx, es_dihedral_angles(ctx, m, x, a));
+    lengths(m, x, l);
+    es__bend_weights(emb, l, NULL, 0, emb->omega);
+    for (int64_t e = 0; e < ne; e++) {
+        double s = e % 3 == 0 ? 0.05 : e % 3 == 1 ? -0.05 : 0;   /* below, above, inside */
+        emb->band_lo[e] = a[e] + s - 0.02;
+        emb->band_hi[e] = a[e] + s + 0.02;
+    }
+    es__bend_prior bp = {.alpha = emb->band_lo, .hi = emb->band_hi, .omega = emb->omega,
+                         .flap = emb->flap, .mu = 0.7, .decay = 1, .mu_min = 0.7};
+    double want = 0;
+    for (int64_t e = 0; e < ne; e++) {
+        double d = a[e] < emb->band_lo[e] ? a[e] - emb->band_lo[e]
+                   : a[e] > emb->band_hi[e] ? a[e] - emb->band_hi[e] : 0;
+        want += 0.7 * emb->omega[e] * d * d;
+    }
+    ES_CHECK_CLOSE(es__bend_cost(emb, &bp, x), want, 1e-10, 1e-14);
+    es__bend_assemble(emb, x, &bp, g);
+    double worst = 0, gmax = 0;
+    memcpy(xx, x, sizeof(double) * (size_t)(3 * nv));
+    for (int64_t i = 0; i < 3 * nv; i += 7) {
+        double h = 1e-6, c1, c2, fd;
+        xx[i] = x[i] + h;
+        c1 = es__bend_cost(emb, &bp, xx);
+        xx[i] = x[i] - h;
+        c2 = es__bend_cost(emb, &bp, xx);
+        xx[i] = x[i];
+        fd = 0.5 * (c1 - c2) / (2 * h);   /* the half-gradient */
+        worst = fmax(worst, fabs(fd - g[i]));
+        gmax = fmax(gmax, fabs(g[i]));
+    }
+    ES_CHECK_MSG(gmax > 0 && worst < 1e-5 * gmax, "band term: half-gradient off central "
+                 "differences by %g (largest component %g)", worst, gmax);
+    free(a), free(g), free(l), free(xx);
+}
+
 int main(void)
 {
     ES_TEST_BEGIN();
@@ -181,6 +232,7 @@ int main(void)
         bend(nv, set.xyz, axis, dirs[k][0], dirs[k][1], dirs[k][2], dirs[k][3], x[k]);
     }
     const double *in[NIN] = {x[0], x[1], x[2], x[3]};
+    check_band_term(ctx, emb, mesh, x[0]);
     double worst[2] = {0, 0}, mean[2] = {0, 0}, worst_rms[2] = {0, 0};
     for (int guard = 0; guard < 2; guard++) {
         es_embed_opts o;
