@@ -223,7 +223,7 @@ static int embed_mean(notebook *nb, study *s)
         free(prior);
         return nb_fail(nb, rc, "embedder");
     }
-    es_embed_prior pr = {prior, prior + 3 * s->V, prior + 3 * s->V + s->E, NULL};
+    es_embed_prior pr = {prior, prior + 3 * s->V, prior + 3 * s->V + s->E, NULL, NULL, NULL};
     rc = es_embed_prior_solve(nb->ctx, emb, s->mean_len, s->mean_scale, &pr, &eo, s->emb, &s->rep);
     es_embedder_free(emb);
     free(prior);

@@ -184,7 +184,7 @@ static int embed_pair(notebook *nb, pair *p)
     if (rc == ES_OK) {
         t0 = nb_now();
         if (p->open) {
-            es_embed_prior pr = {prior, alpha, NULL, NULL};
+            es_embed_prior pr = {prior, alpha, NULL, NULL, NULL, NULL};
             rc = es_embed_prior_solve(nb->ctx, emb, len, 0, &pr, NULL, x, &rep);
         } else {
             rc = es_embed_solve(nb->ctx, emb, len, 0, alpha, p->xa, NULL, x, &rep);

@@ -312,6 +312,11 @@ int cli_embed_option(const char *verb, int c, const char *arg, es_embed_opts *o)
         else if (!strcmp(arg, "lm")) o->solver = ES_EMBED_SOLVER_LM;
         else return cli_usage_error(verb, "--solver wants auto or lm (got '%s')", arg);
         return 0;
+    case 0x106:
+        if (cli_parse_double(arg, &w) || !(w >= 0))
+            return cli_usage_error(verb, "--crease-guard wants a weight >= 0");
+        o->crease_mu = w;
+        return 0;
     default:
         return -1;
     }

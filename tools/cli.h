@@ -47,7 +47,7 @@ int cli_parse_size(const char *s, uint64_t *out);
 #define CLI_EMBED_LONGOPTS \
     {"bending", required_argument, NULL, 0x101}, {"refine-iters", required_argument, NULL, 0x102}, \
     {"iters", required_argument, NULL, 0x103}, {"fast", no_argument, NULL, 0x104}, \
-    {"solver", required_argument, NULL, 0x105}
+    {"solver", required_argument, NULL, 0x105}, {"crease-guard", required_argument, NULL, 0x106}
 #define CLI_EMBED_HELP \
     "      --iters N        local-global iterations at most (default 40, 70 from\n" \
     "                       50,000 vertices; the solver: lib/embed/local_global.c)\n" \
@@ -60,7 +60,10 @@ int cli_parse_size(const char *s, uint64_t *out);
     "      --solver NAME    auto (the above) or lm (Levenberg-Marquardt from the prior,\n" \
     "                       the solver before: a 3V x 3V factorization per iteration)\n" \
     "      --bending W      weight of the prior's bending term in the Levenberg-\n" \
-    "                       Marquardt iterations (default 0.0025)\n"
+    "                       Marquardt iterations (default 0.0025)\n" \
+    "      --crease-guard W closed meshes: weight of the term that keeps each edge's\n" \
+    "                       bending within the blended rows' (default 0.001; more:\n" \
+    "                       fewer folds, more length error; 0: off)\n"
 int cli_embed_option(const char *verb, int c, const char *arg, es_embed_opts *o);
 
 /* getopt_long for a subcommand (argv[0] is the verb), with the old option

@@ -86,6 +86,14 @@ int es__dihedral_grad(const double *pa, const double *pb, const double *pc, cons
     return 0;
 }
 
+/* The term's residual of edge e at bending angle al: the wrapped distance
+ * from the prior's angle, or with a band the distance outside it. */
+static double bend_residual(const es__bend_prior *bp, int64_t e, double al)
+{
+    if (bp->hi) return al < bp->alpha[e] ? al - bp->alpha[e] : al > bp->hi[e] ? al - bp->hi[e] : 0;
+    return remainder(al - bp->alpha[e], 2.0 * M_PI);
+}
+
 double es__bend_cost(const es_embedder *emb, const es__bend_prior *bp, const double *xyz)
 {
     double c = 0;
@@ -95,7 +103,7 @@ double es__bend_cost(const es_embedder *emb, const es__bend_prior *bp, const dou
         if (fl[0] < 0 || !(bp->omega[e] > 0)) continue;
         al = flap_alpha(xyz + 3 * emb->edges[2 * e], xyz + 3 * emb->edges[2 * e + 1],
                         xyz + 3 * fl[0], xyz + 3 * fl[1], nf, ng, t, &el);
-        r = remainder(al - bp->alpha[e], 2.0 * M_PI);
+        r = bend_residual(bp, e, al);
         c += bp->omega[e] * r * r;
     }
     return bp->mu * c;
@@ -116,7 +124,10 @@ void es__bend_assemble(es_embedder *emb, const double *xyz, const es__bend_prior
         if (es__dihedral_grad(xyz + 3 * q[0], xyz + 3 * q[1], xyz + 3 * q[2], xyz + 3 * q[3],
                               &al, gq) != 0)
             continue;
-        r = remainder(al - bp->alpha[e], 2.0 * M_PI);
+        r = bend_residual(bp, e, al);
+        /* inside a band: no gradient and no curvature (the one-sided term is
+         * flat there) */
+        if (bp->hi && r == 0) continue;
         for (int p = 0; p < 4; p++)
             for (int i = 0; i < 3; i++) g[3 * q[p] + i] += w * r * gq[3 * p + i];
         /* the mesh edges between the flap's vertices (c-d is none) */
@@ -179,6 +190,17 @@ es_status es__bend_flaps(es_embedder *emb)
         if (o[0] < 0 || o[1] < 0 || o[0] == o[1]) o[0] = -1;
     }
     emb->flap = fl;
+    return ES_OK;
+}
+
+es_status es__bend_work(es_embedder *emb)
+{
+    es_status rc;
+    if ((rc = es__bend_flaps(emb)) != ES_OK) return rc;
+    double **bufs[] = {&emb->omega, &emb->prior_alpha, &emb->band_lo, &emb->band_hi};
+    for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++)
+        if (!*bufs[i] && !(*bufs[i] = es__alloc_array(emb->ctx, emb->ne + 1, sizeof(double))))
+            return ES_ENOMEM;
     return ES_OK;
 }
 

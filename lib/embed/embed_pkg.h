@@ -85,6 +85,7 @@ struct es_embedder {
     /* the bending prior (bending.c, prior.c), made on the first prior solve */
     int64_t *flap;          /* 6E: c, d, edges ac, bc, ad, bd of each interior edge's faces */
     double *omega, *prior_alpha, *vdev;   /* E, E, V (vdev: distance from the prior) */
+    double *band_lo, *band_hi;   /* E, E: the crease guard's band (crease_guard.c) */
     int have_deviation;
     int64_t nfactor;        /* numeric factorizations in the last solve */
     /* the local-global solve (local_global.c), made on its first use: the
@@ -198,7 +199,13 @@ es_status es__stage_positions(es_embedder *emb, const double *len, double *xyz);
  * semi-definite, bounds g g^T from above, and fits the vertex-adjacency
  * pattern the embedder analysed once. */
 typedef struct es__bend_prior {
-    const double *alpha;   /* E: prior dihedrals (compared modulo 2 pi) */
+    const double *alpha;   /* E: prior dihedrals (compared modulo 2 pi); with hi, the
+                              lower ends of a band */
+    const double *hi;      /* NULL, or E: the band's upper ends. Then the term is one-
+                              sided, mu sum_e omega_e dist(alpha_e(x), [alpha_e, hi_e])^2
+                              (no wrap): zero inside the band, so it only holds
+                              bending the band does not allow (the crease guard of
+                              es_interp_embed) */
     const double *omega;   /* E: per-edge weights >= 0 (0: not in the term) */
     const int64_t *flap;   /* 6E (embedder's flap) */
     double mu;             /* weight of the term now */
@@ -218,6 +225,23 @@ double es__bend_cost(const es_embedder *emb, const es__bend_prior *bp, const dou
 void es__bend_assemble(es_embedder *emb, const double *xyz, const es__bend_prior *bp, double *g);
 /* emb->flap, made once per embedder. */
 es_status es__bend_flaps(es_embedder *emb);
+/* The term's work, made on its first use in an embedder: the flaps, and
+ * emb->omega, prior_alpha, band_lo and band_hi. */
+es_status es__bend_work(es_embedder *emb);
+
+/* The crease guard (crease_guard.c): a band term of weight mu over the
+ * band of each interior edge, widened by margin on both sides, in
+ * emb->band_lo / band_hi, with emb->omega from the target lengths len.
+ * From the inputs: the span of the bending angles of the inputs with a
+ * weight (not 0) and of the interpolated angles alpha. From a prior: the
+ * rows' span (span_lo, span_hi) and alpha, or without it alpha +- 3 sd
+ * (the rows' spread). */
+es_status es__crease_guard_inputs(es_embedder *emb, int64_t nin, const double *const *xyz,
+                                  const double *w, const double *alpha, const double *len,
+                                  double margin, double mu, es__bend_prior *guard);
+es_status es__crease_guard_prior(es_embedder *emb, const double *alpha, const double *span_lo,
+                                 const double *span_hi, const double *sd, const double *len,
+                                 double margin, double mu, es__bend_prior *guard);
 /* omega (E): the discrete-shells weight 3 l_e^2 / (A_f + A_g) from lengths L
  * normalized to mean 1, divided by 1 + (sd_e / s0)^2 when sd is given, s0 =
  * sd_floor x the median sd over interior edges. */
@@ -300,6 +324,13 @@ typedef struct es__solve_ext {
                                  a slider): the solver may keep that solve's factor */
     es__bend_prior *bp;       /* NULL: lengths only */
 } es__solve_ext;
+
+/* es_embed_solve (its stages from init_alpha, or init_xyz, as there) with
+ * the bending term bp in the refinement (NULL: lengths only). */
+es_status es__embed_solve_bend(es_ctx *ctx, es_embedder *emb, const double *target, double scale,
+                               const double *init_alpha, const double *init_xyz,
+                               const double *align_ref, es__bend_prior *bp,
+                               const es_embed_opts *opts, double *xyz, es_embed_report *report);
 
 /* es_embed_solve with the extensions; start_xyz and align_ref must not
  * alias xyz. */

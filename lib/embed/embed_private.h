@@ -57,6 +57,11 @@ int es__prior_solve_reads_dihedrals(es_embedder *emb, const double *target, doub
                                     const double *prior_xyz, const double *start,
                                     const es_embed_opts *opts);
 
+/* Whether it reads prior->span_lo and span_hi: the crease guard of a closed
+ * mesh without the bending term (crease_mu > 0). Without them it takes its
+ * band from prior->sd. */
+int es__prior_solve_reads_span(const es_embedder *emb, const es_embed_opts *opts);
+
 /* ---- rotations (align.c) ----------------------------------------------------- */
 
 /* Nearest proper rotation (Frobenius) to the row-major 3 x 3 matrix m, in

@@ -580,7 +580,7 @@ void es_embedder_free(es_embedder *emb)
                     emb->xyz_try, emb->xyz_best, emb->init_copy, emb->ltarget, emb->lpath,
                     emb->res, emb->grad, emb->diag, emb->pcg,
                     emb->jw, emb->fanwork, emb->fanr, emb->fanth, emb->fanal, emb->vclos,
-                    emb->verr, emb->flap, emb->omega, emb->prior_alpha, emb->vdev,
+                    emb->verr, emb->flap, emb->omega, emb->prior_alpha, emb->vdev, emb->band_lo, emb->band_hi,
                     emb->perm, emb->pinv, emb->eslot, emb->eswap, emb->vslot,
                     emb->lg_w, emb->lg_wf, emb->lg_rest, emb->lg_work};
     for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++) es__free(ctx, bufs[i]);

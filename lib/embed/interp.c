@@ -3,7 +3,7 @@
  * scale-normalized lengths, circular means of dihedrals for the start of
  * the embedding, sequences aligned frame to frame. See es_interp.h.
  */
-#include "core/core_private.h"
+#include "embed/embed_pkg.h"
 #include "edgespace/es_interp.h"
 #include "edgespace/es_geom.h"
 
@@ -103,6 +103,10 @@ done:
     return rc;
 }
 
+/* The refinement carries the crease guard (crease_guard.c): interpolated
+ * lengths are no mesh's, and realized without it they fold across the
+ * parts where the inputs differ most (notebook 07's Fig. 4 cats: 4-13 % of
+ * the edges bent past every input). */
 es_status es_interp_embed(es_ctx *ctx, es_embedder *emb, int64_t nin, const double *const *xyz,
                           const double *w, const double *align_to, const es_embed_opts *opts,
                           double *out, es_embed_report *report, es_interp_info *info)
@@ -110,8 +114,13 @@ es_status es_interp_embed(es_ctx *ctx, es_embedder *emb, int64_t nin, const doub
     const es_mesh *mesh = es_embedder_mesh(emb);
     int64_t ne = es_mesh_nedges(mesh);
     double *len, *alpha;
+    es_embed_opts dflt;
     es_interp_info inf;
     es_status rc;
+    if (!opts) {
+        es_embed_opts_init(&dflt);
+        opts = &dflt;
+    }
     len = es__alloc_array(ctx, ne, sizeof *len);
     alpha = es__alloc_array(ctx, ne, sizeof *alpha);
     if (!len || !alpha) {
@@ -119,8 +128,18 @@ es_status es_interp_embed(es_ctx *ctx, es_embedder *emb, int64_t nin, const doub
         goto done;
     }
     if ((rc = es_interp_targets(ctx, mesh, nin, xyz, w, len, alpha, &inf)) != ES_OK) goto done;
-    rc = es_embed_solve(ctx, emb, len, 0, alpha, align_to ? align_to : xyz[inf.reference], opts, out,
-                        report);
+    const double *ref = align_to ? align_to : xyz[inf.reference];
+    if (opts->crease_mu > 0 && opts->crease_margin >= 0) {
+        es__bend_prior guard;
+        if ((rc = es__crease_guard_inputs(emb, nin, xyz, w, alpha, len, opts->crease_margin,
+                                          opts->crease_mu, &guard)) != ES_OK) {
+            rc = es__fail(ctx, rc, "%s", es_ctx_errmsg(emb->ctx));
+            goto done;
+        }
+        rc = es__embed_solve_bend(ctx, emb, len, 0, alpha, ref, NULL, &guard, opts, out, report);
+    } else {
+        rc = es_embed_solve(ctx, emb, len, 0, alpha, ref, opts, out, report);
+    }
     if (rc == ES_OK && info) *info = inf;
 done:
     es__free(ctx, len);

@@ -165,12 +165,7 @@ es_status es_embed_prior_from_rows(es_ctx *ctx, int64_t nverts, int64_t nedges, 
 static es_status prior_work(es_embedder *emb)
 {
     es_status rc;
-    if ((rc = es__bend_flaps(emb)) != ES_OK) return rc;
-    if (!emb->omega && !(emb->omega = es__alloc_array(emb->ctx, emb->ne + 1, sizeof(double))))
-        return ES_ENOMEM;
-    if (!emb->prior_alpha &&
-        !(emb->prior_alpha = es__alloc_array(emb->ctx, emb->ne + 1, sizeof(double))))
-        return ES_ENOMEM;
+    if ((rc = es__bend_work(emb)) != ES_OK) return rc;
     if (!emb->vdev && !(emb->vdev = es__alloc_array(emb->ctx, emb->nv + 1, sizeof(double))))
         return ES_ENOMEM;
     return ES_OK;
@@ -255,6 +250,17 @@ int es__prior_solve_reads_dihedrals(es_embedder *emb, const double *target, doub
                             opts->prior_start_max_rms);
 }
 
+int es__prior_solve_reads_span(const es_embedder *emb, const es_embed_opts *opts)
+{
+    es_embed_opts dflt;
+    if (!emb) return 1;
+    if (!opts) {
+        es_embed_opts_init(&dflt);
+        opts = &dflt;
+    }
+    return !bends(emb, opts) && opts->crease_mu > 0 && opts->crease_margin >= 0;
+}
+
 es_status es_embed_prior_solve(es_ctx *ctx, es_embedder *emb, const double *target, double scale,
                                const es_embed_prior *prior, const es_embed_opts *opts, double *xyz,
                                es_embed_report *report)
@@ -301,10 +307,22 @@ es_status es_embed_prior_solve(es_ctx *ctx, es_embedder *emb, const double *targ
     for (int64_t e = 0; e < emb->ne; e++) emb->ltarget[e] = target[e] * f;
     es__bend_weights(emb, emb->ltarget, prior->sd, opts->prior_sd_floor, emb->omega);
     bend = bends(emb, opts);
-    bp = (es__bend_prior){emb->prior_alpha, emb->omega, emb->flap, opts->prior_mu,
-                          opts->prior_decay, opts->prior_mu * opts->prior_mu_floor};
+    bp = (es__bend_prior){.alpha = emb->prior_alpha, .omega = emb->omega, .flap = emb->flap,
+                          .mu = opts->prior_mu, .decay = opts->prior_decay,
+                          .mu_min = opts->prior_mu * opts->prior_mu_floor};
     memset(&ext, 0, sizeof ext);
     ext.bp = bend ? &bp : NULL;
+    /* a closed mesh without the term: interpolation, whose refinement
+     * carries the crease guard as es_interp_embed's does (crease_guard.c),
+     * its band from the rows' span */
+    if (!bend && ((prior->span_lo && prior->span_hi) || prior->sd) && opts->crease_mu > 0 &&
+        opts->crease_margin >= 0) {
+        if ((rc = es__crease_guard_prior(emb, emb->prior_alpha, prior->span_lo, prior->span_hi,
+                                         prior->sd, emb->ltarget, opts->crease_margin,
+                                         opts->crease_mu, &bp)) != ES_OK)
+            return es__fail(ctx, rc, "%s", es_ctx_errmsg(emb->ctx));
+        ext.bp = &bp;
+    }
     /* a closed mesh without the term: the dihedral path from the prior's
      * dihedrals, which is what interpolation does */
     ext.start_xyz = bend ? (prior->start ? prior->start : prior->xyz) : NULL;

@@ -74,6 +74,8 @@ void es_embed_opts_init(es_embed_opts *o)
     o->lg_max_iter_large = 70;
     o->realize_bend = 3;
     o->realize_margin = 0.01;
+    o->crease_margin = 0.1;
+    o->crease_mu = 1e-3;   /* measured: crease_guard.c */
 }
 
 void es_embed_opts_fast(es_embed_opts *o)
@@ -160,7 +162,8 @@ void es__length_fit(const es_embedder *emb, const double *xyz, const double *L, 
 /* Continuation: stage 4 along l(s) = (1 - s) l_init + s l_target from the
  * initial mesh (scaled to the target's sum), which realizes l(0) exactly. */
 static es_status run_continuation(es_embedder *emb, const es_embed_opts *o, const double *L,
-                                  const double *init_xyz, double *xyz, int64_t *iters)
+                                  const double *init_xyz, es__bend_prior *bp, double *xyz,
+                                  int64_t *iters)
 {
     int64_t n = o->continuation_steps, ne = emb->ne;
     double s0 = 0, s1 = 0, f;
@@ -183,7 +186,7 @@ static es_status run_continuation(es_embedder *emb, const es_embed_opts *o, cons
             ro.rtol = 1e-3;
             ro.rms_tol = ro.max_tol = 0;
         }
-        rc = es__stage_refine(emb, lp, xyz, NULL, &ro, iters);
+        rc = es__stage_refine(emb, lp, xyz, bp, &ro, iters);
         if (rc != ES_OK) return rc;
         es__progress(emb->ctx, "embed: continuation", step, n);
     }
@@ -519,7 +522,7 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
         double *cx = have_dihedral_result ? emb->xyz_best : xyz;
         int64_t it = 0;
         t1 = now_s();
-        if ((rc = run_continuation(emb, o, L, init_xyz, cx, &it)) != ES_OK) return rc;
+        if ((rc = run_continuation(emb, o, L, init_xyz, bp, cx, &it)) != ES_OK) return rc;
         rep.t_refine += now_s() - t1;
         rep.continuation_steps = o->continuation_steps;
         if (have_dihedral_result) {
@@ -652,4 +655,16 @@ es_status es__embed_solve_ext(es_ctx *ctx, es_embedder *emb, const double *targe
                               const es_embed_opts *opts, double *xyz, es_embed_report *report)
 {
     return solve_wrapped(ctx, emb, target, scale, init_alpha, NULL, ext, opts, xyz, report);
+}
+
+es_status es__embed_solve_bend(es_ctx *ctx, es_embedder *emb, const double *target, double scale,
+                               const double *init_alpha, const double *init_xyz,
+                               const double *align_ref, es__bend_prior *bp,
+                               const es_embed_opts *opts, double *xyz, es_embed_report *report)
+{
+    es__solve_ext ext;
+    memset(&ext, 0, sizeof ext);
+    ext.bp = bp;
+    ext.align_ref = align_ref;
+    return solve_wrapped(ctx, emb, target, scale, init_alpha, init_xyz, &ext, opts, xyz, report);
 }

@@ -31,7 +31,7 @@ struct es_study_embedder {
     es_embedder *emb;
     es_study_rows *rows;
     int64_t nv, ne, n;
-    double *target, *w, *prior, *last;   /* E, N, 3V + 2E, 3V */
+    double *target, *w, *prior, *last;   /* E, N, 3V + 4E, 3V */
     double *correction, *start;          /* 3V each: x_last - prior_last, the warm start */
     int last_ok;                         /* the last output bent <= 1.1 x its prior */
     int have_last;
@@ -74,7 +74,7 @@ es_status es_study_embedder_open(es_ctx *ctx, es_store *store, int use_cache,
     if ((rc = es__study_rows_check_memory(ctx, se->mesh, se->n)) != ES_OK) goto fail;
     se->target = es__alloc_array(ctx, se->ne, sizeof *se->target);
     se->w = es__alloc_array(ctx, se->n, sizeof *se->w);
-    se->prior = es__alloc_array(ctx, 3 * se->nv + 2 * se->ne, sizeof *se->prior);
+    se->prior = es__alloc_array(ctx, 3 * se->nv + 4 * se->ne, sizeof *se->prior);
     se->last = es__alloc_array(ctx, 3 * se->nv, sizeof *se->last);
     se->correction = es__alloc_array(ctx, 3 * se->nv, sizeof *se->correction);
     se->start = es__alloc_array(ctx, 3 * se->nv, sizeof *se->start);
@@ -125,7 +125,8 @@ es_status es_study_embedder_solve(es_ctx *ctx, es_study_embedder *se, const doub
     es_embed_opts o;
     es_status rc;
     if (!se) ES_FAIL(ctx, ES_EINVAL, "embed: no session");
-    double *alpha = se->prior + 3 * se->nv, *sd = alpha + se->ne;
+    double *alpha = se->prior + 3 * se->nv, *sd = alpha + se->ne, *lo = sd + se->ne,
+           *hi = lo + se->ne;
     if (es_store_nrows(se->store) != se->n)
         ES_FAIL(ctx, ES_EMISMATCH, "embed: the store has %lld rows, the session was made for "
                 "%lld: rows were added since; open a new session", (long long)es_store_nrows(se->store),
@@ -141,14 +142,18 @@ es_status es_study_embedder_solve(es_ctx *ctx, es_study_embedder *se, const doub
     if (warm)   /* (the solve scales the start to the target's sum) */
         for (int64_t i = 0; i < n3; i++) se->start[i] = se->prior[i] + se->correction[i];
     /* the circular means of the rows' dihedrals and their spread (twice the
-     * work of the positions' blend) only where the solve reads them: not
-     * for local-global iterations alone (a slider, a walk, --fast) from a
-     * start near the lengths */
+     * work of the positions' blend), and the span of the rows' dihedrals
+     * (the crease guard's band on closed meshes), only where the solve reads
+     * them: not for local-global iterations alone (a slider, a walk,
+     * --fast) from a start near the lengths */
     int dihedrals = es__prior_solve_reads_dihedrals(se->emb, lengths, scale, se->prior,
                                                     warm ? se->start : NULL, &o);
-    if (dihedrals && (rc = es_study_prior(ctx, se->rows, w, NULL, alpha, sd)) != ES_OK) return rc;
+    int span = dihedrals && es__prior_solve_reads_span(se->emb, &o);
+    if ((dihedrals && (rc = es_study_prior(ctx, se->rows, w, NULL, alpha, sd)) != ES_OK) ||
+        (span && (rc = es_study_prior_span(ctx, se->rows, w, lo, hi)) != ES_OK))
+        return rc;
     es_embed_prior pr = {se->prior, dihedrals ? alpha : NULL, dihedrals ? sd : NULL,
-                         warm ? se->start : NULL};
+                         warm ? se->start : NULL, span ? lo : NULL, span ? hi : NULL};
     if ((rc = es_embed_prior_solve(ctx, se->emb, lengths, scale, &pr, &o, xyz, &res->report)) !=
         ES_OK)
         return rc;

@@ -190,3 +190,21 @@ es_status es_study_prior(es_ctx *ctx, const es_study_rows *r, const double *w, d
     if (!r || !w) ES_FAIL(ctx, ES_EINVAL, "prior: no rows or weights");
     return es_embed_prior_from_rows(ctx, r->nv, r->ne, r->n, r->pa, r->pd, w, xyz, alpha, sd);
 }
+
+es_status es_study_prior_span(es_ctx *ctx, const es_study_rows *r, const double *w, double *lo,
+                              double *hi)
+{
+    int any = 0;
+    if (!r || !w || !lo || !hi) ES_FAIL(ctx, ES_EINVAL, "prior: no rows, weights or output");
+    for (int64_t j = 0; j < r->n; j++) {
+        if (w[j] == 0) continue;
+        for (int64_t e = 0; e < r->ne; e++) {
+            double a = r->pd[j][e];
+            lo[e] = any ? fmin(lo[e], a) : a;
+            hi[e] = any ? fmax(hi[e], a) : a;
+        }
+        any = 1;
+    }
+    if (!any) ES_FAIL(ctx, ES_EINVAL, "prior: every row's weight is 0");
+    return ES_OK;
+}

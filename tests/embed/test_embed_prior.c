@@ -146,7 +146,7 @@ static void test_open(es_ctx *ctx)
         ES_CHECK_OK(ctx, es_dihedral_angles(ctx, mesh, f.xyz, al[0]));
         ES_CHECK_OK(ctx, es_dihedral_angles(ctx, mesh, b, al[1]));
         /* a row: its own mesh comes back, in its own frame */
-        es_embed_prior pr = {prior, pal, psd, NULL};
+        es_embed_prior pr = {prior, pal, psd, NULL, NULL, NULL};
         ES_CHECK_OK(ctx, es_embed_prior_from_rows(ctx, nv, ne, 2, xs, (const double *const *)al,
                                                   w1, prior, pal, psd));
         ES_CHECK_OK(ctx, es_edge_lengths(ctx, mesh, f.xyz, len));
@@ -282,7 +282,7 @@ static void test_closed(es_ctx *ctx)
         xs[1] = b;
         ES_CHECK_OK(ctx, es_dihedral_angles(ctx, mesh, s.xyz, al[0]));
         ES_CHECK_OK(ctx, es_dihedral_angles(ctx, mesh, b, al[1]));
-        es_embed_prior pr = {prior, pal, NULL, NULL};
+        es_embed_prior pr = {prior, pal, NULL, NULL, NULL, NULL};
         ES_CHECK_OK(ctx, es_embed_prior_from_rows(ctx, nv, ne, 2, xs, (const double *const *)al,
                                                   w, prior, pal, NULL));
         ES_CHECK_OK(ctx, es_interp_targets(ctx, mesh, 2, xs, w, len, NULL, NULL));
@@ -309,8 +309,8 @@ static void test_bad_arguments(es_ctx *ctx)
         double *len = malloc((size_t)ne * sizeof *len), *out = malloc(3 * (size_t)nv * sizeof *out);
         double *bad = malloc(3 * (size_t)nv * sizeof *bad), w[1] = {NAN};
         const double *xs[1] = {s.xyz};
-        es_embed_prior none = {NULL, NULL, NULL, NULL}, self = {out, NULL, NULL, NULL},
-                       nan = {bad, NULL, NULL, NULL};
+        es_embed_prior none = {NULL, NULL, NULL, NULL, NULL, NULL}, self = {out, NULL, NULL, NULL, NULL, NULL},
+                       nan = {bad, NULL, NULL, NULL, NULL, NULL};
         es_edge_lengths(ctx, mesh, s.xyz, len);
         memcpy(bad, s.xyz, 3 * (size_t)nv * sizeof *bad);
         bad[7] = NAN;

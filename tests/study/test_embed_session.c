@@ -308,7 +308,7 @@ int main(void)
             ES_CHECK_OK(ctx, es_study_point_weights(ctx, s, points[k], "p", l0, &sc, w0));
             ES_CHECK_OK(ctx, es_study_embedder_solve(ctx, se, l0, sc, w0, &fo, 0, 0, got, &r));
             ES_CHECK_OK(ctx, es_study_prior(ctx, es_study_embedder_rows(se), w0, pri, al, sd));
-            es_embed_prior pr = {pri, al, sd, NULL};
+            es_embed_prior pr = {pri, al, sd, NULL, NULL, NULL};
             ES_CHECK_OK(ctx, es_embed_prior_solve(ctx, es_study_embedder_embedder(se), l0, sc,
                                                   &pr, &fo, ref, &rep));
             ES_CHECK(same(ref, got, n3) && r.report.lg_iters == rep.lg_iters);

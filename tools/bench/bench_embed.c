@@ -148,7 +148,7 @@ static void run(es_ctx *ctx, const char *dir, const char *a, const char *b, int 
             es_dihedral_angles(ctx, mesh, xyz, a2);
             es_dihedral_angles(ctx, mesh, bb, a2 + ne);
             const double *rows[2] = {xyz, bb}, *alr[2] = {a2, a2 + ne};
-            es_embed_prior pr = {prior, prior + 3 * nv, prior + 3 * nv + ne, NULL};
+            es_embed_prior pr = {prior, prior + 3 * nv, prior + 3 * nv + ne, NULL, NULL, NULL};
             es_embed_prior_from_rows(ctx, nv, ne, 2, rows, alr, w, prior, prior + 3 * nv,
                                      prior + 3 * nv + ne);
             es_interp_targets(ctx, mesh, 2, in, w, len, NULL, NULL);

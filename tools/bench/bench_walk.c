@@ -108,7 +108,7 @@ int main(int argc, char **argv)
     double *len = malloc(sizeof(double) * (size_t)ne), *w = malloc(sizeof(double) * (size_t)n);
     double *prior = malloc(sizeof(double) * (size_t)(3 * nv + 2 * ne));
     double *out = malloc(sizeof(double) * (size_t)(3 * nv)), scale;
-    es_embed_prior pr = {prior, prior + 3 * nv, prior + 3 * nv + ne, NULL};
+    es_embed_prior pr = {prior, prior + 3 * nv, prior + 3 * nv + ne, NULL, NULL, NULL};
     es_embed_report r;
     es_embed_opts eo;
     es_embed_opts_init(&eo);

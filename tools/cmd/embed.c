@@ -38,7 +38,10 @@ static const char usage[] =
     "  -s, --scale S        sum of edge lengths of the output (default: the point's\n"
     "                       scale, else the mean scale of the store)\n"
     "  -n, --name NAME      result name in the store (default: the output's base name)\n"
-    "      --no-store       do not write the report into the store\n"
+    "      --no-store       do not write the report into the store\n";
+
+/* the help in two strings: one is longer than C99 compilers must accept */
+static const char usage2[] =
 CLI_EMBED_HELP
     "      --residuals CSV  per vertex of the output: closure energy, mean relative\n"
     "                       edge error and, with the prior, distance from the prior's\n"
@@ -106,7 +109,10 @@ int cmd_embed(int argc, char **argv)
             if (cli_parse_size(optarg, &max_memory))
                 return cli_usage_error("embed", "--max-memory wants a size such as 8G");
             break;
-        case 'h': fputs(usage, stdout); return CLI_OK;
+        case 'h':
+            fputs(usage, stdout);
+            fputs(usage2, stdout);
+            return CLI_OK;
         default:
             if ((e = cli_embed_option("embed", c, optarg, &o.embed)) >= 0) {
                 if (e) return e;

@@ -177,6 +177,19 @@ typedef struct es_embed_opts {
                                  squares) whose every face has its longest edge at most
                                  1 - margin times the sum of the other two (default 0.01;
                                  < 0: embed them as they are); the report says how far */
+    /* Interpolation's crease guard (lib/embed/crease_guard.c): es_interp_embed, and
+     * es_embed_prior_solve on a closed mesh given the rows' span or spread (the
+     * study's walk). Interpolated lengths realized without it fold across the
+     * parts where the inputs differ most (the core paper's Fig. 4 cats: 4-13 %
+     * of the edges bent past every input by 0.3 rad; with it 0.5-4.3 % at a
+     * length RMS of 0.25-0.78 % instead of 0.06-0.20 %). */
+    double crease_margin;     /* each interior edge may bend within the span of the blended
+                                 inputs' (and the interpolated) bending angles widened by
+                                 this many radians; the refinement pays crease_mu x the
+                                 discrete-shells weight x the squared excess (default
+                                 0.1) ... */
+    double crease_mu;         /* ... (default 1e-3; more: fewer creases, more length error;
+                                 0 or a margin < 0: no guard) */
     int blas_threads;         /* OpenBLAS threads during the solve, the caller's setting
                                  restored after; 0 leaves it alone (default 1: the
                                  factorizations' dense blocks are small, and 2 threads
@@ -345,6 +358,11 @@ typedef struct es_embed_prior {
     const double *start;    /* 3 x V: on open meshes, refine from these positions instead
                                of xyz, e.g. a walk's previous frame (NULL: xyz); must
                                not be the output array */
+    const double *span_lo;  /* E each, or NULL: per edge the least and the greatest
+                               bending angle of the rows with a weight (not 0): the band */
+    const double *span_hi;  /* of the crease guard on a closed mesh, as es_interp_embed
+                               makes it from its inputs (crease_margin, crease_mu); NULL:
+                               alpha +- 3 sd, or no guard without sd */
 } es_embed_prior;
 
 /* Embed target lengths (E; scale as es_embed_solve) near a prior. The

@@ -401,6 +401,10 @@ ES_API void es_study_rows_free(es_study_rows *rows);
  * and their spread sd (E each). Any output may be NULL. */
 ES_API es_status es_study_prior(es_ctx *ctx, const es_study_rows *rows, const double *w,
                                 double *xyz, double *alpha, double *sd);
+/* Per edge the least (lo) and the greatest (hi) bending angle of the rows
+ * whose weight is not 0 (E each): the crease guard's band (es_embed_prior). */
+ES_API es_status es_study_prior_span(es_ctx *ctx, const es_study_rows *rows, const double *w,
+                                     double *lo, double *hi);
 
 typedef struct es_study_embed_result {
     es_embed_report report;
