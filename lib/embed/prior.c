@@ -229,8 +229,7 @@ static es_status shape_quality(es_ctx *ctx, es_embedder *emb, const double *xyz,
  * path from the prior's dihedrals. */
 static int bends(const es_embedder *emb, const es_embed_opts *o)
 {
-    int open = 0;
-    for (int64_t e = 0; e < emb->ne && !open; e++) open = emb->eb[e];
+    int open = es_mesh_boundary_loops(emb->mesh, NULL, NULL) > 0;
     return o->prior_mu > 0 && (open || o->prior_bend_closed);
 }
 
