@@ -4,7 +4,9 @@
  * output measured against it.
  *
  * Why each choice, measured on face-study with three subjects held out
- * (tools/bench/bench_prior.c): starting from the prior's positions rather
+ * (when the prior solve was built, commit e097105, by a program not kept;
+ * the test prior_face_study (tests/study/test_prior_faces.c) checks
+ * the held-out bounds): starting from the prior's positions rather
  * than stages 2-3 on its dihedrals (means 0.11 % of the bbox diagonal from
  * the Procrustes mean against 0.22 %); keeping the bending term on (never
  * annealed to 0) on open meshes, whose averaged noisy lengths are realized

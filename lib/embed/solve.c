@@ -36,7 +36,7 @@ void es_embed_opts_init(es_embed_opts *o)
     o->realized_rtol = 1e-2;
     o->verbose = 0;
     o->blas_threads = 1;
-    /* measured on face-study (tools/bench/bench_prior.c) */
+    /* measured on face-study when the prior solve was built (prior.c) */
     o->prior_mu = 2.5e-3;
     o->prior_decay = 0.8;
     o->prior_mu_floor = 0.07;   /* 0.8^12: where 12 iterations end */

@@ -106,7 +106,7 @@ typedef struct es_embed_opts {
     double bad_face_rtol;     /* triangle-inequality tolerance of the report (1e-12) */
     double realized_rtol;     /* report.realized = max relative error <= this (1e-2) */
     int verbose;              /* 1: one note per iteration to the log callback (0) */
-    /* es_embed_prior_solve only (measured on face-study, tools/bench/bench_prior.c): */
+    /* es_embed_prior_solve only (measured on face-study; lib/embed/prior.c says how): */
     double prior_mu;          /* weight of the bending term relative to the length term at
                                  the first refinement iteration (default 2.5e-3: on
                                  face-study's PC +-2 sd points the largest that keeps the
