@@ -17,6 +17,7 @@
  * size on the last rank fails the fit on every rank with its message. */
 #include "edgespace/edgespace.h"
 #include "es_test.h"
+#include "es_test_parallel.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -94,11 +95,10 @@ static void check(es_ctx *job, es_ctx *alone, int64_t k, int d, int64_t n, int s
 int main(int argc, char **argv)
 {
     ES_TEST_BEGIN();
-    es_ctx *job = NULL, *alone = NULL;
-    ES_CHECK(es_ctx_new(&job) == ES_OK && es_ctx_new(&alone) == ES_OK);
-    ES_CHECK_OK(job, es_parallel_init(job, &argc, &argv));
-    ES_CHECK_OK(job, es_ctx_join_parallel(job));
-    const int P = es_ctx_nranks(job), me = es_ctx_rank(job);
+    es_test_job t;
+    es_test_job_begin(&t, &argc, &argv);
+    es_ctx *job = t.job, *alone = t.alone;
+    const int P = t.P, me = t.me;
     if (me == 0) printf("parallel gpa: %d rank(s)\n", P);
 
     check(job, alone, 40, 3, 61, 1, "full, exact scaling");
@@ -122,9 +122,5 @@ int main(int argc, char **argv)
     es_ctx_parallel_traffic(job, &msgs, &bytes);
     ES_CHECK(P == 1 ? msgs == 0 : msgs > 0);
     if (me == 0) printf("rank 0 sent %lld messages, %lld bytes\n", (long long)msgs, (long long)bytes);
-    es_ctx_free(job);
-    es_ctx_free(alone);
-    int failed = es_test_failures;
-    es_parallel_finalize();
-    return failed ? 1 : 0;
+    return es_test_job_end(&t);
 }
