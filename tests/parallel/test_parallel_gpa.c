@@ -10,9 +10,10 @@
  * that is not joined to the job. The joined context aligns only this rank's
  * share. Compared to 1e-12 of their scale: the rank's aligned
  * configurations, the mean, scales, rotations, rho, sizes, centroids and the
- * report (iterations, GSS, rmsrho), for full GPA on the exact Ten Berge route
- * (n^2 k d small: rank 0 decomposes), full GPA on the power-iteration route
- * (n^2 k d > 2e8: each rank takes its dots), partial GPA, and planar data;
+ * report (iterations, power steps, GSS, rmsrho), for full GPA on the exact
+ * Ten Berge route (n^2 k d small: rank 0 decomposes), full GPA on the
+ * power-iteration route (n^2 k d > 2e8: each rank takes its dots), partial
+ * GPA, and planar data;
  * 61 and 203 configurations do not split evenly. A configuration of zero
  * size on the last rank fails the fit on every rank with its message. */
 #include "edgespace/edgespace.h"
@@ -73,6 +74,12 @@ static void check(es_ctx *job, es_ctx *alone, int64_t k, int d, int64_t n, int s
     ES_CHECK_MSG(ra.iterations == rb.iterations && ra.converged && rb.converged,
                  "%s: %lld vs %lld iterations", what, (long long)ra.iterations,
                  (long long)rb.iterations);
+    /* power steps (each a chain on the ranks): only on the power route */
+    const int power = scale && (double)n * (double)n * (double)kd > 2e8;
+    ES_CHECK_MSG(ra.power_steps == rb.power_steps && (power ? ra.power_steps >= ra.iterations
+                                                            : ra.power_steps == 0),
+                 "%s: %lld vs %lld power steps", what, (long long)ra.power_steps,
+                 (long long)rb.power_steps);
     ES_CHECK_MSG(fabs(ra.gss - rb.gss) <= 1e-12 * ra.gss && fabs(ra.rmsrho - rb.rmsrho) <= 1e-12 *
                  ra.rmsrho && fabs(ra.total_ss - rb.total_ss) <= 1e-12 * ra.total_ss,
                  "%s: report differs (gss %.17g vs %.17g)", what, ra.gss, rb.gss);
