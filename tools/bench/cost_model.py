@@ -16,8 +16,8 @@ V = (E + 6) / 3 vertices), top 20 (p = 10, q = 4), P = 1 ... 256.
 "messages" and "sent" are rank 0's, counted as the library counts them
 (es_ctx_parallel_traffic, lib/parallel/parallel.c): an agreement (es_ctx_agree,
 one all-reduce of an int) is 1 message of 4 bytes; the root of a broadcast
-sends P - 1 messages of its bytes (Open MPI sends along a tree, but the count
-is of the data that must leave the root); a reduction or gather to rank 0
+sends P - 1 messages of its bytes (Open MPI sends along a tree: the count is of
+the copies the other ranks receive); a reduction or gather to rank 0
 costs rank 0 nothing (every other rank sends it 1 message); an all-gather is
 P - 1 messages of the rank's share; an all-to-all one message to each rank it
 sends a non-empty part. Collective HDF5 writes (ingest) are HDF5's own MPI-IO
