@@ -81,27 +81,6 @@ static void pca_route(es_ctx *job, rows *d, es_pca_method method, int64_t K, int
     es_pca_free(p);
 }
 
-/* n noisy, scaled, rotated, shifted copies of a random k x d template. */
-static double *configurations(int64_t k, int d, int64_t n, uint64_t seed)
-{
-    es_rng rng;
-    const int64_t kd = k * d;
-    double *x = malloc((size_t)(kd * n) * sizeof *x), *t = malloc((size_t)kd * sizeof *t);
-    es_rng_init(&rng, seed);
-    for (int64_t v = 0; v < kd; v++) t[v] = es_rng_normal(&rng);
-    for (int64_t j = 0; j < n; j++) {
-        double a = es_rng_normal(&rng), s = 1.0 + 0.2 * es_rng_uniform(&rng), c = cos(a), sn = sin(a);
-        for (int64_t v = 0; v < k; v++) {
-            double p0 = t[v] + 0.05 * es_rng_normal(&rng), p1 = t[v + k] + 0.05 * es_rng_normal(&rng);
-            x[j * kd + v] = s * (c * p0 - sn * p1) + 0.3 * (double)j;
-            x[j * kd + v + k] = s * (sn * p0 + c * p1);
-            if (d == 3) x[j * kd + v + 2 * k] = s * (t[v + 2 * k] + 0.05 * es_rng_normal(&rng));
-        }
-    }
-    free(t);
-    return x;
-}
-
 static void gpa_route(es_ctx *job, int64_t k, int d, int64_t n, int scale, const char *name)
 {
     const int64_t kd = k * d;
@@ -109,7 +88,8 @@ static void gpa_route(es_ctx *job, int64_t k, int d, int64_t n, int scale, const
     es_gpa_opts o;
     es_gpa_report rep;
     es_ctx_share(job, n, &lo, &hi);
-    double *x = configurations(k, d, n, 11 + (uint64_t)n), *mine = malloc((size_t)(kd * (hi - lo) + 1) * 8);
+    double *x = es_test_configurations(k, d, n, 11 + (uint64_t)n);
+    double *mine = malloc((size_t)(kd * (hi - lo) + 1) * 8);
     double *res = calloc((size_t)(kd + (3 + d * d + d) * n), sizeof *res);
     /* every output, as `edgespace gpa` asks for them (lib/study/gpa_store.c) */
     es_gpa_out go = {res, res + kd, res + kd + n, res + kd + 2 * n, res + kd + 3 * n,
@@ -119,7 +99,8 @@ static void gpa_route(es_ctx *job, int64_t k, int d, int64_t n, int scale, const
     o.scale = scale;
     memset(&rep, 0, sizeof rep);
     es_ctx_parallel_traffic(job, &m, &b);
-    ES_CHECK_OK(job, es_gpa_align_ranks(job, k, d, n, (es_mat){mine, kd, hi - lo, kd}, &o, &go, &rep));
+    ES_CHECK_OK(job, es_gpa_align_ranks(job, k, d, n, (es_mat){mine, kd, hi - lo, kd}, &o, &go,
+                                        &rep));
     traffic_since(job, &m, &b);
     fprintf(out, "route=%s P=%d rank=%d n=%lld k=%lld d=%d scale=%d iterations=%lld "
             "power_steps=%lld messages=%lld sent=%lld\n", name, P, me, (long long)n, (long long)k,
@@ -198,10 +179,10 @@ static void ingest_route(es_ctx *job, const char *dir, char **files, const int *
 int main(int argc, char **argv)
 {
     ES_TEST_BEGIN();
-    es_test_job t;
-    es_test_job_begin(&t, &argc, &argv);
-    P = t.P;
-    me = t.me;
+    es_test_job run;
+    es_test_job_begin(&run, &argc, &argv);
+    P = run.P;
+    me = run.me;
     if (argc < 2) ES_TEST_SKIP("give the directory for the counts");
     const char *dir = argv[1];
     char path[4096];
@@ -210,7 +191,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "cannot write %s\n", path);
         return 1;
     }
-    es_ctx_set_seed(t.job, 5);
+    es_ctx_set_seed(run.job, 5);
 
     /* PCA: 61 rows (they do not split evenly) of 300 edges, 7 rows a round */
     rows d = {300, 61, malloc(300 * 61 * sizeof(double)), 0};
@@ -222,14 +203,14 @@ int main(int argc, char **argv)
                 d.X[e + j * d.E] = 1.0 + 0.05 * sin(0.7 * (double)(j + 1) * (double)(e % 5 + 1)) +
                                    0.002 * es_rng_normal(&rng);
     }
-    pca_route(t.job, &d, ES_PCA_GRAM, 8, 7, "pca_gram");
-    pca_route(t.job, &d, ES_PCA_RANDOMIZED, 5, 7, "pca_randomized");
+    pca_route(run.job, &d, ES_PCA_GRAM, 8, 7, "pca_gram");
+    pca_route(run.job, &d, ES_PCA_RANDOMIZED, 5, 7, "pca_randomized");
     free(d.X);
 
     /* GPA: 61^2 x 120 <= 2e8 (exact: rank 0 decomposes), 203^2 x 5100 > 2e8 (power) */
-    gpa_route(t.job, 40, 3, 61, 1, "gpa_exact");
-    gpa_route(t.job, 1700, 3, 203, 1, "gpa_power");
-    gpa_route(t.job, 25, 2, 61, 0, "gpa_partial");
+    gpa_route(run.job, 40, 3, 61, 1, "gpa_exact");
+    gpa_route(run.job, 1700, 3, 203, 1, "gpa_power");
+    gpa_route(run.job, 25, 2, 61, 0, "gpa_partial");
 
     /* ingest: 11 tori into a new store (2 rows a round), then 8 new and 3
      * it has (read again for their hash, skipped) appended, 3 a round */
@@ -250,13 +231,13 @@ int main(int argc, char **argv)
             if (!known[i]) ES_CHECK(es_test_write_torus(more[i], 14, 8, 20 + i) == 0);
         }
     }
-    ES_CHECK_OK(t.job, es_ctx_barrier(t.job));   /* the files are there for every rank */
-    ingest_route(t.job, dir, files, none, 11, 2, "ingest_new");
-    ingest_route(t.job, dir, more, known, 11, 3, "ingest_append");
+    ES_CHECK_OK(run.job, es_ctx_barrier(run.job));   /* the files are there for every rank */
+    ingest_route(run.job, dir, files, none, 11, 2, "ingest_new");
+    ingest_route(run.job, dir, more, known, 11, 3, "ingest_append");
     for (int i = 0; i < 11; i++) {
         free(files[i]);
         free(more[i]);
     }
     ES_CHECK(fclose(out) == 0);
-    return es_test_job_end(&t);
+    return es_test_job_end(&run);
 }

@@ -25,32 +25,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* n noisy copies of one random k x d template, each scaled, rotated about
- * a random axis and shifted (column-major k x d per column). */
-static double *make(int64_t k, int d, int64_t n, uint64_t seed)
-{
-    es_rng rng;
-    int64_t kd = k * d;
-    double *x = malloc((size_t)(kd * n) * sizeof *x), *t = malloc((size_t)kd * sizeof *t);
-    es_rng_init(&rng, seed);
-    for (int64_t v = 0; v < kd; v++) t[v] = es_rng_normal(&rng);
-    for (int64_t j = 0; j < n; j++) {
-        double a = es_rng_normal(&rng), s = 1.0 + 0.2 * es_rng_uniform(&rng);
-        double c = cos(a), sn = sin(a), sh[3];
-        for (int q = 0; q < d; q++) sh[q] = es_rng_normal(&rng);
-        for (int64_t v = 0; v < k; v++) {
-            double p[3];
-            for (int q = 0; q < d; q++) p[q] = t[v + q * k] + 0.05 * es_rng_normal(&rng);
-            double r0 = c * p[0] - sn * p[1], r1 = sn * p[0] + c * p[1];
-            x[j * kd + v] = s * r0 + sh[0];
-            x[j * kd + v + k] = s * r1 + sh[1];
-            if (d == 3) x[j * kd + v + 2 * k] = s * p[2] + sh[2];
-        }
-    }
-    free(t);
-    return x;
-}
-
 static void check(es_ctx *job, es_ctx *alone, int64_t k, int d, int64_t n, int scale,
                   const char *what)
 {
@@ -60,7 +34,8 @@ static void check(es_ctx *job, es_ctx *alone, int64_t k, int d, int64_t n, int s
     es_gpa_opts_init(&o);
     o.scale = scale;
     es_ctx_share(job, n, &lo, &hi);
-    double *x = make(k, d, n, 7 + (uint64_t)n), *mine = malloc((size_t)(kd * (hi - lo) + 1) * 8);
+    double *x = es_test_configurations(k, d, n, 7 + (uint64_t)n);
+    double *mine = malloc((size_t)(kd * (hi - lo) + 1) * 8);
     memcpy(mine, x + lo * kd, (size_t)(kd * (hi - lo)) * sizeof *x);
     /* one block per side: mean kd, size, rho, scale n, rot d*d*n, centroid d*n */
     int64_t len = kd + (3 + d * d + d) * n;
@@ -102,10 +77,10 @@ static void check(es_ctx *job, es_ctx *alone, int64_t k, int d, int64_t n, int s
 int main(int argc, char **argv)
 {
     ES_TEST_BEGIN();
-    es_test_job t;
-    es_test_job_begin(&t, &argc, &argv);
-    es_ctx *job = t.job, *alone = t.alone;
-    const int P = t.P, me = t.me;
+    es_test_job run;
+    es_test_job_begin(&run, &argc, &argv);
+    es_ctx *job = run.job, *alone = run.alone;
+    const int P = run.P, me = run.me;
     if (me == 0) printf("parallel gpa: %d rank(s)\n", P);
 
     check(job, alone, 40, 3, 61, 1, "full, exact scaling");
@@ -118,7 +93,7 @@ int main(int argc, char **argv)
         const int64_t k = 10, kd = 30, n = 13;
         int64_t lo, hi;
         es_ctx_share(job, n, &lo, &hi);
-        double *x = make(k, 3, n, 3);
+        double *x = es_test_configurations(k, 3, n, 3);
         for (int64_t v = 0; v < kd; v++) x[(n - 1) * kd + v] = 1.0;
         ES_CHECK_FAILS(job, es_gpa_align_ranks(job, k, 3, n, (es_mat){x + lo * kd, kd, hi - lo, kd},
                                                NULL, NULL, NULL),
@@ -129,5 +104,5 @@ int main(int argc, char **argv)
     es_ctx_parallel_traffic(job, &msgs, &bytes);
     ES_CHECK(P == 1 ? msgs == 0 : msgs > 0);
     if (me == 0) printf("rank 0 sent %lld messages, %lld bytes\n", (long long)msgs, (long long)bytes);
-    return es_test_job_end(&t);
+    return es_test_job_end(&run);
 }

@@ -105,10 +105,10 @@ static void check_route(es_ctx *job, es_ctx *alone, data *d, es_pca_method m, in
 int main(int argc, char **argv)
 {
     ES_TEST_BEGIN();
-    es_test_job t;
-    es_test_job_begin(&t, &argc, &argv);
-    es_ctx *job = t.job, *alone = t.alone;
-    const int P = t.P, me = t.me;
+    es_test_job run;
+    es_test_job_begin(&run, &argc, &argv);
+    es_ctx *job = run.job, *alone = run.alone;
+    const int P = run.P, me = run.me;
     if (me == 0) printf("parallel pca: %d rank(s), MPI %s\n", P,
                         es_parallel_available() ? "built in" : "not built");
     es_ctx_set_seed(job, 99);
@@ -182,5 +182,5 @@ int main(int argc, char **argv)
     es_ctx_parallel_traffic(job, &msgs, &bytes);
     ES_CHECK(P == 1 ? msgs == 0 && bytes == 0 : msgs > 0 && bytes > 0);
     if (me == 0) printf("rank 0 sent %lld messages, %lld bytes\n", (long long)msgs, (long long)bytes);
-    return es_test_job_end(&t);
+    return es_test_job_end(&run);
 }
