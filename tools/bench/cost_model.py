@@ -238,8 +238,8 @@ def main():
     ap.add_argument("--power", type=int, default=4)
     # GPA's sweeps and power steps depend on the data: the defaults are what
     # the check's power-route run took (203 configurations of 1,700 vertices)
-    ap.add_argument("--gpa-iterations", type=int, default=13, help="GPA sweeps")
-    ap.add_argument("--power-steps", type=int, default=24,
+    ap.add_argument("--gpa-iterations", type=int, default=11, help="GPA sweeps")
+    ap.add_argument("--power-steps", type=int, default=20,
                     help="Ten Berge power steps, all sweeps together")
     ap.add_argument("--mesh-bytes", type=int, default=0,
                     help=f"bytes of a mesh file (default {OBJ_BYTES_PER_VERTEX} V)")
