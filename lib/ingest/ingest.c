@@ -148,7 +148,7 @@ static es_status ingest(es_ctx *ctx, const char *store_path, int64_t n, const in
     for (int64_t b0 = 0; b0 < n; b0 += s.b.cap) {
         const int64_t b1 = n - b0 > s.b.cap ? b0 + s.b.cap : n;
         rc = es__ingest_read_block(ctx, &s, b0, b1, NULL);
-        rep->bytes_read = s.j.bytes_read;
+        rep->bytes_read = rep->bytes_read_rank = s.j.bytes_read;
         if (rc || (rc = es__cancelled(ctx, "ingest")) ||
             (rc = keep_block(ctx, store_path, &s, in, b0, b1, ncols, colnames, &k, rep)))
             goto done;

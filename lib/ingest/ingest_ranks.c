@@ -47,6 +47,7 @@ static es_status find_skipped(es_ctx *ctx, ingest_session *s, int64_t lo, int64_
         int skip = 0;
         if (es_store_find_row(s->st, s->j.in[i].id) < 0) continue;
         if ((rc = es__ingest_slurp(ctx, s->j.in[i].path, &buf, &cap, &len)) == ES_OK) {
+            s->j.bytes_read += (int64_t)len;   /* and again in its round */
             es_content_hash(buf, len, s->b.hash[i]);
             rc = es__ingest_known(ctx, s->st, &s->j.in[i], s->b.hash[i], &skip);
             s->b.skip[i] = (uint8_t)skip;
@@ -166,7 +167,7 @@ es_status es__ingest_ranks(es_ctx *ctx, const char *store_path, int64_t n,
 
     /* steps 3 and 4: the values, written by all ranks together */
     if (nkept > 0 && (rc = write_values(ctx, &s, lo, hi, dest, nkept, &notes))) goto done;
-    rep->bytes_read = s.j.bytes_read;
+    rep->bytes_read = rep->bytes_read_rank = s.j.bytes_read;
     if ((rc = es__par_sum_i64(ctx, &rep->bytes_read, 1))) goto done;
     es__progress(ctx, "reading meshes", n, n);
 

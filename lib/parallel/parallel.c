@@ -257,8 +257,8 @@ static es_status gather_impl(es_ctx *ctx, const double *mine, const int64_t *cou
                                      c[p->rank], MPI_DOUBLE, all, c, d, MPI_DOUBLE, 0,
                                      p->comm);
         if (err != MPI_SUCCESS) rc = mpi_fail(ctx, err, everyone ? "MPI_Allgatherv" : "MPI_Gatherv");
-        else count(p, everyone ? p->size - 1 : p->rank != 0, (int64_t)c[p->rank] * 8 *
-                                                                   (everyone ? p->size - 1 : 1));
+        else if (everyone) count(p, p->size - 1, (int64_t)c[p->rank] * 8 * (p->size - 1));
+        else if (p->rank != 0) count(p, 1, (int64_t)c[p->rank] * 8);   /* rank 0's part stays */
     }
     es__free(ctx, c);
     return rc;

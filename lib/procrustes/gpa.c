@@ -550,6 +550,7 @@ static es_status gpa_run(es_ctx *ctx, int64_t k, int d, int64_t n, int ranks, es
                       "%.3g, scale change %.3g, tolerance %.3g)", (long long)o.max_iter,
                       rep.rot_change, rep.scale_change, o.tol);
 done:
+    rep.power_steps = st.power_steps;
     if (report) *report = rep;
     es__free(ctx, buf);
     return rc;

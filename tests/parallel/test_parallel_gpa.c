@@ -10,44 +10,20 @@
  * that is not joined to the job. The joined context aligns only this rank's
  * share. Compared to 1e-12 of their scale: the rank's aligned
  * configurations, the mean, scales, rotations, rho, sizes, centroids and the
- * report (iterations, GSS, rmsrho), for full GPA on the exact Ten Berge route
- * (n^2 k d small: rank 0 decomposes), full GPA on the power-iteration route
- * (n^2 k d > 2e8: each rank takes its dots), partial GPA, and planar data;
+ * report (iterations, power steps, GSS, rmsrho), for full GPA on the exact
+ * Ten Berge route (n^2 k d small: rank 0 decomposes), full GPA on the
+ * power-iteration route (n^2 k d > 2e8: each rank takes its dots), partial
+ * GPA, and planar data;
  * 61 and 203 configurations do not split evenly. A configuration of zero
  * size on the last rank fails the fit on every rank with its message. */
 #include "edgespace/edgespace.h"
 #include "es_test.h"
+#include "es_test_parallel.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* n noisy copies of one random k x d template, each scaled, rotated about
- * a random axis and shifted (column-major k x d per column). */
-static double *make(int64_t k, int d, int64_t n, uint64_t seed)
-{
-    es_rng rng;
-    int64_t kd = k * d;
-    double *x = malloc((size_t)(kd * n) * sizeof *x), *t = malloc((size_t)kd * sizeof *t);
-    es_rng_init(&rng, seed);
-    for (int64_t v = 0; v < kd; v++) t[v] = es_rng_normal(&rng);
-    for (int64_t j = 0; j < n; j++) {
-        double a = es_rng_normal(&rng), s = 1.0 + 0.2 * es_rng_uniform(&rng);
-        double c = cos(a), sn = sin(a), sh[3];
-        for (int q = 0; q < d; q++) sh[q] = es_rng_normal(&rng);
-        for (int64_t v = 0; v < k; v++) {
-            double p[3];
-            for (int q = 0; q < d; q++) p[q] = t[v + q * k] + 0.05 * es_rng_normal(&rng);
-            double r0 = c * p[0] - sn * p[1], r1 = sn * p[0] + c * p[1];
-            x[j * kd + v] = s * r0 + sh[0];
-            x[j * kd + v + k] = s * r1 + sh[1];
-            if (d == 3) x[j * kd + v + 2 * k] = s * p[2] + sh[2];
-        }
-    }
-    free(t);
-    return x;
-}
 
 static void check(es_ctx *job, es_ctx *alone, int64_t k, int d, int64_t n, int scale,
                   const char *what)
@@ -58,7 +34,8 @@ static void check(es_ctx *job, es_ctx *alone, int64_t k, int d, int64_t n, int s
     es_gpa_opts_init(&o);
     o.scale = scale;
     es_ctx_share(job, n, &lo, &hi);
-    double *x = make(k, d, n, 7 + (uint64_t)n), *mine = malloc((size_t)(kd * (hi - lo) + 1) * 8);
+    double *x = es_test_configurations(k, d, n, 7 + (uint64_t)n);
+    double *mine = malloc((size_t)(kd * (hi - lo) + 1) * 8);
     memcpy(mine, x + lo * kd, (size_t)(kd * (hi - lo)) * sizeof *x);
     /* one block per side: mean kd, size, rho, scale n, rot d*d*n, centroid d*n */
     int64_t len = kd + (3 + d * d + d) * n;
@@ -72,6 +49,12 @@ static void check(es_ctx *job, es_ctx *alone, int64_t k, int d, int64_t n, int s
     ES_CHECK_MSG(ra.iterations == rb.iterations && ra.converged && rb.converged,
                  "%s: %lld vs %lld iterations", what, (long long)ra.iterations,
                  (long long)rb.iterations);
+    /* power steps (each a chain on the ranks): only on the power route */
+    const int power = scale && (double)n * (double)n * (double)kd > 2e8;
+    ES_CHECK_MSG(ra.power_steps == rb.power_steps && (power ? ra.power_steps >= ra.iterations
+                                                            : ra.power_steps == 0),
+                 "%s: %lld vs %lld power steps", what, (long long)ra.power_steps,
+                 (long long)rb.power_steps);
     ES_CHECK_MSG(fabs(ra.gss - rb.gss) <= 1e-12 * ra.gss && fabs(ra.rmsrho - rb.rmsrho) <= 1e-12 *
                  ra.rmsrho && fabs(ra.total_ss - rb.total_ss) <= 1e-12 * ra.total_ss,
                  "%s: report differs (gss %.17g vs %.17g)", what, ra.gss, rb.gss);
@@ -94,11 +77,10 @@ static void check(es_ctx *job, es_ctx *alone, int64_t k, int d, int64_t n, int s
 int main(int argc, char **argv)
 {
     ES_TEST_BEGIN();
-    es_ctx *job = NULL, *alone = NULL;
-    ES_CHECK(es_ctx_new(&job) == ES_OK && es_ctx_new(&alone) == ES_OK);
-    ES_CHECK_OK(job, es_parallel_init(job, &argc, &argv));
-    ES_CHECK_OK(job, es_ctx_join_parallel(job));
-    const int P = es_ctx_nranks(job), me = es_ctx_rank(job);
+    es_test_job run;
+    es_test_job_begin(&run, &argc, &argv);
+    es_ctx *job = run.job, *alone = run.alone;
+    const int P = run.P, me = run.me;
     if (me == 0) printf("parallel gpa: %d rank(s)\n", P);
 
     check(job, alone, 40, 3, 61, 1, "full, exact scaling");
@@ -111,7 +93,7 @@ int main(int argc, char **argv)
         const int64_t k = 10, kd = 30, n = 13;
         int64_t lo, hi;
         es_ctx_share(job, n, &lo, &hi);
-        double *x = make(k, 3, n, 3);
+        double *x = es_test_configurations(k, 3, n, 3);
         for (int64_t v = 0; v < kd; v++) x[(n - 1) * kd + v] = 1.0;
         ES_CHECK_FAILS(job, es_gpa_align_ranks(job, k, 3, n, (es_mat){x + lo * kd, kd, hi - lo, kd},
                                                NULL, NULL, NULL),
@@ -122,9 +104,5 @@ int main(int argc, char **argv)
     es_ctx_parallel_traffic(job, &msgs, &bytes);
     ES_CHECK(P == 1 ? msgs == 0 : msgs > 0);
     if (me == 0) printf("rank 0 sent %lld messages, %lld bytes\n", (long long)msgs, (long long)bytes);
-    es_ctx_free(job);
-    es_ctx_free(alone);
-    int failed = es_test_failures;
-    es_parallel_finalize();
-    return failed ? 1 : 0;
+    return es_test_job_end(&run);
 }

@@ -17,6 +17,7 @@
 #include "core/core_private.h"   /* ES_FAIL: a reader sets its message */
 #include "edgespace/edgespace.h"
 #include "es_test.h"
+#include "es_test_parallel.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -104,14 +105,10 @@ static void check_route(es_ctx *job, es_ctx *alone, data *d, es_pca_method m, in
 int main(int argc, char **argv)
 {
     ES_TEST_BEGIN();
-    es_ctx *job = NULL, *alone = NULL;
-    ES_CHECK(es_ctx_new(&job) == ES_OK && es_ctx_new(&alone) == ES_OK);
-    ES_CHECK_OK(job, es_parallel_init(job, &argc, &argv));
-    ES_CHECK_OK(job, es_ctx_join_parallel(job));
-    const int P = es_ctx_nranks(job), me = es_ctx_rank(job);
-    ES_CHECK(P >= 1 && me >= 0 && me < P);
-    ES_CHECK(es_ctx_rank(alone) == 0 && es_ctx_nranks(alone) == 1);
-    if (!es_parallel_available()) ES_CHECK(P == 1);
+    es_test_job run;
+    es_test_job_begin(&run, &argc, &argv);
+    es_ctx *job = run.job, *alone = run.alone;
+    const int P = run.P, me = run.me;
     if (me == 0) printf("parallel pca: %d rank(s), MPI %s\n", P,
                         es_parallel_available() ? "built in" : "not built");
     es_ctx_set_seed(job, 99);
@@ -185,9 +182,5 @@ int main(int argc, char **argv)
     es_ctx_parallel_traffic(job, &msgs, &bytes);
     ES_CHECK(P == 1 ? msgs == 0 && bytes == 0 : msgs > 0 && bytes > 0);
     if (me == 0) printf("rank 0 sent %lld messages, %lld bytes\n", (long long)msgs, (long long)bytes);
-    es_ctx_free(job);
-    es_ctx_free(alone);
-    int failed = es_test_failures;
-    es_parallel_finalize();
-    return failed ? 1 : 0;
+    return es_test_job_end(&run);
 }

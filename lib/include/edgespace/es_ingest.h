@@ -89,8 +89,10 @@ typedef struct es_ingest_report {
     int64_t rows_added;      /* rows appended */
     int64_t rows_skipped;    /* inputs already in the store (same id and content) */
     int64_t rows_total;      /* rows in the store afterwards */
-    int64_t bytes_read;      /* bytes of mesh files read and parsed */
+    int64_t bytes_read;      /* bytes of mesh files read and parsed (by all ranks) */
     int created;             /* 1 if the store was created */
+    int64_t bytes_read_rank; /* of bytes_read, those this rank read (all of them on one
+                                process; datasets-spec/parallel.md: what each rank reads) */
 } es_ingest_report;
 
 /* Ingest the meshes of a manifest (labels from its columns) into the store

@@ -100,6 +100,9 @@ typedef struct es_gpa_report {
     double total_ss;       /* sum of squares of the centred inputs (kept by full GPA) */
     double gss;            /* sum over configurations of ||aligned - mean||^2 */
     double rmsrho;         /* sqrt(mean rho^2) */
+    int64_t power_steps;   /* Ten Berge power-iteration steps, all scaling steps together
+                              (0 on the explicit-Gram route and for partial GPA): on the
+                              ranks each is a broadcast chain (datasets-spec/parallel.md) */
 } es_gpa_report;
 
 /* Optional per-configuration outputs of es_gpa_align (each may be NULL). */
