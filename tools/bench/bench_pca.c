@@ -11,14 +11,22 @@
  *   randomized top K: es_pca_fit (Halko et al. subspace iteration, p, q)
  *     against the same algorithm in numpy (Gaussian test matrix, q power
  *     iterations re-orthonormalized by QR, SVD of A^T Q).
- * Wall and CPU time of each, the ratio numpy / ours, and the largest relative
+ * Wall and CPU time of each (the median of --repeat runs: one run of a
+ * second or two swings by 15 % on a shared 2-core machine), the ratio
+ * numpy / ours, and the largest relative
  * difference of the top eigenvalues (numpy is the oracle). numpy runs under
  * /usr/bin/python3 (Debian's, with python3-numpy; the python3 first on PATH
  * may lack it); when it cannot run, the bench says so and why. Both sides
  * use the same OpenBLAS with the same thread count (OPENBLAS_NUM_THREADS, or
- * OpenBLAS's default: one per core); it is printed.
+ * OpenBLAS's default: one per core) and the same worker spin: the short one
+ * the edgespace command sets (tools/blas_spin.c), which numpy inherits;
+ * both are printed. With OpenBLAS's default spin the workers burn CPU while
+ * this side copies its chunks between the Gram matrix's products: top 20,
+ * median of 5, 3.10 s CPU against numpy's 2.91; with the command's, 2.49
+ * against 2.93.
  *
- *   bench_pca [--rows N] [--edges E] [--rank R] [--components K] [--no-numpy]
+ *   bench_pca [--rows N] [--edges E] [--rank R] [--components K] [--repeat N]
+ *             [--no-numpy]
  */
 
 #include "edgespace/es_stats.h"
@@ -33,6 +41,7 @@
 #include <unistd.h>
 
 #include "bench_clock.h"
+#include "blas_spin.h"
 
 typedef struct gen {
     int64_t E, N, R;
@@ -117,12 +126,15 @@ static void print_stages(const stages *st)
 static const char numpy_script[] =
     "import sys, time\n"
     "import numpy as np\n"
-    "X = np.load(sys.argv[1]); K, p, q, seed = (int(a) for a in sys.argv[2:6])\n"
+    "X = np.load(sys.argv[1]); K, p, q, seed, reps = (int(a) for a in sys.argv[2:7])\n"
     "E, N = X.shape\n"
     "def timed(name, f):\n"
-    "    t, c = time.perf_counter(), time.process_time()\n"
-    "    w = f()\n"
-    "    print(name, time.perf_counter() - t, time.process_time() - c,\n"
+    "    walls, cpus = [], []\n"
+    "    for _ in range(reps):\n"
+    "        t, c = time.perf_counter(), time.process_time()\n"
+    "        w = f()\n"
+    "        walls.append(time.perf_counter() - t); cpus.append(time.process_time() - c)\n"
+    "    print(name, sorted(walls)[reps // 2], sorted(cpus)[reps // 2],\n"
     "          ' '.join(repr(float(v)) for v in w[:10]), flush=True)\n"
     "def gram(k):\n"
     "    A = X - X.mean(axis=1, keepdims=True)\n"
@@ -179,16 +191,33 @@ typedef struct timing {
     int neig;
 } timing;
 
-static es_pca *fit(es_ctx *ctx, const es_source *src, const es_pca_opts *o, timing *t)
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The fit `reps` times (at most 64): the last one's result, the median wall
+ * and CPU time. */
+static es_pca *fit(es_ctx *ctx, const es_source *src, const es_pca_opts *o, int reps, timing *t)
 {
     es_pca *p = NULL;
-    double w0 = bench_wall_s(), c0 = bench_process_cpu_s();
-    if (es_pca_fit(ctx, src, o, &p) != ES_OK) {
-        fprintf(stderr, "bench_pca: %s\n", es_ctx_errmsg(ctx));
-        exit(1);
+    double wall[64], cpu[64];
+    for (int r = 0; r < reps; r++) {
+        es_pca_free(p);   /* the last run's, outside the clock */
+        p = NULL;
+        double w0 = bench_wall_s(), c0 = bench_process_cpu_s();
+        if (es_pca_fit(ctx, src, o, &p) != ES_OK) {
+            fprintf(stderr, "bench_pca: %s\n", es_ctx_errmsg(ctx));
+            exit(1);
+        }
+        wall[r] = bench_wall_s() - w0;
+        cpu[r] = bench_process_cpu_s() - c0;
     }
-    t->wall = bench_wall_s() - w0;
-    t->cpu = bench_process_cpu_s() - c0;
+    qsort(wall, (size_t)reps, sizeof *wall, cmp_double);
+    qsort(cpu, (size_t)reps, sizeof *cpu, cmp_double);
+    t->wall = wall[reps / 2];
+    t->cpu = cpu[reps / 2];
     t->neig = p->ncomp < 10 ? (int)p->ncomp : 10;
     for (int k = 0; k < t->neig; k++) t->eig[k] = p->eigenvalues[k];
     return p;
@@ -210,11 +239,13 @@ static void compare(const char *what, const timing *ours, const timing *np)
 int main(int argc, char **argv)
 {
     int64_t N = 600, E = 175000, R = 20, K = 10;
-    int numpy = 1;
+    short_blas_spin(argv);
+    int numpy = 1, reps = 1;
     static const struct option lo[] = {
         {"rows", required_argument, 0, 'n'}, {"edges", required_argument, 0, 'e'},
         {"rank", required_argument, 0, 'r'}, {"components", required_argument, 0, 'k'},
-        {"no-numpy", no_argument, 0, 'x'}, {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
+        {"repeat", required_argument, 0, 'R'}, {"no-numpy", no_argument, 0, 'x'},
+        {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
     int c;
     while ((c = getopt_long(argc, argv, "", lo, NULL)) != -1) {
         switch (c) {
@@ -223,9 +254,16 @@ int main(int argc, char **argv)
         case 'r': R = atoll(optarg); break;
         case 'k': K = atoll(optarg); break;
         case 'x': numpy = 0; break;
+        case 'R':
+            reps = atoi(optarg);
+            if (reps < 1 || reps > 64) {
+                fprintf(stderr, "bench_pca: --repeat %s: give 1 to 64 runs\n", optarg);
+                return 2;
+            }
+            break;
         default:
             printf("usage: bench_pca [--rows N] [--edges E] [--rank R] [--components K] "
-                   "[--no-numpy]\n");
+                   "[--repeat N] [--no-numpy]\n");
             return c == 'h' ? 0 : 2;
         }
     }
@@ -257,8 +295,11 @@ int main(int argc, char **argv)
     gen_read(ctx, &src, 0, N, (es_mat){X, E, N, E});
     es_source mat = es_source_matrix((es_mat){X, E, N, E}, NULL, N);
     const char *threads = getenv("OPENBLAS_NUM_THREADS");
-    printf("  load average at start: %s; OpenBLAS threads: %s (%ld cores online)\n", loadavg(),
-           threads ? threads : "default", sysconf(_SC_NPROCESSORS_ONLN));
+    const char *spin = getenv("OPENBLAS_THREAD_TIMEOUT");
+    printf("  load average at start: %s; OpenBLAS threads: %s (%ld cores online), "
+           "OPENBLAS_THREAD_TIMEOUT %s; times: the median of %d run%s\n", loadavg(),
+           threads ? threads : "default", sysconf(_SC_NPROCESSORS_ONLN), spin ? spin : "unset",
+           reps, reps == 1 ? "" : "s");
 
     es_pca_opts o;
     es_pca_opts_init(&o);
@@ -267,8 +308,9 @@ int main(int argc, char **argv)
     memset(&stg, 0, sizeof stg);
     es_ctx_set_progress(ctx, on_progress, &stg);
     stg.t0 = bench_wall_s();
-    es_pca *exact = fit(ctx, &mat, &o, &t_exact);
+    es_pca *exact = fit(ctx, &mat, &o, 1, &t_exact);   /* one run's stages */
     es_ctx_set_progress(ctx, NULL, NULL);
+    if (reps > 1) es_pca_free(fit(ctx, &mat, &o, reps, &t_exact));
     printf("  ours, exact (Gram route, %lld components): %.2f s wall, %.2f s CPU, peak RSS %.0f "
            "MiB\n", (long long)exact->ncomp, t_exact.wall, t_exact.cpu, bench_peak_rss_mib());
     print_stages(&stg);
@@ -278,10 +320,10 @@ int main(int argc, char **argv)
            exact->eigenvalues[0], exact->eigenvalues[1], exact->eigenvalues[2], 100 * cum);
     es_pca_opts ot = o;
     ot.ncomp = 20;
-    es_pca_free(fit(ctx, &mat, &ot, &t_top));
+    es_pca_free(fit(ctx, &mat, &ot, reps, &t_top));
     o.method = ES_PCA_RANDOMIZED;
     o.ncomp = K;
-    es_pca *rnd = fit(ctx, &mat, &o, &t_rnd);
+    es_pca *rnd = fit(ctx, &mat, &o, reps, &t_rnd);
     double maxrel = 0;
     for (int64_t k = 0; k < K; k++) {
         double rel = fabs(rnd->eigenvalues[k] - exact->eigenvalues[k]) / exact->eigenvalues[k];
@@ -303,9 +345,9 @@ int main(int argc, char **argv)
             why = "cannot write the matrix and script to /tmp";
     }
     if (!why) {
-        snprintf(cmd, sizeof cmd, PYTHON " %s %s %lld %lld %lld %llu", py, npy, (long long)K,
+        snprintf(cmd, sizeof cmd, PYTHON " %s %s %lld %lld %lld %llu %d", py, npy, (long long)K,
                  (long long)o.oversample, (long long)o.power_iters,
-                 (unsigned long long)es_ctx_seed(ctx));
+                 (unsigned long long)es_ctx_seed(ctx), reps);
         FILE *pp = popen(cmd, "r");
         char line[2048], name[32];
         int got = 0;
