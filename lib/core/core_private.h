@@ -62,6 +62,9 @@ void *es__realloc(es_ctx *ctx, void *ptr, size_t size);
 void es__free(es_ctx *ctx, void *ptr);
 /* n elements of `size` bytes, n an int64 count (negative counts fail). */
 void *es__alloc_array(es_ctx *ctx, int64_t n, size_t size);
+/* The operating system (os.c). Seconds on the monotonic clock, for
+ * timing stages and reports. */
+double es__seconds(void);
 /* Ask the kernel to back the 2 MiB-aligned interior of [p, p + bytes) with
  * transparent huge pages (Linux madvise MADV_HUGEPAGE; elsewhere, or for
  * memory that is not anonymous, nothing happens). Call before the first

@@ -14,9 +14,6 @@
 #include <stdint.h>
 #include <sys/resource.h>
 #include <unistd.h>
-#ifdef __linux__
-#include <sys/mman.h>
-#endif
 
 #ifndef ES_VERSION_STRING
 #define ES_VERSION_STRING "unknown"
@@ -261,17 +258,6 @@ void *es__calloc(es_ctx *ctx, size_t n, size_t size)
     if (p && bytes >= ((size_t)4 << 20)) es__advise_huge(p, bytes);
     if (p) memset(p, 0, bytes ? bytes : 1);
     return p;
-}
-
-void es__advise_huge(void *p, size_t bytes)
-{
-#ifdef MADV_HUGEPAGE
-    const uintptr_t huge = (uintptr_t)2 << 20;
-    uintptr_t a = ((uintptr_t)p + huge - 1) & ~(huge - 1), b = ((uintptr_t)p + bytes) & ~(huge - 1);
-    if (p && b > a) (void)madvise((void *)a, (size_t)(b - a), MADV_HUGEPAGE);
-#else
-    (void)p, (void)bytes;
-#endif
 }
 
 void *es__realloc(es_ctx *ctx, void *ptr, size_t size)

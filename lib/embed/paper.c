@@ -27,7 +27,6 @@
 
 #include <float.h>
 #include <math.h>
-#include <time.h>
 
 void es_embed_paper_opts_init(es_embed_paper_opts *o)
 {
@@ -36,13 +35,6 @@ void es_embed_paper_opts_init(es_embed_paper_opts *o)
     o->factr = 1e7;
     o->pgtol = 1e-5;
     es_embed_opts_init(&o->embed);
-}
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 /* ---- L-BFGS on the closure energy ---------------------------------------------- */
@@ -233,7 +225,7 @@ es_status es_embed_paper_solve(es_ctx *ctx, es_embedder *emb, const double *targ
     es_embed_report rep;
     const es_mesh *mesh = emb ? es_embedder_mesh(emb) : NULL;
     lbfgs L;
-    double f0 = 0, f1 = 0, t0 = now_s(), t_stage1, sum = 0, fs;
+    double f0 = 0, f1 = 0, t0 = es__seconds(), t_stage1, sum = 0, fs;
     int64_t ne, iters = 0;
     es_status rc;
     if (!opts) {
@@ -285,7 +277,7 @@ es_status es_embed_paper_solve(es_ctx *ctx, es_embedder *emb, const double *targ
     rc = opts->max_iter > 0 ? run_lbfgs(&L, opts, &f0, &f1, &iters)
                             : es_embed_closure(ctx, mesh, L.len, L.x, &f0, NULL, NULL);
     if (opts->max_iter <= 0) f1 = f0;
-    t_stage1 = now_s() - t0;
+    t_stage1 = es__seconds() - t0;
     /* stages 2-3 from the minimizer, nothing after them */
     eo = opts->embed;
     eo.dihedral_mode = ES_EMBED_DIHEDRAL_OFF;
@@ -303,7 +295,7 @@ es_status es_embed_paper_solve(es_ctx *ctx, es_embedder *emb, const double *targ
     rep.dihedral_iters = iters;
     rep.used_stage1 = 1;
     rep.t_dihedral = t_stage1;
-    rep.t_total = now_s() - t0;
+    rep.t_total = es__seconds() - t0;
     if (report) *report = rep;
     return ES_OK;
 }

@@ -16,7 +16,6 @@
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
-#include <time.h>
 
 void es_embed_opts_init(es_embed_opts *o)
 {
@@ -85,13 +84,6 @@ void es_embed_opts_fast(es_embed_opts *o)
     o->lg_max_iter = 30;
     o->lg_rms_tol = 1e-3;
     o->lg_max_tol = 2e-2;
-}
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 static int all_finite(const double *x, int64_t n)
@@ -200,12 +192,12 @@ static es_status linear_stages(es_embedder *emb, const double *alpha, const doub
                                double *xyz, es_embed_report *rep)
 {
     es_status rc;
-    double t1 = now_s();
+    double t1 = es__seconds();
     if ((rc = es__stage_frames(emb, alpha)) != ES_OK) return rc;
-    rep->t_frames += now_s() - t1;
-    t1 = now_s();
+    rep->t_frames += es__seconds() - t1;
+    t1 = es__seconds();
     if ((rc = es__stage_positions(emb, L, xyz)) != ES_OK) return rc;
-    rep->t_positions += now_s() - t1;
+    rep->t_positions += es__seconds() - t1;
     if (!all_finite(xyz, 3 * emb->nv))
         for (int64_t i = 0; i < 3 * emb->nv; i++) xyz[i] = 0;
     return ES_OK;
@@ -348,9 +340,9 @@ static es_status shape_from_start(es_embedder *emb, const es_embed_opts *o, es__
         Lr = emb->len;
     }
     if (o->prior_exact) lo.rms_tol /= 3, lo.max_tol /= 3;
-    double t0 = now_s();
+    double t0 = es__seconds();
     rc = es__lg_solve(emb, Lr, xyz, &lo, &res);
-    rep->t_local_global = now_s() - t0;
+    rep->t_local_global = es__seconds() - t0;
     if (rc != ES_OK) return rc;
     rep->lg_iters = res.iters;
     /* a target no mesh has: the finish always runs, with the prior's term at
@@ -389,7 +381,7 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
     es_embed_report rep;
     const es_embed_opts *o = opts;
     int64_t nv, ne, n3;
-    double sum = 0, f, t0 = now_s(), t1, *L, *alpha;
+    double sum = 0, f, t0 = es__seconds(), t1, *L, *alpha;
     const double *ref;
     es_status rc;
     int have_dihedral_result = 0;
@@ -466,11 +458,11 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
         if ((rc = positions_start(emb, ext, init_alpha ? alpha : NULL, L, xyz, &rep)) != ES_OK)
             return rc;
         es__progress(ctx, "embedding", 1, emb->progress_total);
-        t1 = now_s();
+        t1 = es__seconds();
         rc = lg ? shape_from_start(emb, o, bp, L, ext && ext->warm, xyz, &rep)
                 : refine_from_start(emb, o, bp, L, xyz, &rep);
         if (rc != ES_OK) return rc;
-        rep.t_refine = now_s() - t1;
+        rep.t_refine = es__seconds() - t1;
         es__progress(ctx, "embedding", emb->progress_total, emb->progress_total);
         emb->progress_total = 0;
     } else if (!(o->continuation_steps > 0 && init_xyz) || o->try_both) {
@@ -485,7 +477,7 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
             double lambda1 = 1e-3;
             int first = mode == ES_EMBED_DIHEDRAL_AUTO ? 1 : o->dihedral_max_iter;
             memcpy(emb->alpha_keep, alpha, (size_t)ne * sizeof *alpha);
-            t1 = now_s();
+            t1 = es__seconds();
             if ((rc = es__stage_dihedrals(emb, o, first, alpha, &rep.closure_stage1,
                                       &rep.dihedral_iters, &lambda1)) != ES_OK)
                 return rc;
@@ -501,18 +493,18 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
                     return rc;
                 }
             }
-            rep.t_dihedral = now_s() - t1;
+            rep.t_dihedral = es__seconds() - t1;
         }
         es__progress(ctx, "embedding", 1, emb->progress_total);
         if ((rc = linear_stages(emb, alpha, L, xyz, &rep)) != ES_OK) return rc;
         es__progress(ctx, "embedding", 2, emb->progress_total);
         es__length_fit(emb, xyz, L, &rep.rms_ratio_linear, &mx);
-        t1 = now_s();
+        t1 = es__seconds();
         es__refine_opts ro = es__refine_opts_from(o);
         if (o->refine_max_iter > 0 &&
             (rc = es__stage_refine(emb, L, xyz, bp, &ro, &rep.refine_iters)) != ES_OK)
             return rc;
-        rep.t_refine = now_s() - t1;
+        rep.t_refine = es__seconds() - t1;
         es__progress(ctx, "embedding", emb->progress_total, emb->progress_total);
         emb->progress_total = 0;
         have_dihedral_result = 1;
@@ -521,9 +513,9 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
     if (o->continuation_steps > 0 && init_xyz && !start) {
         double *cx = have_dihedral_result ? emb->xyz_best : xyz;
         int64_t it = 0;
-        t1 = now_s();
+        t1 = es__seconds();
         if ((rc = run_continuation(emb, o, L, init_xyz, bp, cx, &it)) != ES_OK) return rc;
-        rep.t_refine += now_s() - t1;
+        rep.t_refine += es__seconds() - t1;
         rep.continuation_steps = o->continuation_steps;
         if (have_dihedral_result) {
             double r1, m1, r2, m2;
@@ -582,7 +574,7 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
     rep.closure_after = es__closure_eval(emb, emb->alpha_try, 0, emb->vclos);
     emb->have_vertex_results = 1;
     rep.realized = rep.max_rel <= o->realized_rtol && rep.n_bad_faces == 0;
-    rep.t_total = now_s() - t0;
+    rep.t_total = es__seconds() - t0;
     if (report) *report = rep;
     return ES_OK;
 }

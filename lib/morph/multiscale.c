@@ -19,14 +19,6 @@
 #include "edgespace/es_geom.h"
 
 #include <math.h>
-#include <time.h>
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 void es_multiscale_opts_init(es_multiscale_opts *o)
 {
@@ -211,10 +203,10 @@ static es_status blend_inner(es_multiscale *ms, ms_node *n, const double *len, d
 {
     int64_t m = n->nchild;
     double *r = ms->work + es__ms_register_work(ms->maxm), *t = r + 9 * m, *b = t + 3 * m;
-    double t0 = now(), t1;
+    double t0 = es__seconds(), t1;
     es_status rc = es__ms_register(ms, n, r, t, ms->work, ms->iwork);
     if (rc != ES_OK) return rc;
-    t1 = now();
+    t1 = es__seconds();
     *t_reg += t1 - t0;
     for (int64_t i = 0; i < 3 * n->nv; i++) b[i] = 0;
     /* right-hand side M^T e of eq. 3: each occurrence's direction, rotated
@@ -238,7 +230,7 @@ static es_status blend_inner(es_multiscale *ms, ms_node *n, const double *len, d
     if ((rc = es__spd_solve(ms->spd, n->spd, 3, b, n->nv)) != ES_OK) return rc;
     for (int64_t i = 0; i < n->nv; i++)
         for (int c = 0; c < 3; c++) n->x[3 * i + c] = b[i + n->nv * c];
-    *t_blend += now() - t1;
+    *t_blend += es__seconds() - t1;
     return ES_OK;
 }
 
@@ -253,9 +245,9 @@ static es_status solve_one(es_multiscale *ms, const double *len, const double *a
     for (int64_t i = ms->nnode - 1; i >= 0 && rc == ES_OK; i--) {
         ms_node *n = &ms->node[i];
         if (!n->nchild) {
-            t0 = now();
+            t0 = es__seconds();
             glue_leaf(ms, n, len, alpha, ms->iwork + ms->maxm * ms->maxm + 2 * ms->maxm);
-            t_leaf += now() - t0;
+            t_leaf += es__seconds() - t0;
         } else {
             rc = blend_inner(ms, n, len, &t_reg, &t_blend);
         }

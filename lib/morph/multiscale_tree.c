@@ -18,7 +18,6 @@
 
 #include <math.h>
 #include <stdlib.h>
-#include <time.h>
 
 /* What building needs beyond the nodes: scratch arrays indexed by mesh
  * face, vertex and edge, reset after each use. */
@@ -35,13 +34,6 @@ typedef struct builder {
     int64_t stamp_next;
     es_rng rng;
 } builder;
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static int cmp_i64(const void *a, const void *b)
 {
@@ -357,7 +349,7 @@ es_status es__ms_build(es_multiscale *ms)
     es_ctx *ctx = ms->ctx;
     builder b;
     int64_t *all;
-    double t0 = now(), t1;
+    double t0 = es__seconds(), t1;
     es_status rc = ES_OK;
     memset(&b, 0, sizeof b);
     b.ms = ms;
@@ -393,7 +385,7 @@ es_status es__ms_build(es_multiscale *ms)
         if ((rc = node_elements(&b, &ms->node[i])) == ES_OK) rc = split(&b, i);
         if (i % 64 == 0) es__progress(ctx, "multiscale: patches", i + 1, ms->nnode);
     }
-    t1 = now();
+    t1 = es__seconds();
     for (int64_t i = 0; rc == ES_OK && i < ms->nnode; i++) {
         ms_node *n = &ms->node[i];
         if (n->level + 1 > ms->info.levels) ms->info.levels = n->level + 1;
@@ -409,7 +401,7 @@ es_status es__ms_build(es_multiscale *ms)
     }
     ms->info.nodes = ms->nnode;
     ms->info.t_split = t1 - t0;
-    ms->info.t_factor = now() - t1;
+    ms->info.t_factor = es__seconds() - t1;
 done:
     es__free(ctx, b.in_node);
     es__free(ctx, b.part);

@@ -26,7 +26,6 @@
 
 #include <math.h>
 #include <stdio.h>
-#include <time.h>
 
 typedef struct mwalk {
     es_ctx *ctx;
@@ -40,13 +39,6 @@ typedef struct mwalk {
                                    store's meshes closed off for the conformal morph) */
     const double *file_xyz;
 } mwalk;
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static double step_t(const es_study_interp_opts *o, int64_t i)
 {
@@ -119,7 +111,7 @@ static es_status geometric(mwalk *w, const double *xa, const double *xb)
         rc = o->method == ES_MORPH_MULTISCALE ? es_multiscale_new(ctx, w->mesh, &o->multiscale, &ms)
                                               : es_shape_space_new(ctx, w->mesh, xa, xb, NULL, &ss);
     for (int64_t i = 0; rc == ES_OK && i < o->steps; i++) {
-        double t = step_t(o, i), wt[2] = {1 - t, t}, t0 = now_s();
+        double t = step_t(o, i), wt[2] = {1 - t, t}, t0 = es__seconds();
         char heading[96], params[1024];
         es_embed_report rep;
         if ((rc = geom_target(w, in, la, lb, t, len)) != ES_OK) break;
@@ -127,7 +119,7 @@ static es_status geometric(mwalk *w, const double *xa, const double *xb)
                 : es_shape_space_frame(ctx, ss, len, t, xyz);
         if (rc != ES_OK) break;
         memset(&rep, 0, sizeof rep);
-        rep.t_total = now_s() - t0;
+        rep.t_total = es__seconds() - t0;
         if ((rc = es_morph_report(ctx, w->mesh, len, xyz, o->embed.realized_rtol, &rep, vc,
                                   ve)) != ES_OK)
             break;
@@ -321,7 +313,7 @@ static es_status data_driven(mwalk *w, int lri)
     if (rc == ES_OK && !lri) rc = es_study_embedder_open(ctx, w->store, 1, &se);
     for (int64_t i = 0; rc == ES_OK && i < m; i++) {
         const double *wi = wts + i * n;
-        double s = (double)i / (double)(m - 1), t0 = now_s();
+        double s = (double)i / (double)(m - 1), t0 = es__seconds();
         es_embed_report rep;
         char heading[200], params[1024];
         dd_frame(w, n, l, sc, wi, i, v, &scale);
@@ -335,7 +327,7 @@ static es_status data_driven(mwalk *w, int lri)
                 (rc = es_lri_place(ctx, nv, y, X + 3 * nv * w->ra, X + 3 * nv * w->rb, s,
                                    xyz)) != ES_OK)
                 break;
-            rep.t_total = now_s() - t0;
+            rep.t_total = es__seconds() - t0;
             if ((rc = es_morph_report(ctx, w->mesh, tl, xyz, o->embed.realized_rtol, &rep, vc,
                                       ve)) != ES_OK)
                 break;
