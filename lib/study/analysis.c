@@ -7,6 +7,7 @@
  * es_study.h). Commands (tools/cmd/mean.c, ...) and notebooks call these,
  * so a result made from C is the same as one made from the command line.
  */
+#include "study/study_pkg.h"
 #include "edgespace/es_study.h"
 #include "edgespace/es_geom.h"
 #include "edgespace/es_io.h"
@@ -40,15 +41,6 @@ es_status es_study_source(es_ctx *ctx, es_store *store, const int64_t *rows, int
     out->read = store_read;
     out->userdata = store;
     out->rows = rows;
-    return ES_OK;
-}
-
-/* "<kind>/<name>/<dataset>" */
-static es_status dpath(es_ctx *ctx, char *buf, const char *kind, const char *name,
-                       const char *ds)
-{
-    int n = snprintf(buf, PATH_MAX_LEN, "%s/%s/%s", kind, name, ds);
-    if (n < 0 || n >= PATH_MAX_LEN) ES_FAIL(ctx, ES_ERANGE, "analysis: name '%s' too long", name);
     return ES_OK;
 }
 
@@ -181,15 +173,15 @@ es_status es_study_mean(es_ctx *ctx, es_store *store, const char *name, const ch
         snprintf(params, sizeof params, "filter=%s; by=%s", filter ? filter : "", by ? by : "");
         es_provenance prov = {command ? command : "es_study_mean", rows, nrows, params};
         if ((rc = es_store_result_begin(ctx, store, "mean", name, &prov)) != ES_OK) goto done;
-        if ((rc = dpath(ctx, p, "mean", name, "means")) != ES_OK ||
+        if ((rc = es__result_path(ctx, p, PATH_MAX_LEN, "mean", name, "means")) != ES_OK ||
             (rc = es_store_put_matrix(ctx, store, p, (es_mat){r->means, E, ng, E})) != ES_OK ||
-            (rc = dpath(ctx, p, "mean", name, "counts")) != ES_OK ||
+            (rc = es__result_path(ctx, p, PATH_MAX_LEN, "mean", name, "counts")) != ES_OK ||
             (rc = es_store_put_ints(ctx, store, p, r->counts, ng)) != ES_OK ||
-            (rc = dpath(ctx, p, "mean", name, "scales")) != ES_OK ||
+            (rc = es__result_path(ctx, p, PATH_MAX_LEN, "mean", name, "scales")) != ES_OK ||
             (rc = es_store_put_vector(ctx, store, p, r->scales, ng)) != ES_OK ||
-            (rc = dpath(ctx, p, "mean", name, "centroid_sizes")) != ES_OK ||
+            (rc = es__result_path(ctx, p, PATH_MAX_LEN, "mean", name, "centroid_sizes")) != ES_OK ||
             (rc = es_store_put_vector(ctx, store, p, r->centroid_sizes, ng)) != ES_OK ||
-            (rc = dpath(ctx, p, "mean", name, "groups")) != ES_OK ||
+            (rc = es__result_path(ctx, p, PATH_MAX_LEN, "mean", name, "groups")) != ES_OK ||
             (rc = es_store_put_strings(ctx, store, p, (const char *const *)r->names, ng)) != ES_OK)
             goto done;
         snprintf(p, sizeof p, "mean/%s", name);
@@ -239,19 +231,19 @@ static es_status save_pca(es_ctx *ctx, es_store *store, const char *name, const 
     if (!st) return ES_ENOMEM;
     for (int64_t i = 0; i < N; i++)
         for (int64_t k = 0; k < K; k++) st[k + i * K] = p->scores[i + k * N];
-    if ((rc = dpath(ctx, path, "pca", name, "mean")) != ES_OK ||
+    if ((rc = es__result_path(ctx, path, PATH_MAX_LEN, "pca", name, "mean")) != ES_OK ||
         (rc = es_store_put_vector(ctx, store, path, p->mean, E)) != ES_OK ||
-        (rc = dpath(ctx, path, "pca", name, "components")) != ES_OK ||
+        (rc = es__result_path(ctx, path, PATH_MAX_LEN, "pca", name, "components")) != ES_OK ||
         (rc = es_store_put_matrix(ctx, store, path, (es_mat){p->components, E, K, E})) != ES_OK ||
-        (rc = dpath(ctx, path, "pca", name, "eigenvalues")) != ES_OK ||
+        (rc = es__result_path(ctx, path, PATH_MAX_LEN, "pca", name, "eigenvalues")) != ES_OK ||
         (rc = es_store_put_vector(ctx, store, path, p->eigenvalues, K)) != ES_OK ||
-        (rc = dpath(ctx, path, "pca", name, "explained")) != ES_OK ||
+        (rc = es__result_path(ctx, path, PATH_MAX_LEN, "pca", name, "explained")) != ES_OK ||
         (rc = es_store_put_vector(ctx, store, path, p->explained, K)) != ES_OK ||
-        (rc = dpath(ctx, path, "pca", name, "total_variance")) != ES_OK ||
+        (rc = es__result_path(ctx, path, PATH_MAX_LEN, "pca", name, "total_variance")) != ES_OK ||
         (rc = es_store_put_vector(ctx, store, path, &p->total_variance, 1)) != ES_OK ||
-        (rc = dpath(ctx, path, "pca", name, "scores")) != ES_OK ||
+        (rc = es__result_path(ctx, path, PATH_MAX_LEN, "pca", name, "scores")) != ES_OK ||
         (rc = es_store_put_matrix(ctx, store, path, (es_mat){st, K, N, K > 0 ? K : 1})) != ES_OK ||
-        (rc = dpath(ctx, path, "pca", name, "rows")) != ES_OK ||
+        (rc = es__result_path(ctx, path, PATH_MAX_LEN, "pca", name, "rows")) != ES_OK ||
         (rc = es_store_put_ints(ctx, store, path, rows, N)) != ES_OK)
         goto done;
     snprintf(path, sizeof path, "pca/%s", name);
@@ -345,17 +337,17 @@ es_status es_study_pca_load(es_ctx *ctx, es_store *store, const char *name, es_p
         es_store_result_hint(ctx, store, "pca", nm, hint, sizeof hint);
         ES_FAIL(ctx, ES_ENOTFOUND, "pca: no PCA named '%s'%s", nm, hint);
     }
-    if ((rc = dpath(ctx, path, "pca", nm, "mean")) != ES_OK ||
+    if ((rc = es__result_path(ctx, path, PATH_MAX_LEN, "pca", nm, "mean")) != ES_OK ||
         (rc = es_store_get_vector(ctx, store, path, &mean, &E)) != ES_OK ||
-        (rc = dpath(ctx, path, "pca", nm, "eigenvalues")) != ES_OK ||
+        (rc = es__result_path(ctx, path, PATH_MAX_LEN, "pca", nm, "eigenvalues")) != ES_OK ||
         (rc = es_store_get_vector(ctx, store, path, &eig, &K)) != ES_OK ||
-        (rc = dpath(ctx, path, "pca", nm, "total_variance")) != ES_OK ||
+        (rc = es__result_path(ctx, path, PATH_MAX_LEN, "pca", nm, "total_variance")) != ES_OK ||
         (rc = es_store_get_vector(ctx, store, path, &tv, &ntv)) != ES_OK ||
-        (rc = dpath(ctx, path, "pca", nm, "components")) != ES_OK ||
+        (rc = es__result_path(ctx, path, PATH_MAX_LEN, "pca", nm, "components")) != ES_OK ||
         (rc = es_store_get_matrix(ctx, store, path, &comps)) != ES_OK ||
-        (rc = dpath(ctx, path, "pca", nm, "scores")) != ES_OK ||
+        (rc = es__result_path(ctx, path, PATH_MAX_LEN, "pca", nm, "scores")) != ES_OK ||
         (rc = es_store_get_matrix(ctx, store, path, &scores)) != ES_OK ||
-        (rc = dpath(ctx, path, "pca", nm, "rows")) != ES_OK ||
+        (rc = es__result_path(ctx, path, PATH_MAX_LEN, "pca", nm, "rows")) != ES_OK ||
         (rc = es_store_get_ints(ctx, store, path, &rows, &nrows)) != ES_OK)
         goto done;
     if (comps.rows != E || comps.cols != K || ntv != 1 || scores.rows != K ||
@@ -464,14 +456,14 @@ es_status es_study_diff(es_ctx *ctx, es_store *store, const char *name, const ch
         static const char *const vn[4] = {"mean", "sd", "se", "t"};
         const double *vv[4] = {d->mean, d->sd, d->se, d->t};
         for (int i = 0; i < 4; i++)
-            if ((rc = dpath(ctx, p, "diff", name, vn[i])) != ES_OK ||
+            if ((rc = es__result_path(ctx, p, PATH_MAX_LEN, "diff", name, vn[i])) != ES_OK ||
                 (rc = es_store_put_vector(ctx, store, p, vv[i], E)) != ES_OK)
                 goto done;
-        if ((rc = dpath(ctx, p, "diff", name, "pair_from")) != ES_OK ||
+        if ((rc = es__result_path(ctx, p, PATH_MAX_LEN, "diff", name, "pair_from")) != ES_OK ||
             (rc = es_store_put_ints(ctx, store, p, d->pair_from, d->npairs)) != ES_OK ||
-            (rc = dpath(ctx, p, "diff", name, "pair_to")) != ES_OK ||
+            (rc = es__result_path(ctx, p, PATH_MAX_LEN, "diff", name, "pair_to")) != ES_OK ||
             (rc = es_store_put_ints(ctx, store, p, d->pair_to, d->npairs)) != ES_OK ||
-            (rc = dpath(ctx, p, "diff", name, "unpaired")) != ES_OK ||
+            (rc = es__result_path(ctx, p, PATH_MAX_LEN, "diff", name, "unpaired")) != ES_OK ||
             (rc = es_store_put_ints(ctx, store, p, d->unpaired, d->nunpaired)) != ES_OK)
             goto done;
         snprintf(p, sizeof p, "diff/%s", name);
@@ -579,7 +571,7 @@ static es_status resolve_diff(es_ctx *ctx, es_study_resolver *r, const char *arg
     int64_t n = 0, *from = NULL, *to = NULL, nf = 0, nt = 0;
     es_status rc;
     if (bad_name(arg)) ES_FAIL(ctx, ES_EINVAL, "bad difference name");
-    if ((rc = dpath(ctx, p, "diff", arg, "mean")) != ES_OK) return rc;
+    if ((rc = es__result_path(ctx, p, PATH_MAX_LEN, "diff", arg, "mean")) != ES_OK) return rc;
     if (!es_store_has(r->store, p)) {
         char hint[400];
         es_store_result_hint(ctx, r->store, "diff", arg, hint, sizeof hint);
@@ -595,9 +587,9 @@ static es_status resolve_diff(es_ctx *ctx, es_study_resolver *r, const char *arg
     es_free(ctx, v);
     if (!w) return ES_OK;
     /* the mean over pairs of (to - from) */
-    if ((rc = dpath(ctx, p, "diff", arg, "pair_from")) == ES_OK &&
+    if ((rc = es__result_path(ctx, p, PATH_MAX_LEN, "diff", arg, "pair_from")) == ES_OK &&
         (rc = es_store_get_ints(ctx, r->store, p, &from, &nf)) == ES_OK &&
-        (rc = dpath(ctx, p, "diff", arg, "pair_to")) == ES_OK &&
+        (rc = es__result_path(ctx, p, PATH_MAX_LEN, "diff", arg, "pair_to")) == ES_OK &&
         (rc = es_store_get_ints(ctx, r->store, p, &to, &nt)) == ES_OK) {
         const int64_t N = es_store_nrows(r->store);
         if (nf != nt || nf < 1) rc = es__fail(ctx, ES_EFORMAT, "difference '%s' has %lld "
@@ -715,11 +707,11 @@ es_status es_study_point(es_ctx *ctx, es_store *store, const char *name, const c
         char p[PATH_MAX_LEN];
         es_provenance prov = {command ? command : "es_study_point", NULL, -1, expr};
         if ((rc = es_store_result_begin(ctx, store, "point", name, &prov)) != ES_OK ||
-            (rc = dpath(ctx, p, "point", name, "lengths")) != ES_OK ||
+            (rc = es__result_path(ctx, p, PATH_MAX_LEN, "point", name, "lengths")) != ES_OK ||
             (rc = es_store_put_vector(ctx, store, p, v, E)) != ES_OK ||
-            (rc = dpath(ctx, p, "point", name, "scale")) != ES_OK ||
+            (rc = es__result_path(ctx, p, PATH_MAX_LEN, "point", name, "scale")) != ES_OK ||
             (rc = es_store_put_vector(ctx, store, p, &in.scale, 1)) != ES_OK ||
-            (rc = dpath(ctx, p, "point", name, "row_weights")) != ES_OK ||
+            (rc = es__result_path(ctx, p, PATH_MAX_LEN, "point", name, "row_weights")) != ES_OK ||
             (rc = es_store_put_vector(ctx, store, p, w, N)) != ES_OK)
             goto done;
         snprintf(p, sizeof p, "point/%s", name);

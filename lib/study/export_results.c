@@ -16,7 +16,7 @@ es_status es__result_path(es_ctx *ctx, char *buf, size_t n, const char *kind, co
                           const char *ds)
 {
     int len = snprintf(buf, n, "%s/%s/%s", kind, name, ds);
-    if (len < 0 || (size_t)len >= n) ES_FAIL(ctx, ES_ERANGE, "export: name '%s' too long", name);
+    if (len < 0 || (size_t)len >= n) ES_FAIL(ctx, ES_ERANGE, "result name '%s' is too long", name);
     return ES_OK;
 }
 
