@@ -23,22 +23,11 @@
  * central differences).
  */
 #include "embed/embed_pkg.h"
+#include "core/vec3.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-static void cross3(const double *u, const double *v, double *w)
-{
-    w[0] = u[1] * v[2] - u[2] * v[1];
-    w[1] = u[2] * v[0] - u[0] * v[2];
-    w[2] = u[0] * v[1] - u[1] * v[0];
-}
-
-static double dot3(const double *u, const double *v)
-{
-    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
-}
 
 /* The bending angle of the flap (a, b; c, d), with the normals and the edge
  * vector for the gradient. */
@@ -52,12 +41,12 @@ static double flap_alpha(const double *pa, const double *pb, const double *pc, c
         ba[i] = pa[i] - pb[i];
         bd[i] = pd[i] - pb[i];
     }
-    cross3(e, ac, nf);
-    cross3(ba, bd, ng);
-    *el = sqrt(dot3(e, e));
-    cross3(ng, nf, c);
+    es__v3_cross(e, ac, nf);
+    es__v3_cross(ba, bd, ng);
+    *el = sqrt(es__v3_dot(e, e));
+    es__v3_cross(ng, nf, c);
     if (!(*el > 0)) return 0;
-    return atan2(dot3(c, e) / *el, dot3(ng, nf));
+    return atan2(es__v3_dot(c, e) / *el, es__v3_dot(ng, nf));
 }
 
 int es__dihedral_grad(const double *pa, const double *pb, const double *pc, const double *pd,
@@ -65,8 +54,8 @@ int es__dihedral_grad(const double *pa, const double *pb, const double *pc, cons
 {
     double nf[3], ng[3], e[3], el, nf2, ng2, sc, sd, ee;
     *alpha = flap_alpha(pa, pb, pc, pd, nf, ng, e, &el);
-    nf2 = dot3(nf, nf);
-    ng2 = dot3(ng, ng);
+    nf2 = es__v3_dot(nf, nf);
+    ng2 = es__v3_dot(ng, ng);
     ee = el * el;
     if (!(el > 0 && nf2 > 1e-30 * ee * ee && ng2 > 1e-30 * ee * ee)) {
         memset(g, 0, 12 * sizeof *g);
@@ -74,8 +63,8 @@ int es__dihedral_grad(const double *pa, const double *pb, const double *pc, cons
     }
     double ac[3] = {pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2]};
     double ad[3] = {pd[0] - pa[0], pd[1] - pa[1], pd[2] - pa[2]};
-    sc = dot3(ac, e) / ee;
-    sd = dot3(ad, e) / ee;
+    sc = es__v3_dot(ac, e) / ee;
+    sd = es__v3_dot(ad, e) / ee;
     for (int i = 0; i < 3; i++) {
         double gc = el * nf[i] / nf2, gd = el * ng[i] / ng2;
         g[6 + i] = gc;

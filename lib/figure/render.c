@@ -21,6 +21,7 @@
  */
 #include "figure/figure_pkg.h"
 #include "edgespace/es_render.h"
+#include "core/vec3.h"
 
 #include <float.h>
 #include <lapacke.h>
@@ -60,23 +61,10 @@ void es_render_mesh_from(es_render_mesh *item, const es_mesh *mesh, const double
 
 /* ---- small vector helpers ---------------------------------------------- */
 
-static double dot3(const double *a, const double *b)
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static void cross3(const double *a, const double *b, double *c)
-{
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-static double norm3(const double *a) { return sqrt(dot3(a, a)); }
 
 static bool normalize3(double *a)
 {
-    double n = norm3(a);
+    double n = es__v3_norm(a);
     if (!(n > 1e-300) || !isfinite(n)) return false;
     a[0] /= n, a[1] /= n, a[2] /= n;
     return true;
@@ -129,11 +117,11 @@ es_status es_render_auto_view(es_ctx *ctx, int64_t nverts, const double *xyz,
         const double *a = xyz + 3 * t[0], *b = xyz + 3 * t[1], *d = xyz + 3 * t[2];
         double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
         double s[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]}, n[3];
-        cross3(u, s, n);
+        es__v3_cross(u, s, n);
         for (int k = 0; k < 3; k++) nsum[k] += n[k];
-        asum += norm3(n);
+        asum += es__v3_norm(n);
     }
-    double side = dot3(nsum, e0);
+    double side = es__v3_dot(nsum, e0);
     double sgn;
     if (asum > 0 && fabs(side) > 1e-3 * asum) sgn = side > 0 ? -1 : 1;
     else sgn = e0[argmax_abs3(e0)] > 0 ? -1 : 1; /* camera on the positive side */
@@ -272,7 +260,7 @@ static es_status make_basis(es_ctx *ctx, const es_render_spec *spec, const es_re
     if (spec->has_view) memcpy(view, spec->view, sizeof view);
     if (spec->has_up) memcpy(up, spec->up, sizeof up);
     if (!normalize3(view)) ES_FAIL(ctx, ES_EINVAL, "render: the view direction is zero");
-    double d = dot3(up, view);
+    double d = es__v3_dot(up, view);
     for (int k = 0; k < 3; k++) up[k] -= d * view[k];
     if (!normalize3(up)) {
         if (spec->has_up) ES_FAIL(ctx, ES_EINVAL, "render: the up vector is zero or parallel to the view");
@@ -280,14 +268,14 @@ static es_status make_basis(es_ctx *ctx, const es_render_spec *spec, const es_re
         static const double axes[2][3] = {{0, 1, 0}, {0, 0, 1}};
         for (int a = 0; a < 2; a++) {
             memcpy(up, axes[a], sizeof up);
-            d = dot3(up, view);
+            d = es__v3_dot(up, view);
             for (int k = 0; k < 3; k++) up[k] -= d * view[k];
             if (normalize3(up)) break;
         }
     }
     memcpy(cam->f, view, sizeof view);
     memcpy(cam->u, up, sizeof up);
-    cross3(cam->f, cam->u, cam->r);
+    es__v3_cross(cam->f, cam->u, cam->r);
     return ES_OK;
 }
 
@@ -295,9 +283,9 @@ static es_status make_basis(es_ctx *ctx, const es_render_spec *spec, const es_re
 static void to_camera(const camera *cam, const double *p, double *q)
 {
     double d[3] = {p[0] - cam->c[0], p[1] - cam->c[1], p[2] - cam->c[2]};
-    q[0] = dot3(d, cam->r);
-    q[1] = dot3(d, cam->u);
-    q[2] = dot3(d, cam->f) + cam->dist;
+    q[0] = es__v3_dot(d, cam->r);
+    q[1] = es__v3_dot(d, cam->u);
+    q[2] = es__v3_dot(d, cam->f) + cam->dist;
 }
 
 /* Place the camera: centre on the bounding box in camera axes, and for
@@ -395,7 +383,7 @@ static uint32_t shade(const shade_in *in, const double n_in[3], double value, in
     double n[3] = {n_in[0], n_in[1], n_in[2]}, base[3];
     if (!normalize3(n)) n[0] = light[0], n[1] = light[1], n[2] = light[2];
     if (back) n[0] = -n[0], n[1] = -n[1], n[2] = -n[2];
-    double lam = fmax(0, dot3(n, light));
+    double lam = fmax(0, es__v3_dot(n, light));
     if (in->m->scalar_kind == ES_SCALARS_NONE)
         memcpy(base, in->m->rgb ? in->m->rgb : spec->base_rgb, sizeof base);
     else es_colormap_rgb(spec->cmap, isfinite(value) ? (value - in->vmin) / (in->vmax - in->vmin)
@@ -475,7 +463,7 @@ static void vertex_normals(const es_render_mesh *m, double *vn)
         const double *a = m->xyz + 3 * t[0], *b = m->xyz + 3 * t[1], *c = m->xyz + 3 * t[2];
         double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
         double s[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]}, n[3];
-        cross3(u, s, n);
+        es__v3_cross(u, s, n);
         for (int k = 0; k < 3; k++)
             for (int j = 0; j < 3; j++) vn[3 * t[k] + j] += n[j];
     }

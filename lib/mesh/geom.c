@@ -14,6 +14,7 @@
  */
 #include "edgespace/es_geom.h"
 #include "mesh/mesh_pkg.h"
+#include "core/vec3.h"
 
 #include <math.h>
 
@@ -102,20 +103,13 @@ es_status es_corner_angles(es_ctx *ctx, const es_mesh *mesh, const double *len, 
     return ES_OK;
 }
 
-static void cross(const double *a, const double *b, double *c)
-{
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 static void face_normal(const es_mesh *m, const double *xyz, int64_t f, double *n)
 {
     const double *p = xyz + 3 * m->faces[3 * f], *q = xyz + 3 * m->faces[3 * f + 1];
     const double *r = xyz + 3 * m->faces[3 * f + 2];
     double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
     double v[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
-    cross(u, v, n);
+    es__v3_cross(u, v, n);
     double s = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     if (s > 0) { n[0] /= s; n[1] /= s; n[2] /= s; }
 }
@@ -153,7 +147,7 @@ es_status es_dihedral_angles(es_ctx *ctx, const es_mesh *mesh, const double *xyz
         double t[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, c[3];
         double tn = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
         const double *nf = nrm + 3 * f, *ng = nrm + 3 * g;
-        cross(ng, nf, c);
+        es__v3_cross(ng, nf, c);
         double y = tn > 0 ? (c[0] * t[0] + c[1] * t[1] + c[2] * t[2]) / tn : 0;
         double x = ng[0] * nf[0] + ng[1] * nf[1] + ng[2] * nf[2];
         alpha[e] = atan2(y, x);

@@ -11,6 +11,7 @@
 #endif
 
 #include "core/core_private.h"
+#include "core/vec3.h"
 #include "embed/embed_private.h"
 #include "edgespace/es_morph.h"
 
@@ -72,22 +73,7 @@ int64_t es__ms_register_work(int64_t m);
 
 /* ---- small vector helpers --------------------------------------------------- */
 
-static inline void es__v3_sub(const double *a, const double *b, double *out)
-{
-    out[0] = a[0] - b[0], out[1] = a[1] - b[1], out[2] = a[2] - b[2];
-}
-
-static inline void es__v3_cross(const double *a, const double *b, double *out)
-{
-    double c0 = a[1] * b[2] - a[2] * b[1], c1 = a[2] * b[0] - a[0] * b[2];
-    double c2 = a[0] * b[1] - a[1] * b[0];
-    out[0] = c0, out[1] = c1, out[2] = c2;
-}
-
-static inline double es__v3_dot(const double *a, const double *b)
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
+/* es__v3_sub, es__v3_cross, es__v3_dot: core/vec3.h */
 
 /* Normalize in place; returns the length before (0 leaves v alone). */
 double es__v3_normalize(double *v);
