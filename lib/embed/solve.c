@@ -371,6 +371,187 @@ static es_status shape_from_start(es_embedder *emb, const es_embed_opts *o, es__
     return ES_OK;
 }
 
+/* The inputs refused with a message naming the edge or vertex; *sum the
+ * target lengths' sum. */
+static es_status check_inputs(es_embedder *emb, const double *target, double scale,
+                              const double *init_alpha, const double *init_xyz, double *sum)
+{
+    *sum = 0;
+    if (!(isfinite(scale) && scale >= 0))
+        ES_FAIL(emb->ctx, ES_EINVAL, "embed: scale %g is not finite and >= 0", scale);
+    for (int64_t e = 0; e < emb->ne; e++) {
+        if (!(isfinite(target[e]) && target[e] > 0))
+            ES_FAIL(emb->ctx, ES_EINVAL, "embed: target length of edge %lld (%lld-%lld) is %g, not "
+                    "finite and positive", (long long)e, (long long)emb->edges[2 * e],
+                    (long long)emb->edges[2 * e + 1], target[e]);
+        *sum += target[e];
+    }
+    if (!isfinite(*sum)) ES_FAIL(emb->ctx, ES_EINVAL, "embed: target lengths sum to %g", *sum);
+    if (init_alpha)
+        for (int64_t e = 0; e < emb->ne; e++)
+            if (!emb->eb[e] && !isfinite(init_alpha[e]))
+                ES_FAIL(emb->ctx, ES_EINVAL, "embed: initial dihedral of edge %lld is not finite",
+                        (long long)e);
+    if (init_xyz)   /* all vertices: those in no face are copied to the output */
+        for (int64_t i = 0; i < 3 * emb->nv; i++)
+            if (!isfinite(init_xyz[i]))
+                ES_FAIL(emb->ctx, ES_EINVAL, "embed: initial position of vertex %lld is not finite",
+                        (long long)(i / 3));
+    return ES_OK;
+}
+
+/* The path from given positions (a prior's realization): the start, then
+ * local-global iterations (or Levenberg-Marquardt with ES_EMBED_SOLVER_LM).
+ * alpha: the dihedrals for positions_start's stages 2-3 fallback, or NULL. */
+static es_status solve_from_positions(es_embedder *emb, const es_embed_opts *o, es__bend_prior *bp,
+                                      const es__solve_ext *ext, const double *alpha,
+                                      const double *L, double *xyz, es_embed_report *rep)
+{
+    es_status rc;
+    double t1;
+    int lg = o->solver != ES_EMBED_SOLVER_LM;
+    emb->progress_total = 1 + (lg ? shape_iters(emb, o) : o->refine_max_iter > 0 ? o->refine_max_iter : 0);
+    es__progress(emb->ctx, "embedding", 0, emb->progress_total);
+    if ((rc = positions_start(emb, ext, alpha, L, xyz, rep)) != ES_OK)
+        return rc;
+    es__progress(emb->ctx, "embedding", 1, emb->progress_total);
+    t1 = es__seconds();
+    rc = lg ? shape_from_start(emb, o, bp, L, ext && ext->warm, xyz, rep)
+            : refine_from_start(emb, o, bp, L, xyz, rep);
+    if (rc != ES_OK) return rc;
+    rep->t_refine = es__seconds() - t1;
+    es__progress(emb->ctx, "embedding", emb->progress_total, emb->progress_total);
+    emb->progress_total = 0;
+    return ES_OK;
+}
+
+/* The dihedral path (edge-length-interpolation Section 2): stages 1-4.
+ * Stage 1 repairs incoherent (noisy) dihedrals but can pull interpolated
+ * ones into a wrong closure minimum (oracle README, failure E). In auto
+ * mode one LM iteration decides: stage 1 goes on only if that iteration
+ * removed 99 % of the closure energy, else its dihedrals are dropped. On
+ * noisy dihedrals (0.001-0.1 rad, six real meshes) one iteration cuts the
+ * energy 300-20000x; on interpolated ones (midpoints of six real pairs)
+ * 1.1-36x, and there a finished stage 1 was always worse than none
+ * (failure E), and even the one iteration gave no better result after the
+ * refinement (cactus midpoints, 5K and 21K vertices: RMS ratio 0.0183 % /
+ * 0.0097 % with it, 0.0170 % / 0.0093 % without). So the linear stages run
+ * once. */
+static es_status solve_dihedral_path(es_embedder *emb, const es_embed_opts *o,
+                                     es__bend_prior *bp, double *alpha, const double *L,
+                                     double *xyz, es_embed_report *rep)
+{
+    es_status rc;
+    double t1;
+    double mx;
+    int mode = o->dihedral_mode;
+    if (emb->nvar == 0 || o->dihedral_max_iter <= 0) mode = ES_EMBED_DIHEDRAL_OFF;
+    rep->closure_stage1 = rep->closure_before;
+    /* one bar on a terminal: stage 1, stages 2-3, each refinement iteration */
+    emb->progress_total = 3 + (o->refine_max_iter > 0 ? o->refine_max_iter : 0);
+    es__progress(emb->ctx, "embedding", 0, emb->progress_total);
+    if (mode != ES_EMBED_DIHEDRAL_OFF) {
+        double lambda1 = 1e-3;
+        int first = mode == ES_EMBED_DIHEDRAL_AUTO ? 1 : o->dihedral_max_iter;
+        memcpy(emb->alpha_keep, alpha, (size_t)emb->ne * sizeof *alpha);
+        t1 = es__seconds();
+        if ((rc = es__stage_dihedrals(emb, o, first, alpha, &rep->closure_stage1,
+                                  &rep->dihedral_iters, &lambda1)) != ES_OK)
+            return rc;
+        rep->used_stage1 = 1;
+        if (mode == ES_EMBED_DIHEDRAL_AUTO) {
+            if (!(rep->closure_stage1 < 0.01 * rep->closure_before)) {
+                memcpy(alpha, emb->alpha_keep, (size_t)emb->ne * sizeof *alpha);
+                rep->used_stage1 = 0;
+            } else if (first < o->dihedral_max_iter &&
+                       (rc = es__stage_dihedrals(emb, o, o->dihedral_max_iter - first, alpha,
+                                             &rep->closure_stage1, &rep->dihedral_iters,
+                                             &lambda1)) != ES_OK) {
+                return rc;
+            }
+        }
+        rep->t_dihedral = es__seconds() - t1;
+    }
+    es__progress(emb->ctx, "embedding", 1, emb->progress_total);
+    if ((rc = linear_stages(emb, alpha, L, xyz, rep)) != ES_OK) return rc;
+    es__progress(emb->ctx, "embedding", 2, emb->progress_total);
+    es__length_fit(emb, xyz, L, &rep->rms_ratio_linear, &mx);
+    t1 = es__seconds();
+    es__refine_opts ro = es__refine_opts_from(o);
+    if (o->refine_max_iter > 0 &&
+        (rc = es__stage_refine(emb, L, xyz, bp, &ro, &rep->refine_iters)) != ES_OK)
+        return rc;
+    rep->t_refine = es__seconds() - t1;
+    es__progress(emb->ctx, "embedding", emb->progress_total, emb->progress_total);
+    emb->progress_total = 0;
+    return ES_OK;
+}
+
+/* The continuation path (run_continuation) from init_xyz; after the
+ * dihedral path it replaces that result only where its worst edge is
+ * better. */
+static es_status solve_continuation(es_embedder *emb, const es_embed_opts *o, es__bend_prior *bp,
+                                    const double *L, const double *init_xyz,
+                                    int have_dihedral_result, double *xyz, es_embed_report *rep)
+{
+    es_status rc;
+    double t1;
+    double *cx = have_dihedral_result ? emb->xyz_best : xyz;
+    int64_t it = 0;
+    t1 = es__seconds();
+    if ((rc = run_continuation(emb, o, L, init_xyz, bp, cx, &it)) != ES_OK) return rc;
+    rep->t_refine += es__seconds() - t1;
+    rep->continuation_steps = o->continuation_steps;
+    if (have_dihedral_result) {
+        double r1, m1, r2, m2;
+        es__length_fit(emb, xyz, L, &r1, &m1);
+        es__length_fit(emb, cx, L, &r2, &m2);
+        if (all_finite(cx, 3 * emb->nv) && (m2 < m1 || !all_finite(xyz, 3 * emb->nv))) {
+            memcpy(xyz, cx, (size_t)(3 * emb->nv) * sizeof *xyz);
+            rep->used_continuation = 1;
+            rep->refine_iters = it;
+        }
+    } else {
+        rep->used_continuation = 1;
+        rep->refine_iters = it;
+    }
+    return ES_OK;
+}
+
+/* The report's measures of the output: length errors, each vertex's mean
+ * relative error and closure energy, the worst edge, realized. */
+static es_status report_output(es_embedder *emb, const es_embed_opts *o, const double *L,
+                               const double *xyz, es_embed_report *rep)
+{
+    es_status rc;
+    if ((rc = es_embed_length_error(emb->ctx, emb->mesh, xyz, L, 0, &rep->rms_ratio, &rep->max_rel,
+                                    &rep->p99_rel)) != ES_OK)
+        return rc;
+    edge_lengths_of(emb, xyz, emb->lpath);
+    for (int64_t v = 0; v < emb->nv; v++) emb->verr[v] = 0;
+    {
+        double mx = -1;
+        for (int64_t e = 0; e < emb->ne; e++) {
+            double r = fabs(emb->lpath[e] - L[e]) / L[e];
+            emb->verr[emb->edges[2 * e]] += r;
+            emb->verr[emb->edges[2 * e + 1]] += r;
+            if (r > mx) {
+                mx = r;
+                rep->worst_edge = e;
+            }
+        }
+    }
+    for (int64_t v = 0; v < emb->nv; v++) {
+        int64_t k = emb->off[v + 1] - emb->off[v];
+        if (k) emb->verr[v] /= (double)k;
+    }
+    dihedrals_of(emb, xyz, emb->alpha_try);
+    rep->closure_after = es__closure_eval(emb, emb->alpha_try, 0, emb->vclos);
+    emb->have_vertex_results = 1;
+    rep->realized = rep->max_rel <= o->realized_rtol && rep->n_bad_faces == 0;
+    return ES_OK;
+}
+
 static es_status embed_solve(es_embedder *emb, const double *target, double scale,
                              const double *init_alpha, const double *init_xyz,
                              const es__solve_ext *ext, const es_embed_opts *opts, double *xyz,
@@ -381,7 +562,7 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
     es_embed_report rep;
     const es_embed_opts *o = opts;
     int64_t nv, ne, n3;
-    double sum = 0, f, t0 = es__seconds(), t1, *L, *alpha;
+    double sum = 0, f, t0 = es__seconds(), *L, *alpha;
     const double *ref;
     es_status rc;
     int have_dihedral_result = 0;
@@ -401,26 +582,7 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
     es__bend_prior *bp = ext ? ext->bp : NULL;
     if (!init_alpha && !init_xyz && !start)
         ES_FAIL(ctx, ES_EINVAL, "embed: need initial dihedrals or initial positions");
-    if (!(isfinite(scale) && scale >= 0))
-        ES_FAIL(ctx, ES_EINVAL, "embed: scale %g is not finite and >= 0", scale);
-    for (int64_t e = 0; e < ne; e++) {
-        if (!(isfinite(target[e]) && target[e] > 0))
-            ES_FAIL(ctx, ES_EINVAL, "embed: target length of edge %lld (%lld-%lld) is %g, not "
-                    "finite and positive", (long long)e, (long long)emb->edges[2 * e],
-                    (long long)emb->edges[2 * e + 1], target[e]);
-        sum += target[e];
-    }
-    if (!isfinite(sum)) ES_FAIL(ctx, ES_EINVAL, "embed: target lengths sum to %g", sum);
-    if (init_alpha)
-        for (int64_t e = 0; e < ne; e++)
-            if (!emb->eb[e] && !isfinite(init_alpha[e]))
-                ES_FAIL(ctx, ES_EINVAL, "embed: initial dihedral of edge %lld is not finite",
-                        (long long)e);
-    if (init_xyz)   /* all vertices: those in no face are copied to the output */
-        for (int64_t i = 0; i < n3; i++)
-            if (!isfinite(init_xyz[i]))
-                ES_FAIL(ctx, ES_EINVAL, "embed: initial position of vertex %lld is not finite",
-                        (long long)(i / 3));
+    if ((rc = check_inputs(emb, target, scale, init_alpha, init_xyz, &sum)) != ES_OK) return rc;
 
     L = emb->ltarget;
     alpha = emb->alpha;
@@ -439,98 +601,19 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
     emb->have_vertex_results = 0;
     emb->have_deviation = 0;   /* a prior solve measures it afterwards */
 
-    /* dihedral path: stages 1-4. Stage 1 repairs incoherent (noisy)
-     * dihedrals but can pull interpolated ones into a wrong closure minimum
-     * (oracle README, failure E). In auto mode one LM iteration decides:
-     * stage 1 goes on only if that iteration removed 99 % of the closure
-     * energy, else its dihedrals are dropped. On noisy dihedrals (0.001-0.1
-     * rad, six real meshes) one iteration cuts the energy 300-20000x; on
-     * interpolated ones (midpoints of six real pairs) 1.1-36x, and there a
-     * finished stage 1 was always worse than none (failure E), and even the
-     * one iteration gave no better result after the refinement (cactus
-     * midpoints, 5K and 21K vertices: RMS ratio 0.0183 % / 0.0097 % with it,
-     * 0.0170 % / 0.0093 % without). So the linear stages run once. */
+    /* one path to a first mesh, then alignment and the report */
     if (start) {
-        /* from given positions (a prior's realization) */
-        int lg = o->solver != ES_EMBED_SOLVER_LM;
-        emb->progress_total = 1 + (lg ? shape_iters(emb, o) : o->refine_max_iter > 0 ? o->refine_max_iter : 0);
-        es__progress(ctx, "embedding", 0, emb->progress_total);
-        if ((rc = positions_start(emb, ext, init_alpha ? alpha : NULL, L, xyz, &rep)) != ES_OK)
+        if ((rc = solve_from_positions(emb, o, bp, ext, init_alpha ? alpha : NULL, L, xyz,
+                                       &rep)) != ES_OK)
             return rc;
-        es__progress(ctx, "embedding", 1, emb->progress_total);
-        t1 = es__seconds();
-        rc = lg ? shape_from_start(emb, o, bp, L, ext && ext->warm, xyz, &rep)
-                : refine_from_start(emb, o, bp, L, xyz, &rep);
-        if (rc != ES_OK) return rc;
-        rep.t_refine = es__seconds() - t1;
-        es__progress(ctx, "embedding", emb->progress_total, emb->progress_total);
-        emb->progress_total = 0;
     } else if (!(o->continuation_steps > 0 && init_xyz) || o->try_both) {
-        double mx;
-        int mode = o->dihedral_mode;
-        if (emb->nvar == 0 || o->dihedral_max_iter <= 0) mode = ES_EMBED_DIHEDRAL_OFF;
-        rep.closure_stage1 = rep.closure_before;
-        /* one bar on a terminal: stage 1, stages 2-3, each refinement iteration */
-        emb->progress_total = 3 + (o->refine_max_iter > 0 ? o->refine_max_iter : 0);
-        es__progress(ctx, "embedding", 0, emb->progress_total);
-        if (mode != ES_EMBED_DIHEDRAL_OFF) {
-            double lambda1 = 1e-3;
-            int first = mode == ES_EMBED_DIHEDRAL_AUTO ? 1 : o->dihedral_max_iter;
-            memcpy(emb->alpha_keep, alpha, (size_t)ne * sizeof *alpha);
-            t1 = es__seconds();
-            if ((rc = es__stage_dihedrals(emb, o, first, alpha, &rep.closure_stage1,
-                                      &rep.dihedral_iters, &lambda1)) != ES_OK)
-                return rc;
-            rep.used_stage1 = 1;
-            if (mode == ES_EMBED_DIHEDRAL_AUTO) {
-                if (!(rep.closure_stage1 < 0.01 * rep.closure_before)) {
-                    memcpy(alpha, emb->alpha_keep, (size_t)ne * sizeof *alpha);
-                    rep.used_stage1 = 0;
-                } else if (first < o->dihedral_max_iter &&
-                           (rc = es__stage_dihedrals(emb, o, o->dihedral_max_iter - first, alpha,
-                                                 &rep.closure_stage1, &rep.dihedral_iters,
-                                                 &lambda1)) != ES_OK) {
-                    return rc;
-                }
-            }
-            rep.t_dihedral = es__seconds() - t1;
-        }
-        es__progress(ctx, "embedding", 1, emb->progress_total);
-        if ((rc = linear_stages(emb, alpha, L, xyz, &rep)) != ES_OK) return rc;
-        es__progress(ctx, "embedding", 2, emb->progress_total);
-        es__length_fit(emb, xyz, L, &rep.rms_ratio_linear, &mx);
-        t1 = es__seconds();
-        es__refine_opts ro = es__refine_opts_from(o);
-        if (o->refine_max_iter > 0 &&
-            (rc = es__stage_refine(emb, L, xyz, bp, &ro, &rep.refine_iters)) != ES_OK)
-            return rc;
-        rep.t_refine = es__seconds() - t1;
-        es__progress(ctx, "embedding", emb->progress_total, emb->progress_total);
-        emb->progress_total = 0;
+        if ((rc = solve_dihedral_path(emb, o, bp, alpha, L, xyz, &rep)) != ES_OK) return rc;
         have_dihedral_result = 1;
     }
-    /* continuation path */
-    if (o->continuation_steps > 0 && init_xyz && !start) {
-        double *cx = have_dihedral_result ? emb->xyz_best : xyz;
-        int64_t it = 0;
-        t1 = es__seconds();
-        if ((rc = run_continuation(emb, o, L, init_xyz, bp, cx, &it)) != ES_OK) return rc;
-        rep.t_refine += es__seconds() - t1;
-        rep.continuation_steps = o->continuation_steps;
-        if (have_dihedral_result) {
-            double r1, m1, r2, m2;
-            es__length_fit(emb, xyz, L, &r1, &m1);
-            es__length_fit(emb, cx, L, &r2, &m2);
-            if (all_finite(cx, n3) && (m2 < m1 || !all_finite(xyz, n3))) {
-                memcpy(xyz, cx, (size_t)n3 * sizeof *xyz);
-                rep.used_continuation = 1;
-                rep.refine_iters = it;
-            }
-        } else {
-            rep.used_continuation = 1;
-            rep.refine_iters = it;
-        }
-    }
+    if (o->continuation_steps > 0 && init_xyz && !start &&
+        (rc = solve_continuation(emb, o, bp, L, init_xyz, have_dihedral_result, xyz, &rep)) !=
+            ES_OK)
+        return rc;
     if (!all_finite(xyz, n3))
         for (int64_t i = 0; i < n3; i++) xyz[i] = init_xyz ? init_xyz[i] * f : 0.0;
     for (int64_t v = 0; v < nv; v++)
@@ -548,32 +631,7 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
                 for (int i = 0; i < 3; i++) xyz[3 * v + i] = ref[3 * v + i];
     }
 
-    /* report */
-    if ((rc = es_embed_length_error(ctx, emb->mesh, xyz, L, 0, &rep.rms_ratio, &rep.max_rel,
-                                    &rep.p99_rel)) != ES_OK)
-        return rc;
-    edge_lengths_of(emb, xyz, emb->lpath);
-    for (int64_t v = 0; v < nv; v++) emb->verr[v] = 0;
-    {
-        double mx = -1;
-        for (int64_t e = 0; e < ne; e++) {
-            double r = fabs(emb->lpath[e] - L[e]) / L[e];
-            emb->verr[emb->edges[2 * e]] += r;
-            emb->verr[emb->edges[2 * e + 1]] += r;
-            if (r > mx) {
-                mx = r;
-                rep.worst_edge = e;
-            }
-        }
-    }
-    for (int64_t v = 0; v < nv; v++) {
-        int64_t k = emb->off[v + 1] - emb->off[v];
-        if (k) emb->verr[v] /= (double)k;
-    }
-    dihedrals_of(emb, xyz, emb->alpha_try);
-    rep.closure_after = es__closure_eval(emb, emb->alpha_try, 0, emb->vclos);
-    emb->have_vertex_results = 1;
-    rep.realized = rep.max_rel <= o->realized_rtol && rep.n_bad_faces == 0;
+    if ((rc = report_output(emb, o, L, xyz, &rep)) != ES_OK) return rc;
     rep.t_total = es__seconds() - t0;
     if (report) *report = rep;
     return ES_OK;
