@@ -65,6 +65,8 @@ void *es__alloc_array(es_ctx *ctx, int64_t n, size_t size);
 /* The operating system (os.c). Seconds on the monotonic clock, for
  * timing stages and reports. */
 double es__seconds(void);
+/* Processors online (at least 1). */
+int64_t es__cpu_count(void);
 /* Ask the kernel to back the 2 MiB-aligned interior of [p, p + bytes) with
  * transparent huge pages (Linux madvise MADV_HUGEPAGE; elsewhere, or for
  * memory that is not anonymous, nothing happens). Call before the first

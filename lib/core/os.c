@@ -1,11 +1,13 @@
 /* lib/core/os.c — what the library asks of the operating system, asked in
  * one place (SQLite's OS layer is the model): the clock that times stages
- * and reports, and the transparent-huge-page hint for large buffers.
+ * and reports, the processors online, and the transparent-huge-page hint
+ * for large buffers.
  */
 #include "core/core_private.h"
 
 #include <stdint.h>
 #include <time.h>
+#include <unistd.h>
 #ifdef __linux__
 #include <sys/mman.h>
 #endif
@@ -15,6 +17,12 @@ double es__seconds(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+int64_t es__cpu_count(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n > 0 ? (int64_t)n : 1;
 }
 
 void es__advise_huge(void *p, size_t bytes)

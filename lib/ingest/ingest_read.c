@@ -317,8 +317,7 @@ static void *work(void *arg)
 
 static int64_t auto_threads(const es_ingest_opts *o, int64_t n)
 {
-    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-    int64_t t = o->threads > 0 ? o->threads : cpus > 0 ? cpus : 1;
+    int64_t t = o->threads > 0 ? o->threads : es__cpu_count();
     if (t > 16) t = 16;
     if (t > n) t = n;
     return t < 1 ? 1 : t;
