@@ -249,6 +249,26 @@ static void warn_flat_faces(es_ctx *ctx, const char *path, int64_t nfaces, const
                  (long long)faces[3 * first + 2]);
 }
 
+/* A parsed input's lengths (normalized) and positions into slot `slot` of
+ * the batch, with the warnings a mesh may earn; the first input and every
+ * later one go through here. */
+static es_status measure_slot(es_ctx *ctx, const ingest_ref *r, ingest_batch *b, int64_t slot,
+                              const char *path, const double *xyz)
+{
+    double *li = b->len + slot * b->E;
+    es_status rc;
+    if ((rc = es_edge_lengths(ctx, r->mesh, xyz, li)) ||
+        (rc = es_lengths_normalize(ctx, b->E, li, li, &b->scale[slot]))) {
+        char msg[900];
+        snprintf(msg, sizeof msg, "%s", es_ctx_errmsg(ctx));
+        return es__fail(ctx, rc, "'%s': %s", path, msg);
+    }
+    warn_zero_edges(ctx, path, r->mesh, li, b->E);
+    warn_flat_faces(ctx, path, r->F, r->faces, xyz);
+    memcpy(b->xyz + slot * 3 * b->V, xyz, (size_t)(3 * b->V) * sizeof(double));
+    return ES_OK;
+}
+
 /* One input into slot i. */
 static es_status process_one(ingest_worker *w, int64_t i, char **buf, size_t *cap, es_meshdata *md)
 {
@@ -270,20 +290,8 @@ static es_status process_one(ingest_worker *w, int64_t i, char **buf, size_t *ca
         return ES_OK;
     }
     if ((rc = es_meshdata_parse(ctx, path, *buf, len, j->o->format, md))) return rc;
-    if (!(rc = check_topology(ctx, j->r, path, md))) {
-        const int64_t slot = i - j->slot0;
-        double *li = b->len + slot * b->E;
-        if ((rc = es_edge_lengths(ctx, j->r->mesh, md->xyz, li)) ||
-            (rc = es_lengths_normalize(ctx, b->E, li, li, &b->scale[slot]))) {
-            char msg[900];
-            snprintf(msg, sizeof msg, "%s", es_ctx_errmsg(ctx));
-            rc = es__fail(ctx, rc, "'%s': %s", path, msg);
-        } else {
-            warn_zero_edges(ctx, path, j->r->mesh, li, b->E);
-            warn_flat_faces(ctx, path, j->r->F, j->r->faces, md->xyz);
-            memcpy(b->xyz + slot * 3 * b->V, md->xyz, (size_t)(3 * b->V) * sizeof(double));
-        }
-    }
+    if (!(rc = check_topology(ctx, j->r, path, md)))
+        rc = measure_slot(ctx, j->r, b, i - j->slot0, path, md->xyz);
     es_meshdata_clear(ctx, md);
     return rc;
 }
@@ -434,16 +442,7 @@ static es_status ref_from_first(es_ctx *ctx, ingest_session *s, const ingest_inp
                           r->V, E)))
         goto done;
     es_content_hash(buf, len, b->hash[0]);
-    if ((rc = es_edge_lengths(ctx, r->mesh, md.xyz, b->len)) ||
-        (rc = es_lengths_normalize(ctx, b->E, b->len, b->len, &b->scale[0]))) {
-        char msg[900];
-        snprintf(msg, sizeof msg, "%s", es_ctx_errmsg(ctx));
-        rc = es__fail(ctx, rc, "'%s': %s", in[0].path, msg);
-        goto done;
-    }
-    warn_zero_edges(ctx, in[0].path, r->mesh, b->len, b->E);
-    warn_flat_faces(ctx, in[0].path, r->F, r->faces, md.xyz);
-    memcpy(b->xyz, md.xyz, (size_t)(3 * b->V) * sizeof(double));
+    if ((rc = measure_slot(ctx, r, b, 0, in[0].path, md.xyz))) goto done;
     s->first = 1;
 done:
     es__free(ctx, buf);
