@@ -6,6 +6,7 @@
 #ifndef EDGESPACE_BENCH_CLOCK_H
 #define EDGESPACE_BENCH_CLOCK_H
 
+#include <stdlib.h>
 #include <sys/resource.h>
 #include <time.h>
 
@@ -28,6 +29,22 @@ static inline double bench_peak_rss_mib(void)
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
     return (double)ru.ru_maxrss / 1024.0;
+}
+
+static inline int bench_cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Repeated timings sorted in place, and their median (one run of a second
+ * or two swings by 15 % on a shared machine). */
+static inline void bench_sort(double *v, int n) { qsort(v, (size_t)n, sizeof *v, bench_cmp_double); }
+
+static inline double bench_median(double *v, int n)
+{
+    bench_sort(v, n);
+    return v[n / 2];
 }
 
 #endif

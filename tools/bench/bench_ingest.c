@@ -29,12 +29,6 @@
 
 static double tv(struct timeval t) { return (double)t.tv_sec + 1e-6 * (double)t.tv_usec; }
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
 static void die(es_ctx *ctx, es_status rc, const char *what)
 {
     fprintf(stderr, "bench_ingest: %s: %s\n", what, ctx ? es_ctx_errmsg(ctx) : es_strerror(rc));
@@ -124,8 +118,8 @@ int main(int argc, char **argv)
         cpu[k] = tv(ru.ru_utime) + tv(ru.ru_stime);
         if ((double)ru.ru_maxrss > maxrss) maxrss = (double)ru.ru_maxrss;
     }
-    qsort(wall, (size_t)repeat, sizeof *wall, cmp_double);
-    qsort(cpu, (size_t)repeat, sizeof *cpu, cmp_double);
+    bench_sort(wall, repeat);
+    bench_sort(cpu, repeat);
     {
         struct stat st;
         stat(store, &st);

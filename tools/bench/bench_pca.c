@@ -191,12 +191,6 @@ typedef struct timing {
     int neig;
 } timing;
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 /* The fit `reps` times (at most 64): the last one's result, the median wall
  * and CPU time. */
 static es_pca *fit(es_ctx *ctx, const es_source *src, const es_pca_opts *o, int reps, timing *t)
@@ -214,10 +208,8 @@ static es_pca *fit(es_ctx *ctx, const es_source *src, const es_pca_opts *o, int 
         wall[r] = bench_wall_s() - w0;
         cpu[r] = bench_process_cpu_s() - c0;
     }
-    qsort(wall, (size_t)reps, sizeof *wall, cmp_double);
-    qsort(cpu, (size_t)reps, sizeof *cpu, cmp_double);
-    t->wall = wall[reps / 2];
-    t->cpu = cpu[reps / 2];
+    t->wall = bench_median(wall, reps);
+    t->cpu = bench_median(cpu, reps);
     t->neig = p->ncomp < 10 ? (int)p->ncomp : 10;
     for (int k = 0; k < t->neig; k++) t->eig[k] = p->eigenvalues[k];
     return p;
