@@ -12,6 +12,7 @@
  * for the report.
  */
 #include "embed/embed_pkg.h"
+#include "edgespace/es_geom.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -99,39 +100,6 @@ static void edge_lengths_of(const es_embedder *emb, const double *xyz, double *l
         const double *a = xyz + 3 * emb->edges[2 * e], *b = xyz + 3 * emb->edges[2 * e + 1];
         len[e] = sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
                       (a[2] - b[2]) * (a[2] - b[2]));
-    }
-}
-
-/* Signed bending angles (es_geom.h convention) of positions xyz. */
-static void dihedrals_of(const es_embedder *emb, const double *xyz, double *alpha)
-{
-    const int64_t *F = es_mesh_faces(emb->mesh);
-    for (int64_t e = 0; e < emb->ne; e++) {
-        int64_t f = emb->ef[2 * e], g = emb->ef[2 * e + 1];
-        double n[2][3], t[3], c[3], tl;
-        alpha[e] = 0;
-        if (f < 0 || g < 0) continue;
-        for (int s = 0; s < 2; s++) {
-            const int64_t *fc = F + 3 * (s ? g : f);
-            const double *p0 = xyz + 3 * fc[0], *p1 = xyz + 3 * fc[1], *p2 = xyz + 3 * fc[2];
-            double u[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
-            double w[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
-            n[s][0] = u[1] * w[2] - u[2] * w[1];
-            n[s][1] = u[2] * w[0] - u[0] * w[2];
-            n[s][2] = u[0] * w[1] - u[1] * w[0];
-        }
-        for (int i = 0; i < 3; i++)
-            t[i] = xyz[3 * emb->edges[2 * e + 1] + i] - xyz[3 * emb->edges[2 * e] + i];
-        tl = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-        /* atan2 is scale-free in its two arguments: unnormalized normals are
-         * fine as long as both arguments share the factor |n_f||n_g|. */
-        c[0] = n[1][1] * n[0][2] - n[1][2] * n[0][1];
-        c[1] = n[1][2] * n[0][0] - n[1][0] * n[0][2];
-        c[2] = n[1][0] * n[0][1] - n[1][1] * n[0][0];
-        if (tl > 0)
-            alpha[e] = atan2((c[0] * t[0] + c[1] * t[1] + c[2] * t[2]) / tl,
-                             n[1][0] * n[0][0] + n[1][1] * n[0][1] + n[1][2] * n[0][2]);
-        if (!isfinite(alpha[e])) alpha[e] = 0;
     }
 }
 
@@ -545,7 +513,7 @@ static es_status report_output(es_embedder *emb, const es_embed_opts *o, const d
         int64_t k = emb->off[v + 1] - emb->off[v];
         if (k) emb->verr[v] /= (double)k;
     }
-    dihedrals_of(emb, xyz, emb->alpha_try);
+    if ((rc = es_dihedral_angles(emb->ctx, emb->mesh, xyz, emb->alpha_try)) != ES_OK) return rc;
     rep->closure_after = es__closure_eval(emb, emb->alpha_try, 0, emb->vclos);
     emb->have_vertex_results = 1;
     rep->realized = rep->max_rel <= o->realized_rtol && rep->n_bad_faces == 0;
@@ -595,7 +563,8 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
     if (init_alpha) {
         for (int64_t e = 0; e < ne; e++) alpha[e] = emb->eb[e] ? 0.0 : init_alpha[e];
     } else {
-        dihedrals_of(emb, init_xyz ? init_xyz : start, alpha);
+        if ((rc = es_dihedral_angles(ctx, emb->mesh, init_xyz ? init_xyz : start, alpha)) != ES_OK)
+            return rc;
     }
     rep.closure_before = es__closure_eval(emb, alpha, 0, NULL);
     emb->have_vertex_results = 0;
