@@ -3,6 +3,7 @@
  * their attributes listed, and deleted (store_results.c writes and reads
  * them). */
 #include "store/store_pkg.h"
+#include "store/store_private.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -53,8 +54,7 @@ static es_status list_impl(es_ctx *ctx, es_store *s, const char *kind, char ***n
     char full[600];
     name_list l = {ctx, NULL, 0, 0, ES_OK};
     hid_t g;
-    if (kind && *kind && es__h5_bad_name(kind))
-        ES_FAIL(ctx, ES_EINVAL, "store: bad result kind '%s'", kind);
+    if (kind && *kind && es__result_name_check(ctx, NULL, kind) != ES_OK) return ES_EINVAL;
     snprintf(full, sizeof full, "/analysis%s%s", kind && *kind ? "/" : "", kind ? kind : "");
     {
         bool e;
@@ -161,10 +161,7 @@ static es_status delete_impl(es_ctx *ctx, es_store *s, const char *kind, const c
 {
     char full[600], group[300];
     es_status rc;
-    if (es__h5_bad_name(kind) || es__h5_bad_name(name) || strlen(kind) > 120 ||
-        strlen(name) > 120)
-        ES_FAIL(ctx, ES_EINVAL, "store: bad result kind/name '%s/%s'", kind ? kind : "",
-                name ? name : "");
+    if ((rc = es__result_name_check(ctx, kind, name)) != ES_OK) return rc;
     snprintf(group, sizeof group, "/analysis/%s", kind);
     snprintf(full, sizeof full, "%s/%s", group, name);
     bool e;

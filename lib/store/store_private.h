@@ -47,4 +47,10 @@ es_status es__store_ranks_write(es_ctx *ctx, es__store_ranks *h, int64_t row0, i
  * handle on its working copy again. The status agreed by all. */
 es_status es__store_ranks_close(es_ctx *ctx, es_store *s, es__store_ranks *h);
 
+/* ES_OK if kind (NULL: not checked) and name may name a result: not empty,
+ * ".", "..", no '/' or control character, at most 120 bytes
+ * (store_names.c); else ES_EINVAL saying which rule it breaks. The one rule
+ * for every writer and reader of results. */
+es_status es__result_name_check(es_ctx *ctx, const char *kind, const char *name);
+
 #endif

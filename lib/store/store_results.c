@@ -12,6 +12,7 @@
  * copy (store_publish.c); a failed write marks the handle broken.
  */
 #include "store/store_pkg.h"
+#include "store/store_private.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -131,11 +132,9 @@ static es_status check_free(es_ctx *ctx, es_store *s, const char *kind, const ch
                             bool *exists)
 {
     char full[600];
-    if (es__h5_bad_name(kind) || es__h5_bad_name(name) || strlen(kind) > 120 || strlen(name) > 120)
-        ES_FAIL(ctx, ES_EINVAL, "store: bad result kind/name '%s/%s'", kind ? kind : "",
-                name ? name : "");
-    snprintf(full, sizeof full, "/analysis/%s/%s", kind, name);
     es_status rc;
+    if ((rc = es__result_name_check(ctx, kind, name)) != ES_OK) return rc;
+    snprintf(full, sizeof full, "/analysis/%s/%s", kind, name);
     hid_t f;
     const char *fp;
     if ((rc = es__result_locate(ctx, s, full + 10, ES__RESULT_READ, &f, &fp)) ||

@@ -13,6 +13,7 @@
 #include "edgespace/es_io.h"
 #include "edgespace/es_procrustes.h"
 #include "core/core_private.h"
+#include "store/store_private.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -44,20 +45,10 @@ es_status es_study_source(es_ctx *ctx, es_store *store, const int64_t *rows, int
     return ES_OK;
 }
 
-static int bad_name(const char *name)
-{
-    if (!name || !*name || !strcmp(name, ".") || !strcmp(name, "..")) return 1;
-    for (const char *c = name; *c; c++)
-        if (*c == '/' || (unsigned char)*c < 32) return 1;
-    return 0;
-}
-
 /* A bad name, or one taken (not replaced without ES_STORE_REPLACE), is
  * refused before anything is computed. */
 #define CHECK_NAME(ctx, store, kind, name) do { \
         es_status rc_; \
-        if ((name) && bad_name(name)) \
-            ES_FAIL(ctx, ES_EINVAL, "analysis: bad result name '%s' (no '/', not empty)", name); \
         if ((name) && (rc_ = es_store_result_check(ctx, store, kind, name)) != ES_OK) \
             return rc_; \
     } while (0)
@@ -570,7 +561,7 @@ static es_status resolve_diff(es_ctx *ctx, es_study_resolver *r, const char *arg
     double *v = NULL;
     int64_t n = 0, *from = NULL, *to = NULL, nf = 0, nt = 0;
     es_status rc;
-    if (bad_name(arg)) ES_FAIL(ctx, ES_EINVAL, "bad difference name");
+    if ((rc = es__result_name_check(ctx, NULL, arg)) != ES_OK) return rc;
     if ((rc = es__result_path(ctx, p, PATH_MAX_LEN, "diff", arg, "mean")) != ES_OK) return rc;
     if (!es_store_has(r->store, p)) {
         char hint[400];

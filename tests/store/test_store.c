@@ -415,6 +415,23 @@ static void test_replace_and_hints(es_ctx *ctx, const char *dir)
     ES_CHECK_OK(ctx, es_store_result_check(ctx, s, "mean", "other"));
     ES_CHECK_OK(ctx, es_store_result_check(ctx, s, "pca", "m"));
     ES_CHECK_FAILS(ctx, es_store_result_check(ctx, s, "mean", "a/b"), ES_EINVAL, "bad result");
+    /* the one rule of result names (store_names.c), also the analyses' */
+    {
+        char long_name[122];
+        memset(long_name, 'n', 121);
+        long_name[121] = '\0';
+        ES_CHECK_FAILS(ctx, es_store_result_check(ctx, s, "mean", ""), ES_EINVAL,
+                       "bad result name '' (empty)");
+        ES_CHECK_FAILS(ctx, es_store_result_check(ctx, s, "mean", ".."), ES_EINVAL,
+                       "'.' and '..' name folders");
+        ES_CHECK_FAILS(ctx, es_store_result_check(ctx, s, "mean", "a\nb"), ES_EINVAL,
+                       "no control characters");
+        ES_CHECK_FAILS(ctx, es_store_result_check(ctx, s, "mean", long_name), ES_EINVAL,
+                       "longer than 120 bytes");
+        ES_CHECK_OK(ctx, es_store_result_check(ctx, s, "mean", long_name + 1));
+        ES_CHECK_FAILS(ctx, es_store_result_check(ctx, s, "me/an", "x"), ES_EINVAL,
+                       "bad result kind 'me/an' (no '/')");
+    }
     es_store_close(s);   /* nothing was written: nothing to commit */
     s = NULL;
     ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_READ, &s));
