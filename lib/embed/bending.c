@@ -243,3 +243,34 @@ void es__bend_weights(const es_embedder *emb, const double *L, const double *sd,
     }
     es__free(emb->ctx, t);
 }
+
+/* ---- the weight schedule ------------------------------------------------------ */
+
+void es__bend_schedule(es__bend_prior *bp, double first, double decay, double last,
+                       const es_embed_opts *o)
+{
+    bp->mu = first;
+    bp->decay = decay;
+    bp->mu_min = last;
+    bp->mu_exact = 4e-4 * o->prior_mu;
+    bp->mu_realize = o->realize_bend * o->prior_mu;
+}
+
+int es__bend_annealing(const es__bend_prior *bp)
+{
+    return bp->decay > 0 && bp->decay < 1 && bp->mu > bp->mu_min;
+}
+
+int es__bend_anneal(es__bend_prior *bp)
+{
+    bp->mu = fmax(bp->mu * bp->decay, bp->mu_min);
+    return bp->mu > bp->mu_min;
+}
+
+es__bend_prior es__bend_held(const es__bend_prior *bp, double mu)
+{
+    es__bend_prior h = *bp;
+    h.mu = h.mu_min = mu;
+    h.decay = 1;
+    return h;
+}

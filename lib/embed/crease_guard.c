@@ -49,11 +49,13 @@
 
 /* The guard over the band [lo, hi] in emb->band_lo / band_hi, weighted by
  * the discrete-shells weights of the target lengths len. */
-static void guard_from_band(es_embedder *emb, const double *len, double mu, es__bend_prior *guard)
+static void guard_from_band(es_embedder *emb, const double *len, const es_embed_opts *o,
+                            es__bend_prior *guard)
 {
     es__bend_weights(emb, len, NULL, 0, emb->omega);
     *guard = (es__bend_prior){.alpha = emb->band_lo, .hi = emb->band_hi, .omega = emb->omega,
-                              .flap = emb->flap, .mu = mu, .decay = 1, .mu_min = mu};
+                              .flap = emb->flap};
+    es__bend_schedule(guard, o->crease_mu, 1, o->crease_mu, o);
 }
 
 /* The band: [min(lo, alpha) - margin, max(hi, alpha) + margin] (the
@@ -70,8 +72,9 @@ static void band(es_embedder *emb, const double *alpha, const double *lo, const 
 
 es_status es__crease_guard_inputs(es_embedder *emb, int64_t nin, const double *const *xyz,
                                   const double *w, const double *alpha, const double *len,
-                                  double margin, double mu, es__bend_prior *guard)
+                                  const es_embed_opts *o, es__bend_prior *guard)
 {
+    const double margin = o->crease_margin;
     int64_t ne = emb->ne;
     double *lo, *hi, *a = emb->alpha_try;
     es_status rc;
@@ -88,14 +91,15 @@ es_status es__crease_guard_inputs(es_embedder *emb, int64_t nin, const double *c
         }
     }
     band(emb, alpha, lo, hi, margin);
-    guard_from_band(emb, len, mu, guard);
+    guard_from_band(emb, len, o, guard);
     return ES_OK;
 }
 
 es_status es__crease_guard_prior(es_embedder *emb, const double *alpha, const double *span_lo,
                                  const double *span_hi, const double *sd, const double *len,
-                                 double margin, double mu, es__bend_prior *guard)
+                                 const es_embed_opts *o, es__bend_prior *guard)
 {
+    const double margin = o->crease_margin;
     es_status rc;
     if ((rc = es__bend_work(emb)) != ES_OK) return rc;
     if (span_lo && span_hi) {
@@ -111,6 +115,6 @@ es_status es__crease_guard_prior(es_embedder *emb, const double *alpha, const do
             emb->band_hi[e] = alpha[e] + h;
         }
     }
-    guard_from_band(emb, len, mu, guard);
+    guard_from_band(emb, len, o, guard);
     return ES_OK;
 }

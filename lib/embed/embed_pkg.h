@@ -208,10 +208,27 @@ typedef struct es__bend_prior {
                               es_interp_embed) */
     const double *omega;   /* E: per-edge weights >= 0 (0: not in the term) */
     const int64_t *flap;   /* 6E (embedder's flap) */
+    /* The weight schedule, set once by es__bend_schedule and stepped only
+     * by the functions below it (bending.c): */
     double mu;             /* weight of the term now */
     double decay;          /* mu factor per LM iteration (1: constant) ... */
     double mu_min;         /* ... down to this weight, where it holds */
+    double mu_exact;       /* held while an exactly realizable target finishes */
+    double mu_realize;     /* held in the polish of a target no mesh has */
 } es__bend_prior;
+
+/* The schedule of bp's weight, in one place: first, times decay per
+ * iteration of a refinement, down to last; the two held weights from the
+ * options (4e-4 x and realize_bend x prior_mu: solve.c says why). */
+void es__bend_schedule(es__bend_prior *bp, double first, double decay, double last,
+                       const es_embed_opts *o);
+/* Whether bp's weight still decays (a refinement then re-evaluates its
+ * cost every iteration). */
+int es__bend_annealing(const es__bend_prior *bp);
+/* One decay step of bp's weight; returns es__bend_annealing afterwards. */
+int es__bend_anneal(es__bend_prior *bp);
+/* A copy of bp whose weight is held at mu. */
+es__bend_prior es__bend_held(const es__bend_prior *bp, double mu);
 
 /* Signed bending angle (es_geom.h convention) of edge (a, b), c the third
  * vertex of the face holding a->b and d that of the face holding b->a, and
@@ -229,8 +246,9 @@ es_status es__bend_flaps(es_embedder *emb);
  * emb->omega, prior_alpha, band_lo and band_hi. */
 es_status es__bend_work(es_embedder *emb);
 
-/* The crease guard (crease_guard.c): a band term of weight mu over the
- * band of each interior edge, widened by margin on both sides, in
+/* The crease guard (crease_guard.c): a band term of weight o->crease_mu
+ * over the band of each interior edge, widened by o->crease_margin on both
+ * sides, in
  * emb->band_lo / band_hi, with emb->omega from the target lengths len.
  * From the inputs: the span of the bending angles of the inputs with a
  * weight (not 0) and of the interpolated angles alpha. From a prior: the
@@ -238,10 +256,10 @@ es_status es__bend_work(es_embedder *emb);
  * (the rows' spread). */
 es_status es__crease_guard_inputs(es_embedder *emb, int64_t nin, const double *const *xyz,
                                   const double *w, const double *alpha, const double *len,
-                                  double margin, double mu, es__bend_prior *guard);
+                                  const es_embed_opts *o, es__bend_prior *guard);
 es_status es__crease_guard_prior(es_embedder *emb, const double *alpha, const double *span_lo,
                                  const double *span_hi, const double *sd, const double *len,
-                                 double margin, double mu, es__bend_prior *guard);
+                                 const es_embed_opts *o, es__bend_prior *guard);
 /* omega (E): the discrete-shells weight 3 l_e^2 / (A_f + A_g) from lengths L
  * normalized to mean 1, divided by 1 + (sd_e / s0)^2 when sd is given, s0 =
  * sd_floor x the median sd over interior edges. */

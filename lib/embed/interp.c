@@ -131,8 +131,7 @@ es_status es_interp_embed(es_ctx *ctx, es_embedder *emb, int64_t nin, const doub
     const double *ref = align_to ? align_to : xyz[inf.reference];
     if (opts->crease_mu > 0 && opts->crease_margin >= 0) {
         es__bend_prior guard;
-        if ((rc = es__crease_guard_inputs(emb, nin, xyz, w, alpha, len, opts->crease_margin,
-                                          opts->crease_mu, &guard)) != ES_OK) {
+        if ((rc = es__crease_guard_inputs(emb, nin, xyz, w, alpha, len, opts, &guard)) != ES_OK) {
             rc = es__fail(ctx, rc, "%s", es_ctx_errmsg(emb->ctx));
             goto done;
         }

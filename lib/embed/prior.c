@@ -308,9 +308,9 @@ es_status es_embed_prior_solve(es_ctx *ctx, es_embedder *emb, const double *targ
     for (int64_t e = 0; e < emb->ne; e++) emb->ltarget[e] = target[e] * f;
     es__bend_weights(emb, emb->ltarget, prior->sd, opts->prior_sd_floor, emb->omega);
     bend = bends(emb, opts);
-    bp = (es__bend_prior){.alpha = emb->prior_alpha, .omega = emb->omega, .flap = emb->flap,
-                          .mu = opts->prior_mu, .decay = opts->prior_decay,
-                          .mu_min = opts->prior_mu * opts->prior_mu_floor};
+    bp = (es__bend_prior){.alpha = emb->prior_alpha, .omega = emb->omega, .flap = emb->flap};
+    es__bend_schedule(&bp, opts->prior_mu, opts->prior_decay, opts->prior_mu * opts->prior_mu_floor,
+                      opts);
     memset(&ext, 0, sizeof ext);
     ext.bp = bend ? &bp : NULL;
     /* a closed mesh without the term: interpolation, whose refinement
@@ -319,8 +319,7 @@ es_status es_embed_prior_solve(es_ctx *ctx, es_embedder *emb, const double *targ
     if (!bend && ((prior->span_lo && prior->span_hi) || prior->sd) && opts->crease_mu > 0 &&
         opts->crease_margin >= 0) {
         if ((rc = es__crease_guard_prior(emb, emb->prior_alpha, prior->span_lo, prior->span_hi,
-                                         prior->sd, emb->ltarget, opts->crease_margin,
-                                         opts->crease_mu, &bp)) != ES_OK)
+                                         prior->sd, emb->ltarget, opts, &bp)) != ES_OK)
             return es__fail(ctx, rc, "%s", es_ctx_errmsg(emb->ctx));
         ext.bp = &bp;
     }

@@ -244,9 +244,7 @@ static es_status refine_from_start(es_embedder *emb, const es_embed_opts *o, es_
      * at worst 0.205 % -> 0.194 % of the bbox diagonal; with no term at
      * all 0.178 % on faces that were at 0.11 %) */
     if (bp && o->prior_exact && o->refine_max_iter > 0) {
-        es__bend_prior hold = *bp;
-        hold.mu = hold.mu_min = 4e-4 * o->prior_mu;
-        hold.decay = 1;
+        es__bend_prior hold = es__bend_held(bp, bp->mu_exact);
         /* the lengths decide: no accuracy stop short of where they stop falling */
         ro.max_iter = 3 * o->refine_max_iter;
         ro.rms_tol = ro.max_tol = 0;
@@ -328,11 +326,7 @@ static es_status shape_from_start(es_embedder *emb, const es_embed_opts *o, es__
          * its worst edge from 7 % to 1.01 %) */
         ro.max_iter = o->lg_polish < o->refine_max_iter ? o->lg_polish : o->refine_max_iter;
         ro.rms_tol = lo.rms_tol, ro.max_tol = lo.max_tol;
-        if (bp) {
-            hold = *bp;
-            hold.mu = inconsistent ? o->realize_bend * o->prior_mu : hold.mu_min;
-            hold.decay = 1;
-        }
+        if (bp) hold = es__bend_held(bp, inconsistent ? bp->mu_realize : bp->mu_min);
         if ((rc = es__stage_refine(emb, Lr, xyz, bp ? &hold : NULL, &ro, &rep->refine_iters)) != ES_OK)
             return rc;
     }

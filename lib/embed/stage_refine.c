@@ -163,7 +163,7 @@ es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz, es__b
     /* mu decays within the run (bp->decay < 1) down to bp->mu_min: while it
      * does, the cost changes from one iteration to the next, so it is
      * evaluated afresh and the relative stopping rule waits */
-    int annealing = bp && bp->decay > 0 && bp->decay < 1 && bp->mu > bp->mu_min;
+    int annealing = bp && es__bend_annealing(bp);
     if (bp && !(bp->mu > 0)) bp = NULL;
     emb->cg_lag_ok = 1;   /* learnt afresh in every refinement */
     cur = evaluate(emb, xyz, L, bp);
@@ -173,8 +173,7 @@ es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz, es__b
         int accepted = 0, st, used = -1;
         if (accuracy && cur.rms <= ro->rms_tol && cur.max <= ro->max_tol) break;
         if (bp && annealing && it > 0) {
-            bp->mu = fmax(bp->mu * bp->decay, bp->mu_min);
-            annealing = bp->mu > bp->mu_min;
+            annealing = es__bend_anneal(bp);
             cur = evaluate(emb, xyz, L, bp);
             c_prev = 0;
             if (!annealing) it_hold = it;   /* the stopping rule counts from here */
