@@ -321,17 +321,19 @@ int es_store_pending(const es_store *store)
     return store && (store->work || es__beside_pending(store));
 }
 
-void es_store_close(es_store *store)
+es_status es_store_close(es_store *store)
 {
-    if (!store) return;
+    es_status rc = ES_OK;
+    if (!store) return ES_OK;
     H5E_BEGIN_TRY {
         if ((store->work || es__beside_pending(store)) && !store->broken) {
-            es_status rc = es__store_publish(store->ctx, store);
+            rc = es__store_publish(store->ctx, store);
             if (rc != ES_OK)
                 es__warn(store->ctx, "%s", es_ctx_errmsg(store->ctx));
         }
         release(store, false);
     } H5E_END_TRY
+    return rc;
 }
 
 uint64_t es_store_generation(const es_store *s) { return s ? s->generation : 0; }

@@ -14,6 +14,7 @@
 #include <errno.h>
 #include <signal.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 
 /* A tetrahedron: 4 vertices, 4 faces, 6 edges sorted (min, max). */
@@ -518,6 +519,22 @@ int main(void)
     s = NULL;
     ES_CHECK_FAILS(ctx, es__store_create_raw(ctx, path, V, F, faces, E, edges, "", &s),
                    ES_EEXIST, "exists");
+    /* es_store_close returns its commit's status: a new store whose path
+     * was taken meanwhile (here by a folder) is refused at the close, and
+     * the folder left as it was */
+    snprintf(other, sizeof other, "%s/taken.h5", dir);
+    ES_CHECK_OK(ctx, es__store_create_raw(ctx, other, V, F, faces, E, edges, "", &s));
+    ES_CHECK_OK(ctx, es_store_append(ctx, s, &r1));
+    ES_CHECK(mkdir(other, 0755) == 0);
+    ES_CHECK(es_store_close(s) != ES_OK);
+    ES_CHECK(strstr(es_ctx_errmsg(ctx), "taken.h5") != NULL);
+    {
+        struct stat st;
+        ES_CHECK(stat(other, &st) == 0 && S_ISDIR(st.st_mode));
+    }
+    ES_CHECK(rmdir(other) == 0);
+    ES_CHECK(es_store_close(NULL) == ES_OK);
+    s = NULL;
 
     /* ---- reopen and read back ---- */
     ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_READ, &s));
