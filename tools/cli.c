@@ -7,7 +7,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
 /* A progress stream ("interp: frames", "embedding"): when it started, when
@@ -32,13 +31,6 @@ static void on_log(void *ud, es_log_level level, const char *msg)
     cli_state *st = ud;
     fprintf(stderr, "edgespace %s: %s%s\n", st->verb,
             level == ES_LOG_WARNING ? "warning: " : "", msg);
-}
-
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 /* The stream of this name, made (or the oldest reused) when done is 0. */
@@ -84,7 +76,7 @@ static void log_progress(cli_state *st, const char *what, int64_t done, int64_t 
 static void on_progress(void *ud, const char *what, int64_t done, int64_t total)
 {
     cli_state *st = ud;
-    double t = now_seconds();
+    double t = es_clock_seconds();
     if (!st->tty) {
         log_progress(st, what, done, total, t);
         return;

@@ -19,6 +19,8 @@ double es__seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+double es_clock_seconds(void) { return es__seconds(); }
+
 int64_t es__cpu_count(void)
 {
     long n = sysconf(_SC_NPROCESSORS_ONLN);

@@ -15,18 +15,12 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
 
 #ifndef NB_SHARED_DIR
 #define NB_SHARED_DIR ""
 #endif
 
-double nb_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+double nb_now(void) { return es_clock_seconds(); }
 
 double nb_worst(const double *v, int64_t n)
 {

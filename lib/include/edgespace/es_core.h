@@ -74,6 +74,11 @@ ES_API const char *es_version(void);
 /* Static one-line description of a status code. */
 ES_API const char *es_strerror(es_status code);
 
+/* Seconds on the monotonic clock the library times its stages and reports
+ * with (an arbitrary origin: only differences mean anything), for callers
+ * that time the library's work beside its reports. */
+ES_API double es_clock_seconds(void);
+
 /* Create a context: error message buffer, log and progress hooks, allocator,
  * RNG seed (default 0x5eed). Returns ES_ENOMEM if it cannot be allocated. */
 ES_API es_status es_ctx_new(es_ctx **out);
