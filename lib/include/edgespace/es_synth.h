@@ -89,19 +89,6 @@ ES_API es_status es_synth_subdivide(es_ctx *ctx, es_synth_set *set, int levels);
  * existing files are overwritten. ES_EIO names the path on failure. */
 ES_API es_status es_synth_write(es_ctx *ctx, const es_synth_set *set, const char *dir);
 
-/* 1-to-4 midpoint subdivision. The input must be an oriented manifold
- * (es_mesh_new's checks, ES_ETOPOLOGY otherwise). Output vertices: the V
- * old ones, then one per edge in edge-id order (edges sorted by (min, max),
- * es_mesh.h): vertex V + e is the midpoint of edge e. Face f = (a, b, c)
- * becomes faces 4f .. 4f+3: (a, m_ab, m_ca), (m_ab, b, m_bc),
- * (m_ca, m_bc, c), (m_ab, m_bc, m_ca).
- * xyz: 3 x nverts x nshapes (nshapes >= 0; NULL when 0); *xyz_out gets
- * 3 x (V + E) x nshapes (NULL when nshapes is 0). *faces_out: 3 x 4F.
- * Outputs are allocated through ctx; release them with es_free. */
-ES_API es_status es_mesh_subdivide(es_ctx *ctx, int64_t nverts, int64_t nfaces,
-                                   const int64_t *faces, int64_t nshapes, const double *xyz,
-                                   int64_t *nverts_out, int64_t **faces_out,
-                                   double **xyz_out);
 
 #ifdef __cplusplus
 }
