@@ -1,5 +1,5 @@
-/* lib/embed/spd.c — sparse symmetric positive definite systems on CHOLMOD
- * for the modules above lib/embed (embed_private.h): Winkler et al.'s
+/* lib/sparse/spd.c — sparse symmetric positive definite systems on CHOLMOD
+ * for the modules above (sparse_private.h): Winkler et al.'s
  * blending matrices, one per patch of the hierarchy and factorized once
  * per topology, and the cotangent Laplacians of the conformal map's Newton
  * iterations, refactorized on a fixed pattern.
@@ -9,7 +9,7 @@
  * slot, so a refactorization only scatters new values. All matrices of a
  * set share one cholmod_common and its solve workspaces.
  */
-#include "embed/embed_private.h"
+#include "sparse/sparse_private.h"
 
 #include <cholmod.h>
 #include <stdlib.h>

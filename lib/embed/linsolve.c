@@ -1,4 +1,4 @@
-/* lib/embed/sparse.c — the sparse linear algebra of the embedding, on
+/* lib/embed/linsolve.c — the sparse linear algebra of the embedding, on
  * CHOLMOD: status translation, numeric factorization, solves, and the
  * lagged-factor conjugate gradients that the two Levenberg-Marquardt
  * stages (Marquardt 1963) use between factorizations.
