@@ -94,6 +94,7 @@ int64_t *es__sparse_mat_colptr(es__sparse_mat *A) { return S(A)->p; }
 int64_t *es__sparse_mat_rowind(es__sparse_mat *A) { return S(A)->i; }
 double *es__sparse_mat_values(es__sparse_mat *A) { return S(A)->x; }
 int64_t es__sparse_mat_nzmax(const es__sparse_mat *A) { return (int64_t)S(A)->nzmax; }
+int64_t es__sparse_mat_n(const es__sparse_mat *A) { return (int64_t)S(A)->ncol; }
 
 /* Each stored entry (i, j) counts for (j, i) too, so either triangle
  * gives the whole product. */

@@ -74,6 +74,7 @@ int64_t *es__sparse_mat_colptr(es__sparse_mat *A);
 int64_t *es__sparse_mat_rowind(es__sparse_mat *A);
 double *es__sparse_mat_values(es__sparse_mat *A);
 int64_t es__sparse_mat_nzmax(const es__sparse_mat *A);
+int64_t es__sparse_mat_n(const es__sparse_mat *A);
 
 /* y = A x for the symmetric A held in one triangle. */
 void es__sparse_sym_matvec(const es__sparse_mat *A, const double *x, double *y);
