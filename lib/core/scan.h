@@ -46,7 +46,7 @@ typedef enum es__scan_result {
     ES__SCAN_UNTERMINATED,   /* a '"' with no closing '"' */
     ES__SCAN_EMPTY,          /* "" */
     ES__SCAN_MALFORMED,      /* a number that is not one ("." alone, "1e") */
-    ES__SCAN_TOO_LONG        /* a number of at least max_len bytes */
+    ES__SCAN_TOO_LONG        /* a number longer than its limit */
 } es__scan_result;
 
 void es__scan_init(es__scan *sc, es_ctx *ctx, const char *s, const char *lang,
@@ -90,7 +90,8 @@ es__scan_result es__scan_word(es__scan *sc, int (*ok)(char), const char **w, siz
  * least one digit). Its value in *v (es__parse_double: exactly strtod's,
  * inf past the range), its length in *len, the cursor past it.
  * ES__SCAN_NONE when no digit or '.' is at the cursor; ES__SCAN_TOO_LONG
- * for max_len bytes or more (0: no limit), before it is converted. */
+ * for max_len bytes or more (0: no limit), before it is converted, and
+ * past the 512 bytes the exact parser reads. */
 es__scan_result es__scan_number(es__scan *sc, size_t max_len, double *v, size_t *len);
 
 /* isalnum() (letters and digits in the C locale) or '_'. */
