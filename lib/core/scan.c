@@ -84,6 +84,15 @@ es_status es__scan_fail_code(const es__scan *sc, es_status code, size_t at, cons
     return rc;
 }
 
+es_status es__scan_expect_close(es__scan *sc, char open, char close, size_t open_at)
+{
+    char b[8];
+    es__scan_skip_space(sc);
+    if (es__scan_accept(sc, close)) return ES_OK;
+    return es__scan_fail(sc, sc->pos, "expected '%c' to close the '%c' at column %zu, found %s",
+                         close, open, open_at + 1, es__scan_describe(sc, b, sizeof b));
+}
+
 size_t es__scan_span(es__scan *sc, int (*ok)(char))
 {
     size_t at = sc->pos;

@@ -63,6 +63,11 @@ void es__scan_skip_space(es__scan *sc);
 bool es__scan_accept(es__scan *sc, char c);
 bool es__scan_accept_lit(es__scan *sc, const char *lit);
 
+/* After space, the `close` that ends what the `open` at column open_at + 1
+ * began: consumed, or "expected ')' to close the '(' at column 3, found
+ * ','" (ES_EFORMAT). */
+es_status es__scan_expect_close(es__scan *sc, char open, char close, size_t open_at);
+
 /* The next byte for a message: "'c'" in buf, or sc->end_name at the end. */
 const char *es__scan_describe(const es__scan *sc, char *buf, size_t n);
 

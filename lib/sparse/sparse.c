@@ -9,9 +9,8 @@
  * allocates nothing and every call reaches CHOLMOD as it did when the
  * embedder called it directly.
  */
-#include "sparse/sparse_private.h"
+#include "sparse/sparse_pkg.h"
 
-#include <cholmod.h>
 #include <string.h>
 #ifdef _OPENMP
 #include <omp.h>
@@ -34,10 +33,8 @@ es_status es__sparse_new(es_ctx *ctx, const es__sparse_opts *o, es__sparse **out
     *out = NULL;
     if (!ws) return ES_ENOMEM;
     ws->ctx = ctx;
-    cholmod_l_start(&ws->cm);
+    es__sparse_start(&ws->cm);
     ws->started = 1;
-    ws->cm.print = 0;
-    ws->cm.error_handler = NULL;
     if (o && o->relax)
         for (int k = 0; k < 3; k++) {
             ws->cm.nrelax[k] = (size_t)o->nrelax[k];

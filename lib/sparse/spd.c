@@ -9,9 +9,8 @@
  * slot, so a refactorization only scatters new values. All matrices of a
  * set share one cholmod_common and its solve workspaces.
  */
-#include "sparse/sparse_private.h"
+#include "sparse/sparse_pkg.h"
 
-#include <cholmod.h>
 #include <stdlib.h>
 
 typedef struct spd_mat {
@@ -45,10 +44,8 @@ es_status es__spd_new(es_ctx *ctx, es__spd **out)
     *out = NULL;
     if (!s) return ES_ENOMEM;
     s->ctx = ctx;
-    cholmod_l_start(&s->cm);
+    es__sparse_start(&s->cm);
     s->started = 1;
-    s->cm.print = 0;
-    s->cm.error_handler = NULL;
     /* LL' also for the simplicial factors CHOLMOD picks for small matrices
      * (its default there is LDL', which factorizes indefinite matrices
      * without complaint) */

@@ -190,14 +190,9 @@ static es_status parse_atom(fparser *p, tset *out)
     if (++p->depth > 100) return ferr(p, at, "formula nested too deeply");
     if (p->sc.s[at] == '(') {
         p->sc.pos++;
-        if ((rc = parse_sum(p, out)) != ES_OK) return rc;
-        ws(p);
-        if (p->sc.s[p->sc.pos] != ')') {
-            char b[8];
-            return ferr(p, p->sc.pos, "expected ')' to close the '(' at column %zu, found %s",
-                        at + 1, what(p, b, sizeof b));
-        }
-        p->sc.pos++;
+        if ((rc = parse_sum(p, out)) != ES_OK ||
+            (rc = es__scan_expect_close(&p->sc, '(', ')', at)) != ES_OK)
+            return rc;
         p->depth--;
         return ES_OK;
     }

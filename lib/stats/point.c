@@ -279,14 +279,7 @@ static es_status parse_primary(parser *p, form *f)
         p->sc.pos++;
         es_status rc = parse_sum(p, f);
         if (rc != ES_OK) return rc;
-        skip_ws(p);
-        if (p->sc.s[p->sc.pos] != ')') {
-            char b[8];
-            return perr(p, p->sc.pos, "expected ')' to close the '(' at column %zu, found %s",
-                        at + 1, describe(p, b, sizeof b));
-        }
-        p->sc.pos++;
-        return ES_OK;
+        return es__scan_expect_close(&p->sc, '(', ')', at);
     }
     if (!isalpha((unsigned char)c)) {
         char b[8];

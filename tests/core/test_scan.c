@@ -4,7 +4,8 @@
  * under each whitespace rule, against the tokens, their columns and the
  * errors written out by hand; numbers against strtod bit for bit (the
  * oracle), also on random tokens of the number grammar; the limits of a
- * number; the next token described; the messages with their column.
+ * number; the next token described; closing brackets; the messages with
+ * their column.
  */
 #include "core/scan.h"
 #include "es_test.h"
@@ -154,6 +155,18 @@ static void test_messages(es_ctx *ctx)
     ES_CHECK(!strcmp(es_ctx_errmsg(ctx), "formula: column 4: unexpected '%'"));
     ES_CHECK_FAILS(ctx, es__scan_fail_code(&sc, ES_ENOTFOUND, 0, "no such label column"),
                    ES_ENOTFOUND, "formula: column 1: no such label column");
+    /* a closing bracket after space, or the message naming both places */
+    es__scan_init(&sc, ctx, "(a  ) (b,", "point", "the end of the expression",
+                  ES__SCAN_SPACE_BLANKS);
+    sc.pos = 2;
+    ES_CHECK(es__scan_expect_close(&sc, '(', ')', 0) == ES_OK && sc.pos == 5);
+    sc.pos = 8;
+    ES_CHECK_FAILS(ctx, es__scan_expect_close(&sc, '(', ')', 6), ES_EFORMAT,
+                   "point: column 9: expected ')' to close the '(' at column 7, found ','");
+    sc.pos = 9;
+    ES_CHECK_FAILS(ctx, es__scan_expect_close(&sc, '[', ']', 6), ES_EFORMAT,
+                   "column 10: expected ']' to close the '[' at column 7, found the end of the "
+                   "expression");
     /* a failed scan leaves the cursor; empty quotes move past them */
     es__scan_init(&sc, ctx, "\"abc", "point", "the end", ES__SCAN_SPACE_BLANKS);
     const char *w = NULL;
