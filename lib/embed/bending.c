@@ -100,7 +100,7 @@ double es__bend_cost(const es_embedder *emb, const es__bend_prior *bp, const dou
 
 void es__bend_assemble(es_embedder *emb, const double *xyz, const es__bend_prior *bp, double *g)
 {
-    double *x = emb->H3->x;
+    double *x = es__sparse_mat_values(emb->H3);
     for (int64_t e = 0; e < emb->ne; e++) {
         const int64_t *fl = bp->flap + 6 * e;
         int64_t q[4], qe[4][4];

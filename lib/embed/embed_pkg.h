@@ -1,9 +1,8 @@
 /* lib/embed/embed_pkg.h — what the files of lib/embed share: the es_embedder
- * object (its CHOLMOD matrices, factors and work buffers), the sparse
- * kernels (sparse.c), the four stages (stage_*.c) that solve.c drives, and
- * the vertex-figure and rotation helpers (closure.c, align.c). Never
- * installed; this is the one header that includes cholmod.h, so CHOLMOD's
- * types stay inside lib/embed.
+ * object (its sparse matrices, factors and work buffers, on lib/sparse's
+ * solver service), the linear solves (linsolve.c), the four stages
+ * (stage_*.c) that solve.c drives, and the vertex-figure and rotation
+ * helpers (closure.c, align.c). Never installed.
  *
  * 3 x 3 matrices here are row-major double[9] (m[3*i + j]); they never
  * leave these files.
@@ -18,8 +17,7 @@
 #include "core/core_private.h"
 #include "edgespace/es_embed.h"
 #include "edgespace/es_mesh.h"
-
-#include <cholmod.h>
+#include "sparse/sparse_private.h"
 
 /* ---- limited-memory BFGS (lbfgs.c) -------------------------------------- */
 
@@ -59,7 +57,7 @@ struct es_embedder {
     double *vweight;        /* V: 1 for vertices in a face, else 0 */
     int64_t *rank, *nlow;   /* H1's pattern bookkeeping (see es__pos_off) */
     /* H3 is stored lower-triangular in the fill-reducing vertex order, so
-     * that CHOLMOD factorizes it as it is (no permuted transpose per
+     * that the factorization takes it as it is (no permuted transpose per
      * factorization, which cost ~7 % of each and a fresh allocation):
      * perm[j] is the vertex in block position j, pinv its inverse; the
      * slots of H3's entries are es__h3_off / es__h3_diag (embedder.c). */
@@ -71,11 +69,11 @@ struct es_embedder {
                                old (stage_refine.c) */
     /* closure variables */
     int64_t nvar, *var, *amap_off, *amap, *adiag;
-    cholmod_common cm;
-    int cm_started;
-    cholmod_sparse *H3, *H1, *HA;
-    cholmod_factor *L3, *L1, *LA;
-    cholmod_dense *X, *Y, *Ew, *B3, *B1, *BA;
+    es__sparse *sp;         /* the solver workspace of all of them */
+    es__sparse_mat *H3, *H1, *HA;
+    es__sparse_factor *L3, *L1, *LA;
+    es__sparse_dense *B3, *B1, *BA;
+    es__sparse_solution sol;   /* of the solves with L3, L1, LA */
     /* work, sized once */
     double *ang, *theta, *C, *G, *len, *alpha, *alpha_try, *alpha_keep, *xyz, *xyz_try, *xyz_best;
     double *init_copy;   /* init_xyz when the caller passes the output array itself */
@@ -91,9 +89,10 @@ struct es_embedder {
     /* the local-global solve (local_global.c), made on its first use: the
      * weighted Laplacian A1 in H1's pattern and its factor F1 (H1's order),
      * the edge weights, the rest triangles of the current target, and work */
-    cholmod_sparse *A1;
-    cholmod_factor *F1;
-    cholmod_dense *LB, *LX, *LY, *LE;
+    es__sparse_mat *A1;
+    es__sparse_factor *F1;
+    es__sparse_dense *LB;
+    es__sparse_solution lg_sol;
     double *lg_w, *lg_rest, *lg_work, lg_eps;
     double *lg_wf;         /* the weights F1 was factored with */
     int lg_have_factor;    /* F1 holds a numeric factor of A1 with lg_wf */
@@ -124,40 +123,35 @@ void es__h3_permute(const es_embedder *emb, const double *x, double *xp, int nco
 void es__h3_unpermute(const es_embedder *emb, const double *xp, double *x, int ncol);
 
 /* Value slots of the upper-triangular pattern of the V x V vertex
- * adjacency H1 (bs = 1) that embedder.c builds: entry (r, c) of the block
- * of edge e = (a, b), a < b, in column block b, and entry (r, c) of the
- * diagonal block of v. Edges are sorted by (min, max), so rank[e] is the
- * position of a among b's lower neighbours and nlow[v] their count. */
-static inline int64_t es__pos_off(const cholmod_sparse *A, int bs, const int64_t *rank, int64_t e,
+ * adjacency H1 (bs = 1) that embedder.c builds, cp its column pointers:
+ * entry (r, c) of the block of edge e = (a, b), a < b, in column block b,
+ * and entry (r, c) of the diagonal block of v. Edges are sorted by (min,
+ * max), so rank[e] is the position of a among b's lower neighbours and
+ * nlow[v] their count. */
+static inline int64_t es__pos_off(const int64_t *cp, int bs, const int64_t *rank, int64_t e,
                                   int64_t b, int r, int c)
 {
-    return ((const int64_t *)A->p)[bs * b + c] + bs * rank[e] + r;
+    return cp[bs * b + c] + bs * rank[e] + r;
 }
 
-static inline int64_t es__pos_diag(const cholmod_sparse *A, int bs, const int64_t *nlow, int64_t v,
+static inline int64_t es__pos_diag(const int64_t *cp, int bs, const int64_t *nlow, int64_t v,
                                    int r, int c)
 {
-    return ((const int64_t *)A->p)[bs * v + c] + bs * nlow[v] + r;
+    return cp[bs * v + c] + bs * nlow[v] + r;
 }
 
-/* ---- sparse kernels (sparse.c) ---------------------------------------- */
+/* ---- linear solves (linsolve.c) ---------------------------------------- */
 
-/* Translate emb->cm.status: ES_OK for success and the soft statuses
- * (not positive definite, tiny diagonal), else the code with a message
- * naming `what`. */
-es_status es__cm_check(es_embedder *emb, const char *what);
+/* Translate the status of emb->sp: ES_OK for success and the soft
+ * statuses (not positive definite, tiny diagonal), else the code with a
+ * message naming `what`. */
+es_status es__solver_check(es_embedder *emb, const char *what);
 
-/* Numeric factorization of A into L (analysed by es_embedder_new); returns
- * CHOLMOD's ok flag. */
-int es__factorize(es_embedder *emb, cholmod_sparse *A, cholmod_factor *L);
-
-/* Factorize A and solve A X = B into emb->X. Returns 1 if A is not
- * positive definite (nothing solved), 0 on success, -1 on a CHOLMOD
- * failure (message set). */
-int es__factor_solve(es_embedder *emb, cholmod_sparse *A, cholmod_factor *L, cholmod_dense *B);
-
-/* y = A x for the symmetric matrix held in its upper triangle (CSC). */
-void es__sym_matvec(const cholmod_sparse *A, const double *x, double *y);
+/* Factorize A and solve A X = B (its first ncol columns) into emb->sol.
+ * Returns 1 if A is not positive definite (nothing solved), 0 on success,
+ * -1 on a solver failure (message set). */
+int es__factor_solve(es_embedder *emb, es__sparse_mat *A, es__sparse_factor *L,
+                     es__sparse_dense *B, int64_t ncol);
 
 /* a . b over n entries. */
 double es__dot(const double *a, const double *b, int64_t n);
@@ -166,8 +160,8 @@ double es__dot(const double *a, const double *b, int64_t n);
  * of an earlier A (B: a dense of A's size for the preconditioner's
  * right-hand side). Returns the iterations used, or -1 if the relative
  * residual did not reach eta within max_it. */
-int es__lagged_pcg(es_embedder *emb, const cholmod_sparse *A, cholmod_factor *Lf,
-                   cholmod_dense *B, const double *b, double *d, double eta, int max_it);
+int es__lagged_pcg(es_embedder *emb, const es__sparse_mat *A, es__sparse_factor *Lf,
+                   es__sparse_dense *B, const double *b, double *d, double eta, int max_it);
 
 /* ---- the stages (stage_*.c), driven by solve.c ------------------------- */
 

@@ -66,24 +66,25 @@ static es_status prepare(es_embedder *emb, int history)
         (!emb->lg_rest && !(emb->lg_rest = es__alloc_array(emb->ctx, REST * emb->nf + 1, sizeof(double)))) ||
         (!emb->lg_work && !(emb->lg_work = es__alloc_array(emb->ctx, 6 * 3 * nv + 1, sizeof(double)))))
         return ES_ENOMEM;
-    if (!emb->A1) emb->A1 = cholmod_l_copy_sparse(emb->H1, &emb->cm);
-    if (!emb->LB) emb->LB = cholmod_l_allocate_dense((size_t)nv, 3, (size_t)nv, CHOLMOD_REAL, &emb->cm);
-    if (emb->A1 && emb->LB) emb->F1 = cholmod_l_copy_factor(emb->L1, &emb->cm);
+    if (!emb->A1) emb->A1 = es__sparse_mat_copy(emb->sp, emb->H1);
+    if (!emb->LB) emb->LB = es__sparse_dense_new(emb->sp, nv, 3);
+    if (emb->A1 && emb->LB) emb->F1 = es__sparse_factor_copy(emb->sp, emb->L1);
     if (!emb->A1 || !emb->LB || !emb->F1) {
-        rc = es__cm_check(emb, "allocate (local-global)");
+        rc = es__solver_check(emb, "allocate (local-global)");
         return rc != ES_OK ? rc : es__fail(emb->ctx, ES_ENOMEM, "embed: CHOLMOD out of memory");
     }
     return ES_OK;
 }
 
-static void add_off(es_embedder *emb, int64_t e, double w)
+/* x, cp: A1's values and column pointers */
+static void add_off(const es_embedder *emb, double *x, const int64_t *cp, int64_t e, double w)
 {
-    ((double *)emb->A1->x)[es__pos_off(emb->A1, 1, emb->rank, e, emb->edges[2 * e + 1], 0, 0)] += w;
+    x[es__pos_off(cp, 1, emb->rank, e, emb->edges[2 * e + 1], 0, 0)] += w;
 }
 
-static void add_diag(es_embedder *emb, int64_t v, double w)
+static void add_diag(const es_embedder *emb, double *x, const int64_t *cp, int64_t v, double w)
 {
-    ((double *)emb->A1->x)[es__pos_diag(emb->A1, 1, emb->nlow, v, 0, 0)] += w;
+    x[es__pos_diag(cp, 1, emb->nlow, v, 0, 0)] += w;
 }
 
 /* The weights and A for lengths L (relative residuals: 1 / l^2 at mean
@@ -117,8 +118,9 @@ static es_status assemble(es_embedder *emb, const double *L, double reuse)
 {
     int64_t nv = emb->nv, ne = emb->ne;
     const int64_t *EF = es_mesh_edge_faces(emb->mesh);
-    double lmean = 0, dmean = 0;
-    memset(emb->A1->x, 0, emb->A1->nzmax * sizeof(double));
+    double lmean = 0, dmean = 0, *x = es__sparse_mat_values(emb->A1);
+    const int64_t *cp = es__sparse_mat_colptr(emb->A1);
+    memset(x, 0, (size_t)es__sparse_mat_nzmax(emb->A1) * sizeof(double));
     for (int64_t e = 0; e < ne; e++) lmean += L[e];
     lmean /= (double)(ne > 0 ? ne : 1);
     for (int64_t e = 0; e < ne; e++) {
@@ -127,9 +129,9 @@ static es_status assemble(es_embedder *emb, const double *L, double reuse)
         emb->lg_w[e] = 1.0 / (l * l);
         /* one term per face beside the edge */
         w = emb->lg_w[e] * (double)((EF[2 * e] >= 0) + (EF[2 * e + 1] >= 0));
-        add_off(emb, e, -w);
-        add_diag(emb, a, w);
-        add_diag(emb, b, w);
+        add_off(emb, x, cp, e, -w);
+        add_diag(emb, x, cp, a, w);
+        add_diag(emb, x, cp, b, w);
         dmean += 2 * w;
     }
     dmean /= (double)(nv > 0 ? nv : 1);
@@ -137,12 +139,14 @@ static es_status assemble(es_embedder *emb, const double *L, double reuse)
      * (eps 1e-9 of the mean diagonal) makes A definite without moving any
      * fixed point; vertices in no face keep their positions */
     emb->lg_eps = 1e-9 * dmean;
-    for (int64_t v = 0; v < nv; v++) add_diag(emb, v, emb->off[v + 1] == emb->off[v] ? 1.0 : emb->lg_eps);
+    for (int64_t v = 0; v < nv; v++)
+        add_diag(emb, x, cp, v, emb->off[v + 1] == emb->off[v] ? 1.0 : emb->lg_eps);
     if (factor_still_fits(emb, reuse)) return ES_OK;
     emb->lg_have_factor = 0;
-    emb->cm.status = CHOLMOD_OK;
-    if (!es__factorize(emb, emb->A1, emb->F1) || emb->cm.status != CHOLMOD_OK) {
-        es_status rc = es__cm_check(emb, "factorize (local-global)");
+    es__sparse_clear_status(emb->sp);
+    if (!es__sparse_factorize(emb->sp, emb->A1, emb->F1) ||
+        es__sparse_status(emb->sp, NULL) != ES__SPARSE_OK) {
+        es_status rc = es__solver_check(emb, "factorize (local-global)");
         return rc != ES_OK ? rc : es__fail(emb->ctx, ES_ENUMERIC,
                                            "embed: the local-global matrix is singular");
     }
@@ -271,7 +275,7 @@ static void half_gradient(const es_embedder *emb, const double *xyz, const doubl
     int64_t nv = emb->nv;
     for (int k = 0; k < 3; k++) {
         for (int64_t v = 0; v < nv; v++) t[v] = xyz[3 * v + k];
-        es__sym_matvec(emb->A1, t, t + nv);
+        es__sparse_sym_matvec(emb->A1, t, t + nv);
         for (int64_t v = 0; v < nv; v++) g[3 * v + k] = t[nv + v] - b[v + nv * k];
     }
 }
@@ -280,16 +284,15 @@ static void half_gradient(const es_embedder *emb, const double *xyz, const doubl
 static es_status apply_inverse(es_embedder *emb, const double *q, double *d)
 {
     int64_t nv = emb->nv;
-    double *b = emb->LB->x;
+    double *b = es__sparse_dense_values(emb->LB);
     for (int64_t v = 0; v < nv; v++)
         for (int k = 0; k < 3; k++) b[v + nv * k] = q[3 * v + k];
-    emb->cm.status = CHOLMOD_OK;
-    if (!cholmod_l_solve2(CHOLMOD_A, emb->F1, emb->LB, NULL, &emb->LX, NULL, &emb->LY, &emb->LE,
-                          &emb->cm)) {
-        es_status rc = es__cm_check(emb, "solve (local-global)");
+    es__sparse_clear_status(emb->sp);
+    if (!es__sparse_solve(emb->sp, emb->F1, emb->LB, 3, &emb->lg_sol)) {
+        es_status rc = es__solver_check(emb, "solve (local-global)");
         return rc != ES_OK ? rc : ES_ENUMERIC;
     }
-    const double *s = emb->LX->x;
+    const double *s = es__sparse_solution_values(&emb->lg_sol);
     for (int64_t v = 0; v < nv; v++)
         for (int k = 0; k < 3; k++) d[3 * v + k] = s[v + nv * k];
     return ES_OK;
@@ -307,7 +310,7 @@ es_status es__lg_solve(es_embedder *emb, const double *L, double *xyz, const es_
         (rc = assemble(emb, L, o->factor_reuse)) != ES_OK)
         return rc;
     g = emb->lg_work, gn = g + n3, d = gn + n3, xt = d + n3, tmp = xt + n3, acc = tmp + n3;
-    b = emb->LB->x;
+    b = es__sparse_dense_values(emb->LB);
     es__lbfgs_reset(&emb->lg_hist);
     es__corner_angles(emb->mesh, L, 0, emb->ang);
     rest_triangles(emb, L);

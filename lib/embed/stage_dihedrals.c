@@ -45,7 +45,8 @@ es_status es__stage_dihedrals(es_embedder *emb, const es_embed_opts *o, int max_
     es_status need = es__embedder_need(emb, ES__NEED_CLOSURE);
     if (need != ES_OK) return need;
     int64_t n = emb->nvar, it = 0;
-    double *x = emb->HA ? emb->HA->x : NULL, *g = emb->grad, lambda = *lambda_io, e;
+    double *x = emb->HA ? es__sparse_mat_values(emb->HA) : NULL, *g = emb->grad;
+    double lambda = *lambda_io, e;
     int have_factor = 0;
     e = es__closure_eval(emb, alpha, 0, NULL);
     if (n == 0 || max_iter <= 0) {
@@ -56,7 +57,7 @@ es_status es__stage_dihedrals(es_embedder *emb, const es_embed_opts *o, int max_
         double e_new = 0;
         int accepted = 0;
         es__closure_eval(emb, alpha, 1, NULL);
-        memset(x, 0, emb->HA->nzmax * sizeof(double));
+        memset(x, 0, (size_t)es__sparse_mat_nzmax(emb->HA) * sizeof(double));
         for (int64_t a = 0; a < n; a++) g[a] = 0;
         for (int64_t v = 0; v < emb->nv; v++) {
             int64_t o0 = emb->off[v], k = emb->off[v + 1] - o0;
@@ -85,7 +86,7 @@ es_status es__stage_dihedrals(es_embedder *emb, const es_embed_opts *o, int max_
             }
             mean /= (double)n;
             for (int tries = 0; tries < 12 && !accepted; tries++) {
-                double *bx = emb->BA->x;
+                double *bx = es__sparse_dense_values(emb->BA);
                 int st;
                 double *dx = emb->diag + n, *rhs = dx + n;
                 int used = -1;
@@ -98,11 +99,12 @@ es_status es__stage_dihedrals(es_embedder *emb, const es_embed_opts *o, int max_
                                       fmin(1e-2, fmax(1e-12, sqrt(e))), 12);
                 if (used < 0) {
                     memcpy(bx, rhs, (size_t)n * sizeof *bx);
-                    st = es__factor_solve(emb, emb->HA, emb->LA, emb->BA);
+                    st = es__factor_solve(emb, emb->HA, emb->LA, emb->BA, 1);
                     if (st < 0) return ES_ENUMERIC;
                     have_factor = st == 0;
                     emb->nfactor++;
-                    if (st == 0) memcpy(dx, emb->X->x, (size_t)n * sizeof *dx);
+                    if (st == 0)
+                        memcpy(dx, es__sparse_solution_values(&emb->sol), (size_t)n * sizeof *dx);
                 } else {
                     st = 0;
                 }

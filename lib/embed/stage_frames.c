@@ -48,11 +48,11 @@ es_status es__stage_frames(es_embedder *emb, const double *alpha)
 {
     es_status need = es__embedder_need(emb, ES__NEED_H3);
     if (need != ES_OK) return need;
-    double *x = emb->H3->x, *b = emb->pcg;   /* 3 right-hand sides in vertex order */
+    double *x = es__sparse_mat_values(emb->H3), *b = emb->pcg;   /* 3 right-hand sides in vertex order */
     int64_t n3 = 3 * emb->nv;
     int st;
     compute_fan_frames(emb, alpha);
-    memset(x, 0, emb->H3->nzmax * sizeof(double));
+    memset(x, 0, (size_t)es__sparse_mat_nzmax(emb->H3) * sizeof(double));
     memset(b, 0, (size_t)(3 * n3) * sizeof(double));
     for (int64_t e = 0; e < emb->ne; e++) {
         int64_t a = emb->edges[2 * e], c = emb->edges[2 * e + 1];
@@ -89,12 +89,12 @@ es_status es__stage_frames(es_embedder *emb, const double *alpha)
                 x[es__h3_diag(emb, v, r, r)] = 1.0;
                 b[3 * v + r + n3 * r] = 1.0;
             }
-    es__h3_permute(emb, b, emb->B3->x, 3);
-    st = es__factor_solve(emb, emb->H3, emb->L3, emb->B3);
+    es__h3_permute(emb, b, es__sparse_dense_values(emb->B3), 3);
+    st = es__factor_solve(emb, emb->H3, emb->L3, emb->B3, 3);
     if (st < 0) return ES_ENUMERIC;
     if (st > 0) ES_FAIL(emb->ctx, ES_ENUMERIC, "embed: frame system is singular");
     {
-        const double *s = emb->X->x;
+        const double *s = es__sparse_solution_values(&emb->sol);
         for (int64_t v = 0; v < emb->nv; v++) {
             double *G = emb->G + 9 * v;
             for (int r = 0; r < 3; r++)
@@ -109,7 +109,7 @@ es_status es__stage_positions(es_embedder *emb, const double *len, double *xyz)
 {
     es_status need = es__embedder_need(emb, ES__NEED_POSITIONS);
     if (need != ES_OK) return need;
-    double *b = emb->B1->x;
+    double *b = es__sparse_dense_values(emb->B1);
     int64_t nv = emb->nv;
     memset(b, 0, (size_t)(3 * nv) * sizeof(double));
     for (int64_t v = 0; v < nv; v++)
@@ -123,14 +123,13 @@ es_status es__stage_positions(es_embedder *emb, const double *len, double *xyz)
                 if (!emb->pinned[v]) b[v + nv * r] -= g;
             }
         }
-    emb->cm.status = CHOLMOD_OK;
-    if (!cholmod_l_solve2(CHOLMOD_A, emb->L1, emb->B1, NULL, &emb->X, NULL, &emb->Y, &emb->Ew,
-                          &emb->cm)) {
-        (void)es__cm_check(emb, "solve (positions)");   /* the message; the code stays */
+    es__sparse_clear_status(emb->sp);
+    if (!es__sparse_solve(emb->sp, emb->L1, emb->B1, 3, &emb->sol)) {
+        (void)es__solver_check(emb, "solve (positions)");   /* the message; the code stays */
         return ES_ENUMERIC;
     }
     {
-        const double *s = emb->X->x;
+        const double *s = es__sparse_solution_values(&emb->sol);
         for (int64_t v = 0; v < nv; v++)
             for (int r = 0; r < 3; r++) xyz[3 * v + r] = s[v + nv * r];
     }

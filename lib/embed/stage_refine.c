@@ -57,8 +57,8 @@ static fit evaluate(const es_embedder *emb, const double *xyz, const double *L,
 static void assemble(es_embedder *emb, const double *L, const double *xyz,
                      const es__bend_prior *bp, double *g)
 {
-    double *x = emb->H3->x;
-    memset(x, 0, emb->H3->nzmax * sizeof(double));
+    double *x = es__sparse_mat_values(emb->H3);
+    memset(x, 0, (size_t)es__sparse_mat_nzmax(emb->H3) * sizeof(double));
     memset(g, 0, (size_t)(3 * emb->nv) * sizeof(double));
     for (int64_t e = 0; e < emb->ne; e++) {
         int64_t a = emb->edges[2 * e], b = emb->edges[2 * e + 1];
@@ -121,24 +121,22 @@ static void cg_outcome(es_embedder *emb, int lag, int steps)
 
 /* Factorize the damped H3 and solve H3 stepp = bp (H3's order) in place of
  * the right-hand side. Returns 0, 1 if not positive definite, -1 on a
- * CHOLMOD failure. */
+ * solver failure. */
 static int factor_step(es_embedder *emb, const double *bp, double *stepp)
 {
     int64_t n3 = 3 * emb->nv;
     int st;
-    memcpy(emb->B3->x, bp, (size_t)n3 * sizeof(double));
-    emb->B3->ncol = 1;
-    st = es__factor_solve(emb, emb->H3, emb->L3, emb->B3);
-    emb->B3->ncol = 3;
+    memcpy(es__sparse_dense_values(emb->B3), bp, (size_t)n3 * sizeof(double));
+    st = es__factor_solve(emb, emb->H3, emb->L3, emb->B3, 1);
     emb->nfactor++;
-    if (st == 0) memcpy(stepp, emb->X->x, (size_t)n3 * sizeof(double));
+    if (st == 0) memcpy(stepp, es__sparse_solution_values(&emb->sol), (size_t)n3 * sizeof(double));
     return st;
 }
 
 /* Write the damped (or, lambda < 0, the undamped) diagonal into H3. */
 static void set_diagonal(es_embedder *emb, const double *dg, double mean, double lambda)
 {
-    double *x = emb->H3->x;
+    double *x = es__sparse_mat_values(emb->H3);
     for (int64_t i = 0; i < 3 * emb->nv; i++) {
         int64_t v = i / 3, k = i % 3;
         double d = emb->vweight[v] == 0 ? mean : dg[i];
@@ -154,7 +152,7 @@ es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz, es__b
     if (need != ES_OK) return need;
     double hist[4] = {0, 0, 0, 0}, c_prev = 0;
     int64_t nv = emb->nv, n3 = 3 * nv, ne = emb->ne;
-    double *x = emb->H3->x, *g = emb->grad, *dg = emb->diag;
+    double *x = es__sparse_mat_values(emb->H3), *g = emb->grad, *dg = emb->diag;
     double *step = emb->pcg + 4 * n3, *hp = step + n3, *stepp = hp + n3;
     double lambda = 1e-4, ctol = ro->tol * ro->tol * (double)ne;
     int it_hold = 0, lag = -1;   /* lag: iterations since the last factorization (-1: none) */
@@ -212,7 +210,7 @@ es_status es__stage_refine(es_embedder *emb, const double *L, double *xyz, es__b
                 es__h3_unpermute(emb, stepp, step, 1);
                 for (int64_t i = 0; i < n3; i++) xt[i] = xyz[i] + step[i];
                 nxt = evaluate(emb, xt, L, bp);
-                es__sym_matvec(emb->H3, stepp, hp);
+                es__sparse_sym_matvec(emb->H3, stepp, hp);
                 double gs = es__dot(g, step, n3), shs = es__dot(stepp, hp, n3);
                 pred = -2.0 * gs - shs;
                 rho = pred > 0 ? (cur.cost - nxt.cost) / pred : -1;

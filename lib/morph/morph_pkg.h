@@ -12,7 +12,8 @@
 
 #include "core/core_private.h"
 #include "core/vec3.h"
-#include "embed/embed_private.h"
+#include "embed/embed_private.h"     /* the nearest rotation */
+#include "sparse/sparse_private.h"   /* sparse SPD solves */
 #include "edgespace/es_morph.h"
 
 /* ---- the multi-scale hierarchy --------------------------------------------- */

@@ -27,6 +27,7 @@
  * so a misspelt or missing column is said before anything is expanded.
  */
 #include "stats/stats_pkg.h"
+#include "core/scan.h"
 
 #include <ctype.h>
 #include <stdio.h>
@@ -58,36 +59,20 @@ typedef struct tset {
 
 typedef struct fparser {
     es_ctx *ctx;
-    const char *s;
-    size_t pos;
+    es__scan sc;   /* the text and the cursor; whitespace by isspace() */
     es_formula *f;
     int depth;
     es_formula_column_fn known;   /* or NULL: names are not checked */
     void *known_ud;
 } fparser;
 
-static es_status ferr(fparser *p, size_t at, const char *fmt, ...) ES__PRINTF(3, 4);
-static es_status ferr(fparser *p, size_t at, const char *fmt, ...)
-{
-    char msg[512];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    return es__fail(p->ctx, ES_EFORMAT, "formula: column %zu: %s", at + 1, msg);
-}
+#define ferr(p, ...) es__scan_fail(&(p)->sc, __VA_ARGS__)
 
-static void ws(fparser *p)
-{
-    while (p->s[p->pos] && isspace((unsigned char)p->s[p->pos])) p->pos++;
-}
+static void ws(fparser *p) { es__scan_skip_space(&p->sc); }
 
 static const char *what(fparser *p, char *buf, size_t n)
 {
-    char c = p->s[p->pos];
-    if (!c) return "the end of the formula";
-    snprintf(buf, n, "'%c'", c);
-    return buf;
+    return es__scan_describe(&p->sc, buf, n);
 }
 
 static es_status tset_add(es_ctx *ctx, tset *t, uint64_t m)
@@ -116,27 +101,17 @@ static int name_char(char c)
     return isalnum((unsigned char)c) || c == '_' || c == '.';
 }
 
-/* A column name at p->pos: a run of name characters or a quoted string. */
+/* A column name at the cursor: a run of name characters or a quoted string. */
 static es_status read_name(fparser *p, const char **w, size_t *len)
 {
-    size_t at = p->pos;
-    if (p->s[at] == '"') {
-        const char *end = strchr(p->s + at + 1, '"');
-        if (!end) return ferr(p, at, "unterminated quoted column name");
-        *w = p->s + at + 1;
-        *len = (size_t)(end - *w);
-        p->pos = (size_t)(end - p->s) + 1;
-        if (!*len) return ferr(p, at, "empty column name");
-        return ES_OK;
+    size_t at = p->sc.pos;
+    char b[8];
+    switch (es__scan_word(&p->sc, name_char, w, len)) {
+    case ES__SCAN_OK: return ES_OK;
+    case ES__SCAN_UNTERMINATED: return ferr(p, at, "unterminated quoted column name");
+    case ES__SCAN_EMPTY: return ferr(p, at, "empty column name");
+    default: return ferr(p, at, "expected a column name, found %s", what(p, b, sizeof b));
     }
-    while (name_char(p->s[p->pos])) p->pos++;
-    if (p->pos == at) {
-        char b[8];
-        return ferr(p, at, "expected a column name, found %s", what(p, b, sizeof b));
-    }
-    *w = p->s + at;
-    *len = p->pos - at;
-    return ES_OK;
 }
 
 /* The index of variable (name, kind), added if new. */
@@ -179,9 +154,7 @@ static es_status check_column(fparser *p, size_t at, const char *w, size_t len)
     memcpy(name, w, len);
     name[len] = '\0';
     if (p->known(p->known_ud, name, why, sizeof why)) return ES_OK;
-    es__fail(p->ctx, ES_ENOTFOUND, "formula: column %zu: %s", at + 1,
-             *why ? why : "no such label column");
-    return ES_ENOTFOUND;
+    return es__scan_fail_code(&p->sc, ES_ENOTFOUND, at, "%s", *why ? why : "no such label column");
 }
 
 /* Expanding a product or interaction of a and b terms makes (at most) the
@@ -200,10 +173,10 @@ static es_status check_expansion(fparser *p, size_t at, int64_t a, int64_t b, in
 static es_status operand_follows(fparser *p, size_t at, const char *op)
 {
     ws(p);
-    char c = p->s[p->pos];
+    char c = p->sc.s[p->sc.pos];
     if (c == '(' || c == '"' || name_char(c)) return ES_OK;
     char b[8];
-    return ferr(p, p->pos, "expected a term after the '%s' at column %zu, found %s", op, at + 1,
+    return ferr(p, p->sc.pos, "expected a term after the '%s' at column %zu, found %s", op, at + 1,
                 what(p, b, sizeof b));
 }
 
@@ -212,50 +185,45 @@ static es_status parse_sum(fparser *p, tset *out);
 static es_status parse_atom(fparser *p, tset *out)
 {
     ws(p);
-    size_t at = p->pos;
+    size_t at = p->sc.pos;
     es_status rc;
     if (++p->depth > 100) return ferr(p, at, "formula nested too deeply");
-    if (p->s[at] == '(') {
-        p->pos++;
-        if ((rc = parse_sum(p, out)) != ES_OK) return rc;
-        ws(p);
-        if (p->s[p->pos] != ')') {
-            char b[8];
-            return ferr(p, p->pos, "expected ')' to close the '(' at column %zu, found %s",
-                        at + 1, what(p, b, sizeof b));
-        }
-        p->pos++;
+    if (p->sc.s[at] == '(') {
+        p->sc.pos++;
+        if ((rc = parse_sum(p, out)) != ES_OK ||
+            (rc = es__scan_expect_close(&p->sc, '(', ')', at)) != ES_OK)
+            return rc;
         p->depth--;
         return ES_OK;
     }
-    if (p->s[at] && strchr("+*/:%", p->s[at]))
+    if (p->sc.s[at] && strchr("+*/:%", p->sc.s[at]))
         return ferr(p, at, "'%.*s' has no term before it",
-                    strncmp(p->s + at, "%in%", 4) ? 1 : 4, p->s + at);
+                    strncmp(p->sc.s + at, "%in%", 4) ? 1 : 4, p->sc.s + at);
     const char *w = NULL;
     size_t len = 0;
     if ((rc = read_name(p, &w, &len)) != ES_OK) return rc;
     es_var_kind kind = ES_VAR_AUTO;
-    size_t after = p->pos;
+    size_t after = p->sc.pos;
     ws(p);
-    if (p->s[p->pos] == '(' && p->s[at] != '"') {
+    if (p->sc.s[p->sc.pos] == '(' && p->sc.s[at] != '"') {
         if (len == 6 && !memcmp(w, "factor", 6)) kind = ES_VAR_FACTOR;
         else if (len == 3 && !memcmp(w, "log", 3)) kind = ES_VAR_LOG;
         else
             return ferr(p, at, "unknown function '%.*s' (factor() and log() are known)",
                         (int)len, w);
-        p->pos++;
+        p->sc.pos++;
         ws(p);
-        at = p->pos;
+        at = p->sc.pos;
         if ((rc = read_name(p, &w, &len)) != ES_OK) return rc;
         ws(p);
-        if (p->s[p->pos] != ')') {
+        if (p->sc.s[p->sc.pos] != ')') {
             char b[8];
-            return ferr(p, p->pos, "expected ')' after the column name, found %s",
+            return ferr(p, p->sc.pos, "expected ')' after the column name, found %s",
                         what(p, b, sizeof b));
         }
-        p->pos++;
+        p->sc.pos++;
     } else {
-        p->pos = after;
+        p->sc.pos = after;
     }
     int64_t v = 0;
     if ((rc = check_column(p, at, w, len)) != ES_OK ||
@@ -312,8 +280,8 @@ static es_status parse_inter(fparser *p, tset *out)
     es_status rc = parse_atom(p, out);
     while (rc == ES_OK) {
         ws(p);
-        if (p->s[p->pos] != ':') break;
-        size_t at = p->pos++;
+        if (p->sc.s[p->sc.pos] != ':') break;
+        size_t at = p->sc.pos++;
         tset b = {0}, c = {0};
         if ((rc = operand_follows(p, at, ":")) == ES_OK &&
             (rc = parse_atom(p, &b)) == ES_OK &&
@@ -326,10 +294,10 @@ static es_status parse_inter(fparser *p, tset *out)
     return rc;
 }
 
-/* Whether "%in%" is at p->pos; any other %...% is refused by name. */
+/* Whether "%in%" is at p->sc.pos; any other %...% is refused by name. */
 static es_status at_in_operator(fparser *p, int *yes)
 {
-    const char *s = p->s + p->pos;
+    const char *s = p->sc.s + p->sc.pos;
     *yes = 0;
     if (*s != '%') return ES_OK;
     if (!strncmp(s, "%in%", 4)) {
@@ -338,7 +306,7 @@ static es_status at_in_operator(fparser *p, int *yes)
     }
     const char *end = strchr(s + 1, '%');
     int len = end && end - s < 40 ? (int)(end - s) + 1 : 1;
-    return ferr(p, p->pos, "unknown operator '%.*s' (the operators are '+', '*', ':', '/' and "
+    return ferr(p, p->sc.pos, "unknown operator '%.*s' (the operators are '+', '*', ':', '/' and "
                 "'%%in%%')", len, s);
 }
 
@@ -350,8 +318,8 @@ static es_status parse_in(fparser *p, tset *out)
         ws(p);
         int in = 0;
         if ((rc = at_in_operator(p, &in)) != ES_OK || !in) break;
-        size_t at = p->pos;
-        p->pos += 4;
+        size_t at = p->sc.pos;
+        p->sc.pos += 4;
         tset b = {0}, c = {0};
         if ((rc = operand_follows(p, at, "%in%")) == ES_OK &&
             (rc = parse_inter(p, &b)) == ES_OK &&
@@ -369,9 +337,9 @@ static es_status parse_product(fparser *p, tset *out)
     es_status rc = parse_in(p, out);
     while (rc == ES_OK) {
         ws(p);
-        char op = p->s[p->pos];
+        char op = p->sc.s[p->sc.pos];
         if (op != '*' && op != '/') break;
-        size_t at = p->pos++;
+        size_t at = p->sc.pos++;
         tset b = {0}, c = {0};
         if ((rc = operand_follows(p, at, op == '*' ? "*" : "/")) != ES_OK ||
             (rc = parse_in(p, &b)) != ES_OK) {
@@ -396,12 +364,12 @@ static es_status parse_sum(fparser *p, tset *out)
     es_status rc = parse_product(p, out);
     while (rc == ES_OK) {
         ws(p);
-        char c = p->s[p->pos];
+        char c = p->sc.s[p->sc.pos];
         if (c == '-')
-            return ferr(p, p->pos, "removing terms with '-' is not supported; list the terms "
+            return ferr(p, p->sc.pos, "removing terms with '-' is not supported; list the terms "
                         "to keep");
         if (c != '+') break;
-        size_t at = p->pos++;
+        size_t at = p->sc.pos++;
         tset b = {0};
         if ((rc = operand_follows(p, at, "+")) == ES_OK &&
             (rc = parse_product(p, &b)) == ES_OK &&
@@ -465,27 +433,28 @@ es_status es_formula_parse_checked(es_ctx *ctx, const char *text, es_formula_col
     es_formula *f = es__calloc(ctx, 1, sizeof *f);
     if (!f) return ES_ENOMEM;
     f->ctx = ctx;
-    fparser p = {ctx, text, 0, f, 0, known, userdata};
+    fparser p = {ctx, {0}, f, 0, known, userdata};
     tset t = {0};
     es_status rc;
+    es__scan_init(&p.sc, ctx, text, "formula", "the end of the formula", ES__SCAN_SPACE_C);
     ws(&p);
     const char *tilde = strchr(text, '~');
-    if (tilde && tilde != text + p.pos) {
-        rc = ferr(&p, p.pos, "the response is the store's shapes: write the formula as "
+    if (tilde && tilde != text + p.sc.pos) {
+        rc = ferr(&p, p.sc.pos, "the response is the store's shapes: write the formula as "
                   "'~ terms', without a left-hand side");
         goto done;
     }
-    if (text[p.pos] == '~') p.pos++;
+    if (text[p.sc.pos] == '~') p.sc.pos++;
     ws(&p);
-    if (!text[p.pos]) {
-        rc = ferr(&p, p.pos, "the formula has no terms (write e.g. '~ group')");
+    if (!text[p.sc.pos]) {
+        rc = ferr(&p, p.sc.pos, "the formula has no terms (write e.g. '~ group')");
         goto done;
     }
     if ((rc = parse_sum(&p, &t)) != ES_OK) goto done;
     ws(&p);
-    if (text[p.pos]) {
+    if (text[p.sc.pos]) {
         char b[8];
-        rc = ferr(&p, p.pos, "unexpected %s (terms are joined by '+', '*', ':', '/' or "
+        rc = ferr(&p, p.sc.pos, "unexpected %s (terms are joined by '+', '*', ':', '/' or "
                   "'%%in%%')",
                   what(&p, b, sizeof b));
         goto done;

@@ -18,6 +18,7 @@
  */
 #include "edgespace/es_point.h"
 #include "core/core_private.h"
+#include "core/scan.h"
 
 #include <ctype.h>
 #include <math.h>
@@ -48,31 +49,16 @@ typedef struct form {
 
 typedef struct parser {
     es_ctx *ctx;
-    const char *s;
-    size_t pos;
+    es__scan sc;   /* the text and the cursor; whitespace ' ', '\t', '\n', '\r' */
     es_point_expr *x;
     int depth;
 } parser;
 
 #define MAX_DEPTH 200
 
-static es_status perr(parser *p, size_t at, const char *fmt, ...) ES__PRINTF(3, 4);
-static es_status perr(parser *p, size_t at, const char *fmt, ...)
-{
-    char msg[512];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    return es__fail(p->ctx, ES_EFORMAT, "point: column %zu: %s", at + 1, msg);
-}
+#define perr(p, ...) es__scan_fail(&(p)->sc, __VA_ARGS__)
 
-static void skip_ws(parser *p)
-{
-    while (p->s[p->pos] == ' ' || p->s[p->pos] == '\t' || p->s[p->pos] == '\n' ||
-           p->s[p->pos] == '\r')
-        p->pos++;
-}
+static void skip_ws(parser *p) { es__scan_skip_space(&p->sc); }
 
 static int is_id_char(char c)
 {
@@ -82,10 +68,7 @@ static int is_id_char(char c)
 /* What the next token looks like, for messages. */
 static const char *describe(parser *p, char *buf, size_t n)
 {
-    char c = p->s[p->pos];
-    if (!c) return "the end of the expression";
-    snprintf(buf, n, "'%c'", c);
-    return buf;
+    return es__scan_describe(&p->sc, buf, n);
 }
 
 static es_status add_term(parser *p, double coef, es_point_leaf kind, const char *arg,
@@ -123,24 +106,14 @@ static void scale_form(parser *p, form *f, double c)
 static es_status word(parser *p, int (*ok)(char), const char *what, const char **w,
                       size_t *len)
 {
-    size_t at = p->pos;
-    if (p->s[at] == '"') {
-        const char *end = strchr(p->s + at + 1, '"');
-        if (!end) return perr(p, at, "unterminated quoted string (expected %s)", what);
-        *w = p->s + at + 1;
-        *len = (size_t)(end - *w);
-        p->pos = (size_t)(end - p->s) + 1;
-        if (*len == 0) return perr(p, at, "expected %s, found an empty string", what);
-        return ES_OK;
+    size_t at = p->sc.pos;
+    char b[8];
+    switch (es__scan_word(&p->sc, ok, w, len)) {
+    case ES__SCAN_OK: return ES_OK;
+    case ES__SCAN_UNTERMINATED: return perr(p, at, "unterminated quoted string (expected %s)", what);
+    case ES__SCAN_EMPTY: return perr(p, at, "expected %s, found an empty string", what);
+    default: return perr(p, at, "expected %s, found %s", what, describe(p, b, sizeof b));
     }
-    while (p->s[p->pos] && ok(p->s[p->pos])) p->pos++;
-    if (p->pos == at) {
-        char b[8];
-        return perr(p, at, "expected %s, found %s", what, describe(p, b, sizeof b));
-    }
-    *w = p->s + at;
-    *len = p->pos - at;
-    return ES_OK;
 }
 
 /* A coefficient's name: "age", "expression=happy", "a=x:b=y". */
@@ -167,41 +140,30 @@ static es_status parse_sum(parser *p, form *f);
 static es_status expect(parser *p, char c)
 {
     skip_ws(p);
-    if (p->s[p->pos] != c) {
+    if (p->sc.s[p->sc.pos] != c) {
         char b[8];
-        return perr(p, p->pos, "expected '%c', found %s", c, describe(p, b, sizeof b));
+        return perr(p, p->sc.pos, "expected '%c', found %s", c, describe(p, b, sizeof b));
     }
-    p->pos++;
+    p->sc.pos++;
     return ES_OK;
 }
 
+/* A number (its value exactly strtod's: core/text.h), of fewer than 64
+ * bytes. */
 static es_status parse_number(parser *p, form *f)
 {
-    size_t at = p->pos, i = at;
-    while (isdigit((unsigned char)p->s[i])) i++;
-    if (p->s[i] == '.') {
-        i++;
-        while (isdigit((unsigned char)p->s[i])) i++;
+    size_t at = p->sc.pos, len = 0;
+    switch (es__scan_number(&p->sc, 64, &f->num, &len)) {
+    case ES__SCAN_OK: break;
+    case ES__SCAN_TOO_LONG: return perr(p, at, "number too long");
+    default: return perr(p, at, "malformed number");
     }
-    if (i == at + 1 && p->s[at] == '.') return perr(p, at, "malformed number");
-    if (p->s[i] == 'e' || p->s[i] == 'E') {
-        size_t j = i + 1;
-        if (p->s[j] == '+' || p->s[j] == '-') j++;
-        if (!isdigit((unsigned char)p->s[j])) return perr(p, at, "malformed number");
-        while (isdigit((unsigned char)p->s[j])) j++;
-        i = j;
-    }
-    char buf[64];
-    if (i - at >= sizeof buf) return perr(p, at, "number too long");
-    memcpy(buf, p->s + at, i - at);
-    buf[i - at] = '\0';
     f->is_num = 1;
-    f->num = strtod(buf, NULL);
     if (!isfinite(f->num)) return perr(p, at, "number out of range");
-    p->pos = i;
-    if (isalpha((unsigned char)p->s[i]) || p->s[i] == '_')
-        return perr(p, i, "expected an operator after the number, found '%c' (write 2*pc:1)",
-                    p->s[i]);
+    char c = es__scan_peek(&p->sc);
+    if (isalpha((unsigned char)c) || c == '_')
+        return perr(p, p->sc.pos, "expected an operator after the number, found '%c' (write "
+                    "2*pc:1)", c);
     return ES_OK;
 }
 
@@ -209,13 +171,13 @@ static es_status parse_number(parser *p, form *f)
  * in es_store_select's syntax. */
 static es_status parse_mean(parser *p, form *f)
 {
-    size_t save = p->pos;
+    size_t save = p->sc.pos;
     skip_ws(p);
-    if (p->s[p->pos] != '[') {
-        p->pos = save;
+    if (p->sc.s[p->sc.pos] != '[') {
+        p->sc.pos = save;
         return add_term(p, 1.0, ES_POINT_MEAN, "", 0, 0, f);
     }
-    size_t open = p->pos++;
+    size_t open = p->sc.pos++;
     char *filt = NULL;
     size_t flen = 0;
     es_status rc = ES_OK;
@@ -223,7 +185,7 @@ static es_status parse_mean(parser *p, form *f)
         const char *w = NULL, *v = NULL; /* set by word(); initialized for -O3 */
         size_t wl = 0, vl = 0;
         skip_ws(p);
-        size_t wat = p->pos;
+        size_t wat = p->sc.pos;
         if ((rc = word(p, is_id_char, "a column name", &w, &wl)) != ES_OK) break;
         /* es_store_select splits terms at ',' and the name from the value at
          * the first '=', so a quoted name cannot hold them */
@@ -232,13 +194,13 @@ static es_status parse_mean(parser *p, form *f)
             break;
         }
         skip_ws(p);
-        if (p->s[p->pos] != '=') {
+        if (p->sc.s[p->sc.pos] != '=') {
             char b[8];
-            rc = perr(p, p->pos, "expected '=' after the column name, found %s",
+            rc = perr(p, p->sc.pos, "expected '=' after the column name, found %s",
                       describe(p, b, sizeof b));
             break;
         }
-        p->pos++;
+        p->sc.pos++;
         skip_ws(p);
         if ((rc = word(p, is_id_char, "a value", &v, &vl)) != ES_OK) break;
         /* a value holding ',' is passed quoted (es_store_select's col="v") */
@@ -259,18 +221,18 @@ static es_status parse_mean(parser *p, form *f)
         if (q) filt[flen++] = '"';
         filt[flen] = '\0';
         skip_ws(p);
-        if (p->s[p->pos] == ',') {
-            p->pos++;
+        if (p->sc.s[p->sc.pos] == ',') {
+            p->sc.pos++;
             continue;
         }
-        if (p->s[p->pos] == ']') {
-            p->pos++;
+        if (p->sc.s[p->sc.pos] == ']') {
+            p->sc.pos++;
             break;
         }
         char b[8];
-        rc = !p->s[p->pos] ? perr(p, p->pos, "expected ']' to close the '[' at column %zu",
+        rc = !p->sc.s[p->sc.pos] ? perr(p, p->sc.pos, "expected ']' to close the '[' at column %zu",
                                   open + 1)
-                           : perr(p, p->pos, "expected ',' or ']', found %s",
+                           : perr(p, p->sc.pos, "expected ',' or ']', found %s",
                                   describe(p, b, sizeof b));
         break;
     }
@@ -286,13 +248,13 @@ static es_status parse_lerp(parser *p, form *f, size_t at)
     size_t pa, pb, pt;
     if ((rc = expect(p, '(')) != ES_OK) return rc;
     skip_ws(p);
-    pa = p->pos;
+    pa = p->sc.pos;
     if ((rc = parse_sum(p, &a)) != ES_OK || (rc = expect(p, ',')) != ES_OK) return rc;
     skip_ws(p);
-    pb = p->pos;
+    pb = p->sc.pos;
     if ((rc = parse_sum(p, &b)) != ES_OK || (rc = expect(p, ',')) != ES_OK) return rc;
     skip_ws(p);
-    pt = p->pos;
+    pt = p->sc.pos;
     if ((rc = parse_sum(p, &t)) != ES_OK || (rc = expect(p, ')')) != ES_OK) return rc;
     if (a.is_num) return perr(p, pa, "the first argument of lerp must be a point");
     if (b.is_num) return perr(p, pb, "the second argument of lerp must be a point");
@@ -310,31 +272,21 @@ static es_status parse_lerp(parser *p, form *f, size_t at)
 static es_status parse_primary(parser *p, form *f)
 {
     skip_ws(p);
-    size_t at = p->pos;
-    char c = p->s[at];
+    size_t at = p->sc.pos;
+    char c = p->sc.s[at];
     if (isdigit((unsigned char)c) || c == '.') return parse_number(p, f);
     if (c == '(') {
-        p->pos++;
+        p->sc.pos++;
         es_status rc = parse_sum(p, f);
         if (rc != ES_OK) return rc;
-        skip_ws(p);
-        if (p->s[p->pos] != ')') {
-            char b[8];
-            return perr(p, p->pos, "expected ')' to close the '(' at column %zu, found %s",
-                        at + 1, describe(p, b, sizeof b));
-        }
-        p->pos++;
-        return ES_OK;
+        return es__scan_expect_close(&p->sc, '(', ')', at);
     }
     if (!isalpha((unsigned char)c)) {
         char b[8];
         return perr(p, at, "expected a point or a number, found %s", describe(p, b, sizeof b));
     }
-    size_t i = at;
-    while (isalnum((unsigned char)p->s[i]) || p->s[i] == '_') i++;
-    size_t n = i - at;
-    const char *name = p->s + at;
-    p->pos = i;
+    size_t n = es__scan_span(&p->sc, es__scan_ident_char);
+    const char *name = p->sc.s + at;
 #define IS(lit) (n == sizeof(lit) - 1 && !memcmp(name, lit, n))
     if (IS("mean")) return parse_mean(p, f);
     if (IS("lerp")) return parse_lerp(p, f, at);
@@ -343,14 +295,14 @@ static es_status parse_primary(parser *p, form *f)
         const char *mw = NULL, *cw = NULL;
         size_t ml = 0, cl = 0;
         es_status rc;
-        if (p->s[p->pos] != ':') return perr(p, p->pos, "expected ':' after 'coef'");
-        p->pos++;
+        if (p->sc.s[p->sc.pos] != ':') return perr(p, p->sc.pos, "expected ':' after 'coef'");
+        p->sc.pos++;
         if ((rc = word(p, is_id_char, "a model name", &mw, &ml)) != ES_OK) return rc;
         if (memchr(mw, '/', ml)) return perr(p, at + 5, "a model name cannot contain '/'");
-        if (p->s[p->pos] != ':')
-            return perr(p, p->pos, "expected ':' and a coefficient after 'coef:%.*s' "
+        if (p->sc.s[p->sc.pos] != ':')
+            return perr(p, p->sc.pos, "expected ':' and a coefficient after 'coef:%.*s' "
                         "(coef:MODEL:COEF)", (int)ml, mw);
-        p->pos++;
+        p->sc.pos++;
         if ((rc = word(p, coef_char, "a coefficient name", &cw, &cl)) != ES_OK) return rc;
         char *a = es__malloc(p->ctx, ml + cl + 2);
         if (!a) return ES_ENOMEM;
@@ -362,11 +314,11 @@ static es_status parse_primary(parser *p, form *f)
         return rc;
     }
     if (IS("row") || IS("file") || IS("pc") || IS("diff")) {
-        if (p->s[p->pos] != ':')
-            return perr(p, p->pos, "expected ':' after '%.*s'", (int)n, name);
-        p->pos++;
+        if (p->sc.s[p->sc.pos] != ':')
+            return perr(p, p->sc.pos, "expected ':' after '%.*s'", (int)n, name);
+        p->sc.pos++;
         const char *w = NULL;
-        size_t wl = 0, wat = p->pos;
+        size_t wl = 0, wat = p->sc.pos;
         es_status rc;
         if (IS("row")) {
             if ((rc = word(p, is_id_char, "a row id", &w, &wl)) != ES_OK)
@@ -388,24 +340,24 @@ static es_status parse_primary(parser *p, form *f)
         /* pc:K (the PCA of --pca) or pc:NAME:K (the PCA named inline, as
          * coef:MODEL:COEF names its model). Digits not followed by ':' are
          * K, so pc:1-row:a stays pc:1 minus row:a. */
-        size_t j = p->pos;
-        while (isdigit((unsigned char)p->s[j])) j++;
-        if (j == p->pos || p->s[j] == ':') {
+        size_t j = p->sc.pos;
+        while (isdigit((unsigned char)p->sc.s[j])) j++;
+        if (j == p->sc.pos || p->sc.s[j] == ':') {
             if ((rc = word(p, is_id_char, "a PCA name or a component number", &w, &wl)) != ES_OK)
                 return rc;
-            if (p->s[p->pos] != ':')
-                return perr(p, p->pos, "expected ':' and a component number after 'pc:%.*s' "
+            if (p->sc.s[p->sc.pos] != ':')
+                return perr(p, p->sc.pos, "expected ':' and a component number after 'pc:%.*s' "
                             "(pc:K or pc:NAME:K)", (int)wl, w);
-            wat = ++p->pos;
+            wat = ++p->sc.pos;
         }
         int64_t k = 0;
-        j = p->pos;
-        while (isdigit((unsigned char)p->s[j]) && k < 1000000000) k = 10 * k + (p->s[j++] - '0');
-        if (j == p->pos || k < 1 || isalnum((unsigned char)p->s[j]) || p->s[j] == '_' ||
-            p->s[j] == '.')
+        j = p->sc.pos;
+        while (isdigit((unsigned char)p->sc.s[j]) && k < 1000000000) k = 10 * k + (p->sc.s[j++] - '0');
+        if (j == p->sc.pos || k < 1 || isalnum((unsigned char)p->sc.s[j]) || p->sc.s[j] == '_' ||
+            p->sc.s[j] == '.')
             return perr(p, wat, "expected a component number >= 1 after 'pc:%.*s%s'",
                         (int)wl, w ? w : "", w ? ":" : "");
-        p->pos = j;
+        p->sc.pos = j;
         return add_term(p, 1.0, ES_POINT_PC, w ? w : "", wl, k, f);
     }
 #undef IS
@@ -416,16 +368,16 @@ static es_status parse_primary(parser *p, form *f)
 static es_status parse_unary(parser *p, form *f)
 {
     skip_ws(p);
-    char c = p->s[p->pos];
+    char c = p->sc.s[p->sc.pos];
     if (c == '-' || c == '+') {
-        if (++p->depth > MAX_DEPTH) return perr(p, p->pos, "expression nested too deeply");
-        p->pos++;
+        if (++p->depth > MAX_DEPTH) return perr(p, p->sc.pos, "expression nested too deeply");
+        p->sc.pos++;
         es_status rc = parse_unary(p, f);
         p->depth--;
         if (rc == ES_OK && c == '-') scale_form(p, f, -1.0);
         return rc;
     }
-    if (++p->depth > MAX_DEPTH) return perr(p, p->pos, "expression nested too deeply");
+    if (++p->depth > MAX_DEPTH) return perr(p, p->sc.pos, "expression nested too deeply");
     es_status rc = parse_primary(p, f);
     p->depth--;
     return rc;
@@ -435,10 +387,10 @@ static es_status parse_unary(parser *p, form *f)
  * multiplication sign was left out ("2 pc:1"). */
 static es_status missing_star(parser *p, const form *f)
 {
-    char c = p->s[p->pos];
+    char c = p->sc.s[p->sc.pos];
     if (f->is_num && (isalpha((unsigned char)c) || isdigit((unsigned char)c) || c == '(' ||
                       c == '.'))
-        return perr(p, p->pos, "a '*' is missing between the number and what follows "
+        return perr(p, p->sc.pos, "a '*' is missing between the number and what follows "
                     "(write 2*pc:1, not 2 pc:1)");
     return ES_OK;
 }
@@ -449,12 +401,12 @@ static es_status parse_product(parser *p, form *f)
     while (rc == ES_OK) {
         skip_ws(p);
         if ((rc = missing_star(p, f)) != ES_OK) break;
-        char op = p->s[p->pos];
+        char op = p->sc.s[p->sc.pos];
         if (op != '*' && op != '/') break;
-        size_t at = p->pos++;
+        size_t at = p->sc.pos++;
         form g;
         skip_ws(p);
-        size_t gat = p->pos;
+        size_t gat = p->sc.pos;
         if ((rc = parse_unary(p, &g)) != ES_OK) break;
         if (op == '/') {
             if (!g.is_num) return perr(p, gat, "cannot divide by a point");
@@ -480,9 +432,9 @@ static es_status parse_sum(parser *p, form *f)
     es_status rc = parse_product(p, f);
     while (rc == ES_OK) {
         skip_ws(p);
-        char op = p->s[p->pos];
+        char op = p->sc.s[p->sc.pos];
         if (op != '+' && op != '-') break;
-        size_t at = p->pos++;
+        size_t at = p->sc.pos++;
         form g;
         if ((rc = parse_product(p, &g)) != ES_OK) break;
         if (f->is_num != g.is_num)
@@ -525,14 +477,15 @@ es_status es_point_parse(es_ctx *ctx, const char *text, es_point_expr **out)
     es_point_expr *x = es__calloc(ctx, 1, sizeof *x);
     if (!x) return ES_ENOMEM;
     x->ctx = ctx;
-    parser p = {ctx, text, 0, x, 0};
+    parser p = {ctx, {0}, x, 0};
     form f;
+    es__scan_init(&p.sc, ctx, text, "point", "the end of the expression", ES__SCAN_SPACE_BLANKS);
     es_status rc = parse_sum(&p, &f);
     if (rc == ES_OK) {
         skip_ws(&p);
-        if (text[p.pos]) {
+        if (text[p.sc.pos]) {
             char b[8];
-            rc = perr(&p, p.pos, "unexpected %s after the end of the expression",
+            rc = perr(&p, p.sc.pos, "unexpected %s after the end of the expression",
                       describe(&p, b, sizeof b));
         } else if (f.is_num) {
             rc = perr(&p, 0, "the expression is a number, not a point");

@@ -11,6 +11,7 @@
  */
 #include "store/store_pkg.h"
 #include "store/store_private.h"
+#include "core/scan.h"
 #include "core/suggest.h"
 
 #include <math.h>
@@ -562,6 +563,10 @@ void es_store_result_hint(es_ctx *ctx, es_store *s, const char *kind, const char
     es__fail(ctx, ES_OK, "%s", saved);
 }
 
+/* The row filter's names stop at ',' or '=', its unquoted values at ','. */
+static int filter_name_char(char c) { return c != ',' && c != '='; }
+static int filter_value_char(char c) { return c != ','; }
+
 es_status es_store_select(es_ctx *ctx, const es_store *s, const char *filter, int64_t **rows,
                           int64_t *nrows)
 {
@@ -572,20 +577,28 @@ es_status es_store_select(es_ctx *ctx, const es_store *s, const char *filter, in
     *rows = NULL;
     *nrows = 0;
     if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
-    for (const char *p = filter; p && *p;) {
-        const char *comma = strchr(p, ','), *end = comma ? comma : p + strlen(p);
-        const char *eq = memchr(p, '=', (size_t)(end - p));
+    /* terms column=value separated by ','; blanks are part of names and
+     * values, so the scanner skips none */
+    es__scan sc;
+    es__scan_init(&sc, ctx, filter ? filter : "", "store", "the end of the filter",
+                  ES__SCAN_SPACE_NONE);
+    while (!es__scan_at_end(&sc)) {
+        const char *p = sc.s + sc.pos, *eq = NULL, *w = NULL;
         char name[ES__MAX_COLUMN_NAME + 1];
+        size_t wl = 0;
         bool quoted = false;
-        if (eq && eq[1] == '"') {
-            /* col="value" may hold ',' (labels with commas) */
-            const char *close = strchr(eq + 2, '"');
-            if (!close || (close[1] && close[1] != ','))
+        es__scan_span(&sc, filter_name_char);
+        if (es__scan_peek(&sc) == '=') {
+            eq = sc.s + sc.pos++;
+            /* col="value" may hold ',' (labels with commas); "" is a value */
+            es__scan_result q = es__scan_quoted(&sc, &w, &wl);
+            quoted = q != ES__SCAN_NONE;
+            if (q == ES__SCAN_UNTERMINATED ||
+                (quoted && !es__scan_at_end(&sc) && es__scan_peek(&sc) != ','))
                 ES_FAIL(ctx, ES_EFORMAT, "store: bad quoted value in filter '%s'", filter);
-            quoted = true;
-            end = close + 1;
-            comma = *end == ',' ? end : NULL;
+            if (!quoted) es__scan_span(&sc, filter_value_char);
         }
+        const char *end = sc.s + sc.pos;
         if (!eq || eq == p)
             ES_FAIL(ctx, ES_EFORMAT, "store: bad filter term '%.*s' (want column=value)",
                     (int)(end - p), p);
@@ -608,7 +621,7 @@ es_status es_store_select(es_ctx *ctx, const es_store *s, const char *filter, in
         vals[nterms] = eq + 1 + quoted;
         vlen[nterms] = (size_t)(end - eq - 1) - 2 * (size_t)quoted;
         nterms++;
-        p = comma ? comma + 1 : end;
+        es__scan_accept(&sc, ',');
     }
     if (!(out = es__alloc_array(ctx, s->nrows ? s->nrows : 1, sizeof *out))) return ES_ENOMEM;
     for (int64_t i = 0; i < s->nrows; i++) {

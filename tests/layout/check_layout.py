@@ -3,8 +3,8 @@
 from the sources on every test run:
 
   1. lib/<module>/ includes only modules at or below its own place in the data
-     flow (core < parallel < mesh < meshio < store < ingest < stats < procrustes < embed <
-     morph < study < figure, synth), whether through their library-private headers or
+     flow (core < parallel < sparse < mesh < meshio < store < ingest < stats < procrustes <
+     embed < morph < study < figure, synth), whether through their library-private headers or
      their public headers; siblings (figure, synth) do not include each other;
      the numerical modules (stats, procrustes, embed, morph) take arrays and row
      callbacks and do not include the store at all;
@@ -12,7 +12,7 @@ from the sources on every test run:
      module (and carries the #error guard that enforces it at compile time);
   3. the include graph has no circles;
   4. no file in lib/ is over 800 lines, no command file (tools/cmd/) over 250;
-  5. hdf5.h only under lib/store, cholmod.h only under lib/embed, cairo.h only
+  5. hdf5.h only under lib/store, cholmod.h only under lib/sparse, cairo.h only
      under lib/figure, mpi.h only under lib/parallel (among lib/, tools/ and notebooks-c/);
   6. tools/ and notebooks-c/ include no private header of the library.
 
@@ -22,8 +22,8 @@ import os
 import re
 import sys
 
-ORDER = ["core", "parallel", "mesh", "meshio", "store", "ingest", "stats", "procrustes", "embed",
-         "morph", "study", "figure", "synth"]
+ORDER = ["core", "parallel", "sparse", "mesh", "meshio", "store", "ingest", "stats", "procrustes",
+         "embed", "morph", "study", "figure", "synth"]
 LEVEL = {m: i for i, m in enumerate(ORDER)}
 LEVEL["synth"] = LEVEL["figure"]          # beside figure, above study
 PUBLIC = {
@@ -39,7 +39,7 @@ PUBLIC = {
 }
 FOREIGN = {  # header pattern -> the only module that may include it
     re.compile(r"^(hdf5|H5[A-Za-z]*)\.h$"): "store",
-    re.compile(r"^cholmod[a-z_]*\.h$"): "embed",
+    re.compile(r"^cholmod[a-z_]*\.h$"): "sparse",
     re.compile(r"^cairo[a-z-]*\.h$"): "figure",
     re.compile(r"^mpi\.h$"): "parallel",
 }

@@ -1,5 +1,5 @@
-/* lib/embed/spd.c — sparse symmetric positive definite systems on CHOLMOD
- * for the modules above lib/embed (embed_private.h): Winkler et al.'s
+/* lib/sparse/spd.c — sparse symmetric positive definite systems on CHOLMOD
+ * for the modules above (sparse_private.h): Winkler et al.'s
  * blending matrices, one per patch of the hierarchy and factorized once
  * per topology, and the cotangent Laplacians of the conformal map's Newton
  * iterations, refactorized on a fixed pattern.
@@ -9,9 +9,8 @@
  * slot, so a refactorization only scatters new values. All matrices of a
  * set share one cholmod_common and its solve workspaces.
  */
-#include "embed/embed_private.h"
+#include "sparse/sparse_pkg.h"
 
-#include <cholmod.h>
 #include <stdlib.h>
 
 typedef struct spd_mat {
@@ -45,10 +44,8 @@ es_status es__spd_new(es_ctx *ctx, es__spd **out)
     *out = NULL;
     if (!s) return ES_ENOMEM;
     s->ctx = ctx;
-    cholmod_l_start(&s->cm);
+    es__sparse_start(&s->cm);
     s->started = 1;
-    s->cm.print = 0;
-    s->cm.error_handler = NULL;
     /* LL' also for the simplicial factors CHOLMOD picks for small matrices
      * (its default there is LDL', which factorizes indefinite matrices
      * without complaint) */

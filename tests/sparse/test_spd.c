@@ -1,15 +1,14 @@
-/* tests/embed/test_spd.c — the sparse SPD systems lib/embed offers the
- * modules above it (embed_private.h): solutions of random sparse SPD
+/* tests/sparse/test_spd.c — the sparse SPD systems lib/sparse offers the
+ * modules above it (sparse_private.h): solutions of random sparse SPD
  * matrices (a grid Laplacian with a positive diagonal and random weights,
  * off-diagonal entries given in either triangle and some split into
  * repeated triplets) checked against LAPACK's dense Cholesky solve (dposv,
  * an independent computation) for several right-hand sides with a leading
  * dimension above n; a numeric refactorization with new values on the same
  * triplets against dposv again; many matrices in one set; an indefinite
- * matrix refused with ES_ENUMERIC naming it; an index out of range refused;
- * the nearest rotation of a scaled rotation and of a reflection.
+ * matrix refused with ES_ENUMERIC naming it; an index out of range refused.
  */
-#include "embed/embed_private.h"
+#include "sparse/sparse_private.h"
 #include "es_test.h"
 
 #include <edgespace/edgespace.h>
@@ -137,29 +136,12 @@ static void test_solve(es_ctx *ctx)
     free(A), free(b), free(x), free(t.i), free(t.j), free(t.v);
 }
 
-static void test_rotation(void)
-{
-    /* 2 x a rotation about z by 0.3: the rotation comes back */
-    double c = cos(0.3), s = sin(0.3);
-    double m[9] = {2 * c, -2 * s, 0, 2 * s, 2 * c, 0, 0, 0, 2};
-    double r[9] = {c, -s, 0, s, c, 0, 0, 0, 1};
-    double f[9] = {1, 0, 0, 0, 1, 0, 0, 0, -1}, det;
-    ES_CHECK(es__rotation_nearest(m) == 0);
-    for (int i = 0; i < 9; i++) ES_CHECK_CLOSE(m[i], r[i], 0, 1e-12);
-    /* a reflection: the result is a proper rotation */
-    es__rotation_nearest(f);
-    det = f[0] * (f[4] * f[8] - f[5] * f[7]) - f[1] * (f[3] * f[8] - f[5] * f[6]) +
-          f[2] * (f[3] * f[7] - f[4] * f[6]);
-    ES_CHECK_CLOSE(det, 1.0, 0, 1e-12);
-}
-
 int main(void)
 {
     es_ctx *ctx;
     ES_TEST_BEGIN();
     if (es_ctx_new(&ctx) != ES_OK) return 1;
     test_solve(ctx);
-    test_rotation();
     es_ctx_free(ctx);
     ES_TEST_END();
 }
