@@ -551,8 +551,8 @@ static int embed(notebook *nb, study *s)
         printf("%s:   %-16s rms ratio %.3g, max rel %.3g, bending %.3f x the prior's, %.1f s\n",
                nb->name, s->pt_name[p], s->rep[p].rms_ratio, s->rep[p].max_rel,
                s->rep[p].bend_ratio, s->rep[p].t_total);
-        if ((rc = es_mesh_write(nb->ctx, nb_path(nb, "%s.obj", s->pt_name[p]), ES_FORMAT_OBJ,
-                                s->mesh, s->xyz + p * V3, NULL)) != ES_OK) {
+        if ((rc = es_meshio_write(nb->ctx, nb_path(nb, "%s.obj", s->pt_name[p]), ES_FORMAT_OBJ,
+                                  s->mesh, s->xyz + p * V3, NULL)) != ES_OK) {
             nb_fail(nb, rc, "writing a mesh");
             break;
         }

@@ -190,7 +190,7 @@ static int interpolate(notebook *nb, study *s)
     s->max_emb = s->rms_emb + s->nt;
     s->rms_lin = s->rms_emb + 2 * s->nt;
     s->max_lin = s->rms_emb + 3 * s->nt;
-    if ((rc = es_kabsch_align(nb->ctx, s->V, s->xb, s->xa, NULL, &rms)) != ES_OK ||
+    if ((rc = es_embed_align(nb->ctx, s->V, s->xb, s->xa, NULL, &rms)) != ES_OK ||
         (rc = es_embedder_new(nb->ctx, s->mesh, &emb)) != ES_OK)
         goto done;
     for (int64_t k = 0; k < s->nt; k++) {
@@ -216,8 +216,8 @@ static int interpolate(notebook *nb, study *s)
                "(%.1f s)\n", nb->name, t, r.rms_ratio, r.max_rel, s->rms_lin[k], s->max_lin[k],
                r.t_total);
         fflush(stdout);
-        if ((rc = es_mesh_write(nb->ctx, nb_path(nb, "frame_%02lld.obj", (long long)k),
-                                ES_FORMAT_OBJ, s->mesh, s->frames + V3 * k, NULL)) != ES_OK)
+        if ((rc = es_meshio_write(nb->ctx, nb_path(nb, "frame_%02lld.obj", (long long)k),
+                                  ES_FORMAT_OBJ, s->mesh, s->frames + V3 * k, NULL)) != ES_OK)
             goto done;
         nb_output(nb, nb_path(nb, "frame_%02lld.obj", (long long)k) + strlen(nb->outdir) + 1);
     }

@@ -228,8 +228,8 @@ static int embed_mean(notebook *nb, study *s)
     es_embedder_free(emb);
     free(prior);
     if (rc != ES_OK) return nb_fail(nb, rc, "embedding the mean");
-    if ((rc = es_mesh_write(nb->ctx, nb_path(nb, "mean_lengths.obj"), ES_FORMAT_OBJ, s->mesh,
-                            s->emb, NULL)) != ES_OK)
+    if ((rc = es_meshio_write(nb->ctx, nb_path(nb, "mean_lengths.obj"), ES_FORMAT_OBJ, s->mesh,
+                              s->emb, NULL)) != ES_OK)
         return nb_fail(nb, rc, "writing the mean");
     nb_output(nb, "mean_lengths.obj");
     nb_p(nb, "The mean embeds near the prior of equal weights on the poses: bending %.3f x "
@@ -294,8 +294,8 @@ static int procrustes_mean(notebook *nb, study *s)
     rc = es_embed_length_error(nb->ctx, s->mesh, s->proc, s->mean_len, 1, &s->proc_rms_ratio,
                                &s->proc_max_rel, &p99);
     if (rc == ES_OK)
-        rc = es_mesh_write(nb->ctx, nb_path(nb, "mean_procrustes.obj"), ES_FORMAT_OBJ, s->mesh,
-                           s->proc, NULL);
+        rc = es_meshio_write(nb->ctx, nb_path(nb, "mean_procrustes.obj"), ES_FORMAT_OBJ, s->mesh,
+                             s->proc, NULL);
     nb_output(nb, "mean_procrustes.obj");
     nb_p(nb, "Full GPA of the %lld poses converged in %lld iterations (RMS rho %.3g).",
          (long long)s->n, (long long)gr.iterations, gr.rmsrho);

@@ -174,9 +174,9 @@ static int load(notebook *nb, study *s)
     for (poses *p = &s->cat; p <= &s->arm; p++)
         for (int64_t i = 1; i < p->n; i++) {
             double rms;
-            es_status rc = es_kabsch_align_parts(nb->ctx, es_mesh_nverts(p->mesh), p->x[i],
-                                                 p->x[0], NULL,
-                                                 es_mesh_vertex_component(p->mesh), &rms);
+            es_status rc = es_embed_align_parts(nb->ctx, es_mesh_nverts(p->mesh), p->x[i],
+                                                p->x[0], NULL,
+                                                es_mesh_vertex_component(p->mesh), &rms);
             if (rc != ES_OK) return nb_fail(nb, rc, "alignment");
         }
     return 0;

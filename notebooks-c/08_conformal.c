@@ -208,8 +208,8 @@ static int report(notebook *nb, study *s)
         snprintf(labels[k], sizeof labels[k], "k = %.2f", s->k[k]);
         es_render_mesh_from(&rm[k], s->closed, s->frames + 3 * nv * k);
         rm[k].label = labels[k];
-        if (es_mesh_write(nb->ctx, nb_path(nb, "frame_%d.obj", k), ES_FORMAT_OBJ, s->closed,
-                          s->frames + 3 * nv * k, NULL) != ES_OK)
+        if (es_meshio_write(nb->ctx, nb_path(nb, "frame_%d.obj", k), ES_FORMAT_OBJ, s->closed,
+                            s->frames + 3 * nv * k, NULL) != ES_OK)
             return nb_fail(nb, ES_EIO, "frame file");
     }
     if (nb_csv_close(nb, f)) return 1;

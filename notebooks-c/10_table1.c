@@ -140,8 +140,8 @@ static int load(notebook *nb, study *s)
     for (int i = 0; i < s->np; i++) {
         double rms;
         pair *p = &s->p[i];
-        es_status rc = es_kabsch_align_parts(nb->ctx, es_mesh_nverts(p->mesh), p->xb, p->xa,
-                                             NULL, es_mesh_vertex_component(p->mesh), &rms);
+        es_status rc = es_embed_align_parts(nb->ctx, es_mesh_nverts(p->mesh), p->xb, p->xa,
+                                            NULL, es_mesh_vertex_component(p->mesh), &rms);
         if (rc != ES_OK) return nb_fail(nb, rc, "alignment");
     }
     return 0;

@@ -134,7 +134,7 @@ static int winkler(notebook *nb, study *s)
             double fit;
             if ((rc = es_embed_length_error(nb->ctx, m, o[j], len, 0, &s->w_rms[j][k], &mx,
                                             &p99)) == ES_OK &&
-                (rc = es_kabsch_align(nb->ctx, nv, o[j], member, NULL, &fit)) == ES_OK)
+                (rc = es_embed_align(nb->ctx, nv, o[j], member, NULL, &fit)) == ES_OK)
                 s->w_d[j][k] = fit / es_bbox_diagonal(nv, member);
             snprintf(labels[5 * j + k], sizeof labels[0], "t = %.1f: %.1f %%", t,
                      100 * s->w_d[j][k]);

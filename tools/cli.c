@@ -107,15 +107,15 @@ static int join_job(es_ctx *ctx, const char *verb)
 {
     static int registered;
     if (!es_parallel_available() || !es_parallel_launched()) return 0;
-    if (es_parallel_init(ctx, NULL, NULL) != ES_OK || es_ctx_join_parallel(ctx) != ES_OK) {
+    if (es_parallel_init(ctx, NULL, NULL) != ES_OK || es_parallel_join(ctx) != ES_OK) {
         fprintf(stderr, "edgespace %s: cannot join the MPI job: %s\n", verb, es_ctx_errmsg(ctx));
         return -1;
     }
     if (!registered++) atexit(finalize_mpi);
-    if (es_ctx_rank(ctx) != 0 &&
+    if (es_parallel_rank(ctx) != 0 &&
         (!freopen("/dev/null", "w", stdout) || !freopen("/dev/null", "w", stderr)))
         return -1;
-    if (es_ctx_nranks(ctx) > 1 && !runs_parallel(verb)) {
+    if (es_parallel_nranks(ctx) > 1 && !runs_parallel(verb)) {
         fprintf(stderr, "edgespace %s: does not run on the ranks of an MPI job yet (pca, model, gpa and ingest do); "
                 "run it as one process\n", verb);
         return -1;
@@ -135,7 +135,7 @@ es_ctx *cli_ctx_new(const char *verb)
         return NULL;
     }
     state.verb = verb;
-    state.tty = isatty(STDERR_FILENO) && es_ctx_rank(ctx) == 0;
+    state.tty = isatty(STDERR_FILENO) && es_parallel_rank(ctx) == 0;
     es_ctx_set_log(ctx, on_log, &state);
     es_ctx_set_progress(ctx, on_progress, &state);
     /* the memory a command may plan to use (embeddings refuse above it) */

@@ -107,18 +107,18 @@ int es__mat3_nearest_rotation(double *m)
     return 0;
 }
 
-es_status es_kabsch_align(es_ctx *ctx, int64_t nverts, double *xyz, const double *ref,
-                          const double *w, double *rms)
+es_status es_embed_align(es_ctx *ctx, int64_t nverts, double *xyz, const double *ref,
+                         const double *w, double *rms)
 {
-    return es_kabsch_align_parts(ctx, nverts, xyz, ref, w, NULL, rms);
+    return es_embed_align_parts(ctx, nverts, xyz, ref, w, NULL, rms);
 }
 
 /* One pass gathers every part's weighted centroids and cross-covariance,
  * one 3 x 3 SVD per part gives its rotation, one pass moves the vertices:
  * O(V + parts), so a mesh split into many pieces (seams cut open) costs no
  * more than one piece. */
-es_status es_kabsch_align_parts(es_ctx *ctx, int64_t nverts, double *xyz, const double *ref,
-                                const double *w, const int64_t *part, double *rms)
+es_status es_embed_align_parts(es_ctx *ctx, int64_t nverts, double *xyz, const double *ref,
+                               const double *w, const int64_t *part, double *rms)
 {
     int64_t np = 1;
     double *acc, ss = 0;   /* per part: sum w, centroid of xyz (3), of ref (3), h (9), r (9) */

@@ -209,7 +209,7 @@ static es_status shape_quality(es_ctx *ctx, es_embedder *emb, const double *xyz,
         p[i] = xyz[i];
         ps[i] = prior_xyz[i] * (s0 > 0 ? s1 / s0 : 1.0);
     }
-    if ((rc = es_kabsch_align(ctx, nv, p, ps, emb->vweight, &rms)) != ES_OK) return rc;
+    if ((rc = es_embed_align(ctx, nv, p, ps, emb->vweight, &rms)) != ES_OK) return rc;
     diag = es_bbox_diagonal(nv, ps);
     for (int64_t v = 0; v < nv; v++) {
         double d = 0;

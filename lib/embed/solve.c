@@ -586,8 +586,8 @@ static es_status embed_solve(es_embedder *emb, const double *target, double scal
     ref = ext && ext->align_ref ? ext->align_ref : init_xyz ? init_xyz : es_mesh_xyz(emb->mesh);
     if (o->align && ref) {
         double r;
-        if ((rc = es_kabsch_align_parts(ctx, nv, xyz, ref, emb->vweight,
-                                        es_mesh_vertex_component(emb->mesh), &r)) != ES_OK)
+        if ((rc = es_embed_align_parts(ctx, nv, xyz, ref, emb->vweight,
+                                       es_mesh_vertex_component(emb->mesh), &r)) != ES_OK)
             return rc;
         for (int64_t v = 0; v < nv; v++)
             if (emb->vweight[v] == 0)

@@ -107,7 +107,7 @@ es_status es_figure_color_file(es_ctx *ctx, const es_render_spec *spec, const ch
         ES_FAIL(ctx, ES_EINVAL, "color: no spec, mesh, scalar file or output path");
     const char *dot = strrchr(out_path, '.');
     bool vtp = dot && !strcasecmp(dot, ".vtp");
-    es_mesh_format fmt = vtp ? ES_FORMAT_AUTO : es_mesh_format_from_path(out_path);
+    es_mesh_format fmt = vtp ? ES_FORMAT_AUTO : es_meshio_format_from_path(out_path);
     if (!vtp && fmt != ES_FORMAT_PLY && fmt != ES_FORMAT_GLB)
         ES_FAIL(ctx, ES_EINVAL, "color: '%s': a coloured mesh is written as .ply, .glb or .vtp",
                 out_path);

@@ -53,7 +53,7 @@ es_status es_export_lengths_csv(es_ctx *ctx, es_store *s, const int64_t *rows, i
         if (stat(es_store_path(s), &so) == 0 && stat(path, &sp) == 0 &&
             so.st_dev == sp.st_dev && so.st_ino == sp.st_ino)
             ES_FAIL(ctx, ES_EINVAL, "export: '%s' is the store itself; not overwriting it", path);
-        if (es_file_is_hdf5(path))
+        if (es_store_is_hdf5(path))
             ES_FAIL(ctx, ES_EINVAL, "export: '%s' is an HDF5 file (a store?); not overwriting it "
                     "with CSV", path);
     }

@@ -1,5 +1,5 @@
 /* lib/meshio/mesh_io.c — mesh file reading and writing: format dispatch, the
- * shared builder, whole-file reading, es_mesh_read and es_mesh_write.
+ * shared builder, whole-file reading, es_meshio_read and es_meshio_write.
  *
  * Files are read whole into memory and parsed in place: for the OBJ files
  * this project reads (tens of MB per study) that is far faster than stdio
@@ -88,7 +88,7 @@ void es__mdbuild_finish(es__mdbuild *b)
 
 /* ---------------------------------------------------------------- dispatch */
 
-es_mesh_format es_mesh_format_from_path(const char *path)
+es_mesh_format es_meshio_format_from_path(const char *path)
 {
     const char *dot = path ? strrchr(path, '.') : NULL;
     const char *slash = path ? strrchr(path, '/') : NULL;
@@ -144,7 +144,7 @@ es_status es_meshdata_parse(es_ctx *ctx, const char *name, const char *buf, size
     if (!name) name = "<memory>";
     if (!buf && len) ES_FAIL(ctx, ES_EINVAL, "%s: buffer is NULL", name);
     if (!buf) buf = "";
-    if (format == ES_FORMAT_AUTO) format = es_mesh_format_from_path(name);
+    if (format == ES_FORMAT_AUTO) format = es_meshio_format_from_path(name);
     /* a UTF-8 byte order mark before a text format (editors on Windows);
      * PLY keeps it so that binary byte offsets stay those of the file */
     if (len >= 3 && !memcmp(buf, "\xEF\xBB\xBF", 3) && format != ES_FORMAT_PLY &&
@@ -202,7 +202,7 @@ static es_status meshdata_write(es_ctx *ctx, const char *path, es_mesh_format fo
     es_status rc;
     if (!path || !faces || !xyz || nverts <= 0 || nfaces < 0)
         ES_FAIL(ctx, ES_EINVAL, "mesh write: missing path, faces or positions");
-    if (format == ES_FORMAT_AUTO) format = es_mesh_format_from_path(path);
+    if (format == ES_FORMAT_AUTO) format = es_meshio_format_from_path(path);
     if (format == ES_FORMAT_AUTO)
         ES_FAIL(ctx, ES_EINVAL, "'%s': cannot tell the format (use .obj, .ply, .off, .stl or "
                 ".glb)", path);
@@ -246,11 +246,11 @@ es_status es__mesh_write_staged(es_ctx *ctx, const char *path, es_mesh_format fo
 
 /* ---------------------------------------------------------------- meshes */
 
-es_status es_mesh_read(es_ctx *ctx, const char *path, es_mesh **out)
+es_status es_meshio_read(es_ctx *ctx, const char *path, es_mesh **out)
 {
     es_meshdata md;
     es_status rc;
-    if (!out) ES_FAIL(ctx, ES_EINVAL, "es_mesh_read: out is NULL");
+    if (!out) ES_FAIL(ctx, ES_EINVAL, "es_meshio_read: out is NULL");
     *out = NULL;
     if ((rc = es_meshdata_read(ctx, path, ES_FORMAT_AUTO, &md)) != ES_OK) return rc;
     rc = es_mesh_new(ctx, md.nverts, md.nfaces, md.faces, md.xyz, out);
@@ -264,8 +264,8 @@ es_status es_mesh_read(es_ctx *ctx, const char *path, es_mesh **out)
     return rc;
 }
 
-es_status es_mesh_read_positions(es_ctx *ctx, const es_mesh *mesh, const char *path,
-                                 double *xyz)
+es_status es_meshio_read_positions(es_ctx *ctx, const es_mesh *mesh, const char *path,
+                                   double *xyz)
 {
     es_meshdata md;
     char want[17], got[17];
@@ -284,23 +284,23 @@ es_status es_mesh_read_positions(es_ctx *ctx, const es_mesh *mesh, const char *p
     return rc;
 }
 
-es_status es_mesh_write(es_ctx *ctx, const char *path, es_mesh_format format,
-                        const es_mesh *mesh, const double *xyz, const uint8_t *vertex_rgb)
+es_status es_meshio_write(es_ctx *ctx, const char *path, es_mesh_format format,
+                          const es_mesh *mesh, const double *xyz, const uint8_t *vertex_rgb)
 {
-    if (!mesh) ES_FAIL(ctx, ES_EINVAL, "es_mesh_write: mesh is NULL");
+    if (!mesh) ES_FAIL(ctx, ES_EINVAL, "es_meshio_write: mesh is NULL");
     if (!xyz) xyz = es_mesh_xyz(mesh);
     if (!xyz) ES_FAIL(ctx, ES_EINVAL, "'%s': no positions given and the mesh has none", path);
     return es__meshdata_write(ctx, path, format, es_mesh_nverts(mesh), es_mesh_nfaces(mesh),
                               es_mesh_faces(mesh), xyz, vertex_rgb);
 }
 
-es_status es_lengths_from_file(es_ctx *ctx, const es_mesh *mesh, const char *path, double *len,
-                               double *scale)
+es_status es_meshio_lengths_from_file(es_ctx *ctx, const es_mesh *mesh, const char *path,
+                                      double *len, double *scale)
 {
     double *xyz = es__alloc_array(ctx, 3 * es_mesh_nverts(mesh), sizeof *xyz);
     es_status rc;
     if (!xyz) return ES_ENOMEM;
-    if ((rc = es_mesh_read_positions(ctx, mesh, path, xyz)) == ES_OK &&
+    if ((rc = es_meshio_read_positions(ctx, mesh, path, xyz)) == ES_OK &&
         (rc = es_edge_lengths(ctx, mesh, xyz, len)) == ES_OK)
         rc = es_lengths_normalize(ctx, es_mesh_nedges(mesh), len, len, scale);
     es__free(ctx, xyz);

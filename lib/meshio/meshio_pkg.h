@@ -67,7 +67,7 @@ es_status es__ply_parse(es_ctx *ctx, const char *name, const char *buf, size_t l
 es_status es__off_parse(es_ctx *ctx, const char *name, const char *buf, size_t len,
                         es_meshdata *md);
 
-/* Writers over raw arrays (es_mesh_write gives them a mesh's faces).
+/* Writers over raw arrays (es_meshio_write gives them a mesh's faces).
  * faces 3 x nfaces 0-based, xyz 3 x nverts, rgb NULL or 3 x nverts. */
 es_status es__obj_write(es_ctx *ctx, const char *path, FILE *f, int64_t nverts,
                         int64_t nfaces, const int64_t *faces, const double *xyz);

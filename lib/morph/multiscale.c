@@ -353,8 +353,8 @@ es_status es_multiscale_interp(es_ctx *ctx, es_multiscale *ms, int64_t nin,
     if ((rc = es_interp_targets(ctx, mesh, nin, xyz, w, len, alpha, &inf)) != ES_OK ||
         (rc = es_multiscale_solve(ctx, ms, len, alpha, out)) != ES_OK)
         goto done;
-    rc = es_kabsch_align_parts(ctx, nv, out, align_to ? align_to : xyz[inf.reference], NULL,
-                               es_mesh_vertex_component(mesh), &rms);
+    rc = es_embed_align_parts(ctx, nv, out, align_to ? align_to : xyz[inf.reference], NULL,
+                              es_mesh_vertex_component(mesh), &rms);
     if (rc == ES_OK && info) *info = inf;
 done:
     es__free(ctx, len);

@@ -221,8 +221,8 @@ es_status es_shape_space_new(es_ctx *ctx, const es_mesh *mesh, const double *xa,
     memcpy(ss->xa, xa, 3 * (size_t)ss->nv * sizeof *xa);
     memcpy(ss->xb, xb, 3 * (size_t)ss->nv * sizeof *xb);
     /* the best rigid alignment of B to A before anything (Sec. 3, 5) */
-    if ((rc = es_kabsch_align_parts(ctx, ss->nv, ss->xb, ss->xa, NULL,
-                                    es_mesh_vertex_component(mesh), &rms)) != ES_OK ||
+    if ((rc = es_embed_align_parts(ctx, ss->nv, ss->xb, ss->xa, NULL,
+                                   es_mesh_vertex_component(mesh), &rms)) != ES_OK ||
         (rc = es_edge_lengths(ctx, mesh, ss->xa, ss->la)) != ES_OK ||
         (rc = es_edge_lengths(ctx, mesh, ss->xb, ss->lb)) != ES_OK)
         goto fail;

@@ -92,7 +92,7 @@ static void par_release(void *state)
     free(p);
 }
 
-es_status es_ctx_join_parallel(es_ctx *ctx)
+es_status es_parallel_join(es_ctx *ctx)
 {
     int done = 0, err;
     par *p;
@@ -125,7 +125,7 @@ static void count(par *p, int64_t messages, int64_t bytes)
     p->bytes += bytes;
 }
 
-es_status es_ctx_barrier(es_ctx *ctx)
+es_status es_parallel_barrier(es_ctx *ctx)
 {
     par *p = par_of(ctx);
     int err;
@@ -157,7 +157,7 @@ es_status es__par_agree(es_ctx *ctx, es_status rc)
     return (es_status)m.code;
 }
 
-es_status es_ctx_agree(es_ctx *ctx, es_status rc) { return es__par_agree(ctx, rc); }
+es_status es_parallel_agree(es_ctx *ctx, es_status rc) { return es__par_agree(ctx, rc); }
 
 /* Pieces of at most INT_MAX elements. */
 #define PIECE ((int64_t)INT_MAX)
@@ -311,15 +311,15 @@ es_status es_parallel_init(es_ctx *ctx, int *argc, char ***argv)
     return ES_OK;
 }
 void es_parallel_finalize(void) {}
-es_status es_ctx_join_parallel(es_ctx *ctx) { (void)ctx; return ES_OK; }
+es_status es_parallel_join(es_ctx *ctx) { (void)ctx; return ES_OK; }
 void es__par_traffic(const es_ctx *ctx, int64_t *messages, int64_t *bytes)
 {
     (void)ctx;
     *messages = *bytes = 0;
 }
-es_status es_ctx_barrier(es_ctx *ctx) { (void)ctx; return ES_OK; }
+es_status es_parallel_barrier(es_ctx *ctx) { (void)ctx; return ES_OK; }
 es_status es__par_agree(es_ctx *ctx, es_status rc) { (void)ctx; return rc; }
-es_status es_ctx_agree(es_ctx *ctx, es_status rc) { (void)ctx; return rc; }
+es_status es_parallel_agree(es_ctx *ctx, es_status rc) { (void)ctx; return rc; }
 es_status es__par_bcast(es_ctx *ctx, void *buf, size_t bytes, int root)
 {
     (void)ctx, (void)buf, (void)bytes, (void)root;
@@ -362,15 +362,15 @@ es_status es__par_alltoall(es_ctx *ctx, const double *send, const int64_t *send_
 
 #endif
 
-int es_ctx_rank(const es_ctx *ctx) { return es__par_rank(ctx); }
-int es_ctx_nranks(const es_ctx *ctx) { return es__par_size(ctx); }
+int es_parallel_rank(const es_ctx *ctx) { return es__par_rank(ctx); }
+int es_parallel_nranks(const es_ctx *ctx) { return es__par_size(ctx); }
 
-void es_ctx_share(const es_ctx *ctx, int64_t n, int64_t *lo, int64_t *hi)
+void es_parallel_share(const es_ctx *ctx, int64_t n, int64_t *lo, int64_t *hi)
 {
     es__par_split(n, es__par_size(ctx), es__par_rank(ctx), lo, hi);
 }
 
-void es_ctx_parallel_traffic(const es_ctx *ctx, int64_t *messages, int64_t *bytes)
+void es_parallel_traffic(const es_ctx *ctx, int64_t *messages, int64_t *bytes)
 {
     es__par_traffic(ctx, messages, bytes);
 }

@@ -31,7 +31,7 @@ static inline bool es__par_alone(const es_ctx *ctx) { return es__par_size(ctx) <
  * takes: the first n % size ranks take one more. */
 void es__par_split(int64_t n, int size, int p, int64_t *lo, int64_t *hi);
 
-/* The first failure of any rank (es_ctx_agree). */
+/* The first failure of any rank (es_parallel_agree). */
 es_status es__par_agree(es_ctx *ctx, es_status rc);
 
 /* v[0..n) summed over the ranks, the same bits on every rank (reduced to

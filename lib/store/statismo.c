@@ -245,7 +245,7 @@ static es_status check_target(es_ctx *ctx, const char *path)
 {
     hid_t f = -1;
     htri_t is_model = 0;
-    if (!es_file_is_hdf5(path)) return ES_OK;
+    if (!es_store_is_hdf5(path)) return ES_OK;
     if ((f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT)) >= 0 &&
         H5Lexists(f, "model", H5P_DEFAULT) > 0 && H5Lexists(f, "representer", H5P_DEFAULT) > 0)
         is_model = H5Lexists(f, "model/pcaBasis", H5P_DEFAULT);

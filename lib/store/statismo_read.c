@@ -251,7 +251,7 @@ es_status es_statismo_read(es_ctx *ctx, const char *path, es_statismo_data **out
     es_status rc;
     if (!path || !out) ES_FAIL(ctx, ES_EINVAL, "statismo: NULL argument");
     *out = NULL;
-    if (!es_file_is_hdf5(path))
+    if (!es_store_is_hdf5(path))
         ES_FAIL(ctx, ES_EFORMAT, "statismo: '%s' is not an HDF5 file (or cannot be read)", path);
     if ((rc = es__h5_check_file(ctx, path)) != ES_OK) return rc;
     if (!(m = es__calloc(ctx, 1, sizeof *m))) return ES_ENOMEM;

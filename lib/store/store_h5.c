@@ -504,7 +504,7 @@ bool es__h5_bad_name(const char *name)
     return !name || !*name || strchr(name, '/') || !strcmp(name, ".") || !strcmp(name, "..");
 }
 
-int es_file_is_hdf5(const char *path)
+int es_store_is_hdf5(const char *path)
 {
     htri_t is = 0;
     if (!path || access(path, F_OK) != 0) return 0;

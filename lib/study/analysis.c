@@ -61,7 +61,7 @@ es_status es_study_source(es_ctx *ctx, es_store *store, const int64_t *rows, int
 
 /* ---- means -------------------------------------------------------------------- */
 
-void es_group_result_free(es_group_result *r)
+void es_study_group_result_free(es_group_result *r)
 {
     if (!r) return;
     es_ctx *ctx = r->ctx;
@@ -185,7 +185,7 @@ es_status es_study_mean(es_ctx *ctx, es_store *store, const char *name, const ch
         r = NULL;
     }
 done:
-    es_group_result_free(r);
+    es_study_group_result_free(r);
     es__free(ctx, rows);
     es__free(ctx, (void *)labels);
     es__free(ctx, group);
@@ -644,7 +644,7 @@ es_status es_study_resolve(es_ctx *ctx, void *ud, es_point_leaf kind, const char
             ES_FAIL(ctx, ES_EINVAL, "store '%s' has no faces (a %s store), so mesh files "
                     "cannot be matched to it", es_store_path(r->store),
                     es_topology_kind_name(es_store_topology_kind(r->store)));
-        if ((rc = es_lengths_from_file(ctx, r->mesh, arg, vec, scale)) != ES_OK) return rc;
+        if ((rc = es_meshio_lengths_from_file(ctx, r->mesh, arg, vec, scale)) != ES_OK) return rc;
         return w ? file_weights(ctx, r, vec, w) : ES_OK;
     case ES_POINT_PC:
         return resolve_pc(ctx, r, arg, index, vec, scale, w);

@@ -62,7 +62,7 @@ static es_status choose_start(es_ctx *ctx, es_store *s, const es_mesh *mesh, con
         snprintf(desc, ndesc, "circular mean of dihedrals of %lld rows (%s)", (long long)*nsel,
                  init);
     } else if (!strncmp(init, "mesh:", 5)) {
-        if ((rc = es_mesh_read_positions(ctx, mesh, init + 5, init_xyz)) != ES_OK) return rc;
+        if ((rc = es_meshio_read_positions(ctx, mesh, init + 5, init_xyz)) != ES_OK) return rc;
         snprintf(desc, ndesc, "mesh %s", init + 5);
     } else {
         ES_FAIL(ctx, ES_EINVAL, "--init wants prior, nearest, row:ID, mean, mean[FILTER] or "
@@ -187,7 +187,7 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
      * renamed into place after the commit: a failed store write leaves no
      * mesh behind, and an old file as it was */
     if ((o->output && (rc = es__mesh_write_staged(ctx, o->output,
-                                                  es_mesh_format_from_path(o->output), mesh,
+                                                  es_meshio_format_from_path(o->output), mesh,
                                                   xyz, &files)) != ES_OK) ||
         (o->residuals && (rc = write_residuals(ctx, o->residuals, emb, nv, &files)) != ES_OK))
         goto done;

@@ -21,10 +21,10 @@ static es_status input_lengths(es_ctx *ctx, es_store *st, es_mesh **mesh, const 
     int64_t E = es_store_nedges(st), row;
     double scale;
     es_status rc;
-    if (es_mesh_format_from_path(in) != ES_FORMAT_AUTO) {
+    if (es_meshio_format_from_path(in) != ES_FORMAT_AUTO) {
         /* rows of a truss store project without a mesh; files need its faces */
         if (!*mesh && (rc = es_store_mesh(ctx, st, mesh)) != ES_OK) return rc;
-        return es_lengths_from_file(ctx, *mesh, in, x, &scale);
+        return es_meshio_lengths_from_file(ctx, *mesh, in, x, &scale);
     }
     if ((row = es_store_find_row(st, in)) < 0)
         ES_FAIL(ctx, ES_ENOTFOUND, "'%s' is neither a mesh file (.obj, .ply, .off) nor a row "

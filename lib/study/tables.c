@@ -18,7 +18,7 @@ es_status es__table_begin(es_ctx *ctx, const char *path, es__table_out *t)
         return ES_OK;
     }
     /* an HDF5 file here is most likely the store given as the CSV by mistake */
-    if (es_file_is_hdf5(path))
+    if (es_store_is_hdf5(path))
         ES_FAIL(ctx, ES_EIO, "'%s' is an HDF5 file (a store?); not overwriting it with CSV",
                 path);
     if ((rc = es__replace_begin(ctx, path, &t->w)) != ES_OK) return rc;

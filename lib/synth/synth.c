@@ -4,7 +4,7 @@
  * The shapes themselves are in synth_shapes.c. Subdivision numbers the new
  * vertices by edge id, so a subdivided family stays in correspondence and
  * the result is the same on every run. Members are written with the io
- * module's writer core es__meshdata_write (the body of es_mesh_write: OBJ,
+ * module's writer core es__meshdata_write (the body of es_meshio_write: OBJ,
  * %.17g, exact round trips), which takes the raw face list, so no topology
  * is built just to write files.
  */

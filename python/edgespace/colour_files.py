@@ -1,5 +1,5 @@
 """python/edgespace/colour_files.py — meshes for other viewers with their
-values on them: per-vertex colours for a PLY (es_mesh_write's vertex_rgb,
+values on them: per-vertex colours for a PLY (es_meshio_write's vertex_rgb,
 coloured by the library's colour maps, es_colormap_rgb) and VTK XML
 PolyData (.vtp) with named point and cell arrays, which ParaView colours
 itself. The .vtp writer is the VTK file format's ASCII PolyData, written

@@ -69,7 +69,7 @@ class Embedding(NamedTuple):
         return bytes(self.render(width=360, height=360)) if has("es_render") else None
 
     def write(self, path, mesh=None, ctx=None):
-        """Write the mesh file (OBJ/PLY/OFF by extension; es_mesh_write)."""
+        """Write the mesh file (OBJ/PLY/OFF by extension; es_meshio_write)."""
         m = mesh if mesh is not None else Mesh(self.F, ctx=ctx)
         m.write(path, self.V)
 
@@ -82,7 +82,7 @@ def study_embedding(xyz, faces, res):
     return Embedding(xyz, faces, rep)
 
 
-# es_mesh_write's formats (es_io.h's es_format), as the CLI's --format names them
+# es_meshio_write's formats (es_io.h's es_format), as the CLI's --format names them
 FORMATS = ("auto", "obj", "ply", "ply-ascii", "off", "stl", "glb")
 
 
@@ -170,7 +170,7 @@ class Mesh:
         return tuple(out)
 
     def write(self, path, vertices=None, format=None, colors=None, fmt=None):
-        """Write a mesh file (es_mesh_write: OBJ, PLY, OFF with exact
+        """Write a mesh file (es_meshio_write: OBJ, PLY, OFF with exact
         coordinates; STL, GLB in float32 for viewers) in `format` (the CLI's
         --format; default "auto": from the extension; fmt= is the old
         spelling). colors: (V, 3)
@@ -190,12 +190,12 @@ class Mesh:
                 c = np.round(np.clip(c, 0, 1) * 255)
             c = np.ascontiguousarray(c, dtype=np.uint8)
             rgb = ffi.from_buffer("uint8_t[]", c)
-        self.ctx.call(lib.es_mesh_write, A.cbytes(path, "path"), f, self._ptr, A.dptr(V), rgb)
+        self.ctx.call(lib.es_meshio_write, A.cbytes(path, "path"), f, self._ptr, A.dptr(V), rgb)
 
     def read_positions(self, path):
         """(V, 3) positions of a mesh file with this face list."""
         out = np.empty((self.nverts, 3))
-        self.ctx.call(lib.es_mesh_read_positions, self._ptr, A.cbytes(path, "path"),
+        self.ctx.call(lib.es_meshio_read_positions, self._ptr, A.cbytes(path, "path"),
                       A.dptr(out))
         return out
 
@@ -212,10 +212,10 @@ class Mesh:
 
 
 def read_mesh(path, ctx=None):
-    """A mesh file (OBJ, PLY, OFF) as a Mesh with its positions (es_mesh_read)."""
+    """A mesh file (OBJ, PLY, OFF) as a Mesh with its positions (es_meshio_read)."""
     ctx = ctx_of(ctx)
     p = ffi.new("es_mesh **")
-    ctx.call(lib.es_mesh_read, A.cbytes(path, "path"), p)
+    ctx.call(lib.es_meshio_read, A.cbytes(path, "path"), p)
     return Mesh._adopt(ctx, p[0])
 
 

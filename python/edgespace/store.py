@@ -580,7 +580,7 @@ class Store:
         with self._replacing(replace):
             self._call(lib.es_study_mean, _s(name) or ffi.NULL,
                       _s(where) or ffi.NULL, _s(by) or ffi.NULL, self._command("mean"), out)
-        r = A.owned(self.ctx, out[0], lib.es_group_result_free)
+        r = A.owned(self.ctx, out[0], lib.es_study_group_result_free)
         G, E = int(r.ngroups), int(r.nedges)
         res = MeanResult(groups=[A.string(r.names[g]) for g in range(G)],
                          means=A.view(r.means, (G, E), r),

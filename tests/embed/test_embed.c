@@ -20,7 +20,7 @@ static double aligned_rms(es_ctx *ctx, int64_t nv, const double *a, const double
 {
     double *c = malloc(3 * (size_t)nv * sizeof *c), rms = INFINITY;
     memcpy(c, a, 3 * (size_t)nv * sizeof *c);
-    if (es_kabsch_align(ctx, nv, c, b, NULL, &rms) != ES_OK) rms = INFINITY;
+    if (es_embed_align(ctx, nv, c, b, NULL, &rms) != ES_OK) rms = INFINITY;
     free(c);
     return rms;
 }
@@ -506,7 +506,7 @@ static void test_progress(es_ctx *ctx)
     sphere_close(&c);
 }
 
-/* es_kabsch_align_parts: two parts moved by different rigid motions come
+/* es_embed_align_parts: two parts moved by different rigid motions come
  * back each onto its reference; a vertex of part -1 stays where it is. */
 static void test_kabsch_parts(es_ctx *ctx)
 {
@@ -526,7 +526,7 @@ static void test_kabsch_parts(es_ctx *ctx)
     {
         double keep[3] = {x[15], x[16], x[17]};
         part[5] = 1;   /* first: the free vertex as part of part 1 (3 points fix it) */
-        ES_CHECK_OK(ctx, es_kabsch_align_parts(ctx, 6, x, ref, NULL, part, &rms));
+        ES_CHECK_OK(ctx, es_embed_align_parts(ctx, 6, x, ref, NULL, part, &rms));
         ES_CHECK(rms < 1e-14);
         for (int i = 0; i < 18; i++) ES_CHECK_CLOSE(x[i], ref[i], 0, 1e-14);
         /* again from the moved positions with vertex 5 in no part */
@@ -534,11 +534,11 @@ static void test_kabsch_parts(es_ctx *ctx)
         part[5] = -1;
         for (int v = 0; v < 5; v++)
             for (int i = 0; i < 3; i++) x[3 * v + i] += 0.5;
-        ES_CHECK_OK(ctx, es_kabsch_align_parts(ctx, 6, x, ref, NULL, part, NULL));
+        ES_CHECK_OK(ctx, es_embed_align_parts(ctx, 6, x, ref, NULL, part, NULL));
         for (int i = 0; i < 15; i++) ES_CHECK_CLOSE(x[i], ref[i], 0, 1e-14);
         ES_CHECK(x[15] == keep[0] && x[16] == keep[1] && x[17] == keep[2]);
     }
-    ES_CHECK_FAILS(ctx, es_kabsch_align_parts(ctx, 0, x, ref, NULL, part, NULL), ES_EINVAL,
+    ES_CHECK_FAILS(ctx, es_embed_align_parts(ctx, 0, x, ref, NULL, part, NULL), ES_EINVAL,
                    "empty");
 }
 

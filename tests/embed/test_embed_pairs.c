@@ -73,7 +73,7 @@ static void study_walk(es_ctx *ctx, const char *dir, const char *pa, const char 
         if (ref && sum.n_boundary_edges == 0) {
             double *c = malloc(3 * (size_t)nv * sizeof *c), rms;
             memcpy(c, ref, 3 * (size_t)nv * sizeof *c);
-            ES_CHECK_OK(ctx, es_kabsch_align(ctx, nv, c, walk, NULL, &rms));
+            ES_CHECK_OK(ctx, es_embed_align(ctx, nv, c, walk, NULL, &rms));
             fprintf(stderr, "%s (closed): the prior's walk is %.2g x diag from es_interp_embed\n",
                     dir, rms / diag);
             ES_CHECK_MSG(rms <= 1e-3 * diag, "%s: %g x diag from es_interp_embed", dir, rms / diag);

@@ -19,7 +19,7 @@ static double aligned_rms(es_ctx *ctx, int64_t nv, const double *a, const double
 {
     double *c = malloc(3 * (size_t)nv * sizeof *c), rms = INFINITY;
     memcpy(c, a, 3 * (size_t)nv * sizeof *c);
-    if (es_kabsch_align(ctx, nv, c, b, NULL, &rms) != ES_OK) rms = INFINITY;
+    if (es_embed_align(ctx, nv, c, b, NULL, &rms) != ES_OK) rms = INFINITY;
     free(c);
     return rms;
 }

@@ -44,7 +44,7 @@ static void trip(es_ctx *ctx, const char *data, const char *file, int closed, in
         ES_CHECK_OK(ctx, es_edge_lengths(ctx, mesh, md.xyz, len));
         ES_CHECK_OK(ctx, es_dihedral_angles(ctx, mesh, md.xyz, al));
         ES_CHECK_OK(ctx, es_embed_solve(ctx, emb, len, 0, al, NULL, NULL, out, &r));
-        ES_CHECK_OK(ctx, es_kabsch_align(ctx, nv, out, md.xyz, NULL, &rms));
+        ES_CHECK_OK(ctx, es_embed_align(ctx, nv, out, md.xyz, NULL, &rms));
         fprintf(stderr, "%s exact: vertex rms %.3g x diag, %.2f s\n", file, rms / diag, r.t_total);
         ES_CHECK_MSG(rms <= 1e-9 * diag, "%s: exact round trip %g x diag", file, rms / diag);
         for (int level = 0; level < 2; level++) {
@@ -53,7 +53,7 @@ static void trip(es_ctx *ctx, const char *data, const char *file, int closed, in
             es_rng_init(&rng, 11);
             for (int64_t e = 0; e < ne; e++) al[e] += sigma * es_rng_normal(&rng);
             ES_CHECK_OK(ctx, es_embed_solve(ctx, emb, len, 0, al, NULL, NULL, out, &r));
-            ES_CHECK_OK(ctx, es_kabsch_align(ctx, nv, out, md.xyz, NULL, &rms));
+            ES_CHECK_OK(ctx, es_embed_align(ctx, nv, out, md.xyz, NULL, &rms));
             fprintf(stderr, "%s noise %g rad: rms ratio %.3g, max %.3g, vertex rms %.3g x diag, "
                     "closure %.3g -> %.3g, stage 1 %lld it, refine %lld it, %.2f s\n", file,
                     sigma, r.rms_ratio, r.max_rel, rms / diag, r.closure_before, r.closure_after,

@@ -112,7 +112,7 @@ static double rigid_rms(es_ctx *ctx, int64_t nv, const double *x, const double *
 {
     double *a = malloc(3 * (size_t)nv * sizeof *a), r = INFINITY;
     memcpy(a, x, 3 * (size_t)nv * sizeof *a);
-    ES_CHECK_OK(ctx, es_kabsch_align(ctx, nv, a, ref, NULL, &r));
+    ES_CHECK_OK(ctx, es_embed_align(ctx, nv, a, ref, NULL, &r));
     free(a);
     return r;
 }

@@ -14,7 +14,11 @@ from the sources on every test run:
   4. no file in lib/ is over 800 lines, no command file (tools/cmd/) over 250;
   5. hdf5.h only under lib/store, cholmod.h only under lib/sparse, cairo.h only
      under lib/figure, mpi.h only under lib/parallel (among lib/, tools/ and notebooks-c/);
-  6. tools/ and notebooks-c/ include no private header of the library.
+  6. tools/ and notebooks-c/ include no private header of the library;
+  7. every public function is es_<family>_..., its family one of those its
+     module owns (FAMILIES: the module's name, the types it defines, a few
+     words such as es_bbox_), no family owned by two modules, and it is
+     declared in a public header of that module (es_core.h states the rule).
 
 Usage: check_layout.py SOURCE_ROOT. Prints every violation; exit 1 if any.
 """
@@ -43,6 +47,26 @@ FOREIGN = {  # header pattern -> the only module that may include it
     re.compile(r"^cairo[a-z-]*\.h$"): "figure",
     re.compile(r"^mpi\.h$"): "parallel",
 }
+# The families of public function names (es_<family>_...) each module owns:
+# the name says which module's header declares it.
+FAMILIES = {
+    "core": {"clock", "csv", "ctx", "free", "make", "rng", "strerror", "version"},
+    "parallel": {"parallel"},
+    "mesh": {"bbox", "corner", "dihedral", "edge", "faces", "lengths", "mesh"},
+    "meshio": {"meshdata", "meshio"},
+    "store": {"statismo", "store", "topology"},
+    "ingest": {"content", "export", "id", "ingest", "landmarks", "manifest"},
+    "stats": {"design", "diff", "effect", "fdr", "formula", "group", "groups", "mean", "model",
+              "pca", "point", "quantile", "source"},
+    "procrustes": {"compare", "gpa", "procrustes"},
+    "embed": {"embed", "embedder", "interp"},
+    "morph": {"conformal", "data", "lri", "morph", "multiscale", "shape"},
+    "study": {"study"},
+    "figure": {"colormap", "figure", "heatmap", "histogram", "lines", "palette", "plot",
+               "render", "scatter", "scree"},
+    "synth": {"synth"},
+}
+PUBLIC_FN = re.compile(r"ES_API\s+[^;(]*?\b(es_[a-z0-9_]+)\s*\(", re.S)
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]', re.M)
 LIB_MAX, CMD_MAX = 800, 250
 
@@ -159,6 +183,8 @@ def main(root):
                             not base.startswith("test"):
                         errors.append(f"{shown}: includes the private header {inc}")
 
+    errors += public_name_errors(root)
+
     # no circles in the include graph (depth-first search)
     state = {}
 
@@ -185,6 +211,32 @@ def main(root):
     return 1 if errors else 0
 
 
+def public_name_errors(root):
+    """Rule 7: each public function's family belongs to its header's module."""
+    errors, owner = [], {}
+    for mod, fams in FAMILIES.items():
+        for fam in fams:
+            if fam in owner:
+                errors.append(f"FAMILIES: es_{fam}_ is owned by {owner[fam]} and {mod}")
+            owner[fam] = mod
+    inc = os.path.join(root, "lib", "include", "edgespace")
+    for name in sorted(os.listdir(inc)) if os.path.isdir(inc) else []:
+        mod = PUBLIC.get(name)
+        if not mod:
+            continue
+        with open(os.path.join(inc, name), encoding="utf-8") as f:
+            text = f.read()
+        for fn in PUBLIC_FN.findall(text):
+            fam = fn.split("_")[1]
+            if fam not in owner:
+                errors.append(f"lib/include/edgespace/{name}: {fn}: es_{fam}_ is no module's "
+                              f"family (tests/layout/check_layout.py FAMILIES)")
+            elif owner[fam] != mod:
+                errors.append(f"lib/include/edgespace/{name}: {fn} is declared in a header of "
+                              f"{mod}, but es_{fam}_ is {owner[fam]}'s")
+    return errors
+
+
 def self_test():
     """The checker finds each kind of violation in a small made-up tree."""
     import tempfile
@@ -196,7 +248,8 @@ def self_test():
                 f.write(text)
         put("lib/include/edgespace/es_core.h", "")
         put("lib/include/edgespace/es_study.h", '#include "es_core.h"\n')
-        put("lib/include/edgespace/es_stats.h", '#include "es_study.h"\n')     # upward
+        put("lib/include/edgespace/es_stats.h", '#include "es_study.h"\n'     # upward
+            "ES_API int es_store_rows_of(void);\nES_API int es_wobble_x(void);\n")
         put("lib/core/a.c", '#include "embed/embed_pkg.h"\n#include <cairo.h>\n')
         put("lib/embed/embed_pkg.h", "/* no guard */\n")
         put("lib/stats/s.c", '#include "edgespace/es_store.h"\n')             # numeric
@@ -213,7 +266,9 @@ def self_test():
         want = ["es_study.h of study, above it", "embed/embed_pkg.h of embed, above it",
                 "private to lib/embed/", "<cairo.h>", "without its #ifndef ES_MODULE_EMBED",
                 "es_store.h of store", "include circle", "big.c: 801 lines",
-                "private core/core_private.h", "c.c: 251 lines"]
+                "private core/core_private.h", "c.c: 251 lines",
+                "es_store_rows_of is declared in a header of stats, but es_store_ is store's",
+                "es_wobble_x: es_wobble_ is no module's family"]
         missing = [w for w in want if w not in text]
         if rc != 1 or missing:
             print(text)

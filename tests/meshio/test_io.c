@@ -207,11 +207,11 @@ static void test_syntax(es_ctx *ctx)
     }
 
     /* format from the name, from the contents, or forced */
-    ES_CHECK(es_mesh_format_from_path("a/b.OBJ") == ES_FORMAT_OBJ);
-    ES_CHECK(es_mesh_format_from_path("x.ply") == ES_FORMAT_PLY);
-    ES_CHECK(es_mesh_format_from_path("x.off") == ES_FORMAT_OFF);
-    ES_CHECK(es_mesh_format_from_path("dir.obj/file") == ES_FORMAT_AUTO);
-    ES_CHECK(es_mesh_format_from_path("noext") == ES_FORMAT_AUTO);
+    ES_CHECK(es_meshio_format_from_path("a/b.OBJ") == ES_FORMAT_OBJ);
+    ES_CHECK(es_meshio_format_from_path("x.ply") == ES_FORMAT_PLY);
+    ES_CHECK(es_meshio_format_from_path("x.off") == ES_FORMAT_OFF);
+    ES_CHECK(es_meshio_format_from_path("dir.obj/file") == ES_FORMAT_AUTO);
+    ES_CHECK(es_meshio_format_from_path("noext") == ES_FORMAT_AUTO);
     ES_CHECK_OK(ctx, parse_str(ctx, "<memory>", offs[0], &md));
     ES_CHECK_OK(ctx, parse_str(ctx, "<memory>", "# c\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
                                "v 0 0 1\nf 1 3 2\n", &md2));
@@ -528,7 +528,7 @@ static void test_mesh(es_ctx *ctx)
     es_meshdata md;
     const char *tmp = ES_BUILD_ROOT "/test_io_mesh.ply";
 
-    ES_CHECK_OK(ctx, es_mesh_read(ctx, SRC "/valid/cube.obj", &mesh));
+    ES_CHECK_OK(ctx, es_meshio_read(ctx, SRC "/valid/cube.obj", &mesh));
     if (!mesh) return;
     ES_CHECK(es_mesh_nverts(mesh) == 8 && es_mesh_nfaces(mesh) == 12 &&
              es_mesh_nedges(mesh) == 18);
@@ -536,9 +536,9 @@ static void test_mesh(es_ctx *ctx)
     ES_CHECK(es_mesh_xyz(mesh) && !memcmp(es_mesh_xyz(mesh), cube_xyz, sizeof cube_xyz));
 
     /* the mesh's own positions, then given ones with colours */
-    ES_CHECK_OK(ctx, es_mesh_write(ctx, tmp, ES_FORMAT_AUTO, mesh, NULL, NULL));
+    ES_CHECK_OK(ctx, es_meshio_write(ctx, tmp, ES_FORMAT_AUTO, mesh, NULL, NULL));
     ES_CHECK_OK(ctx, es_meshdata_read(ctx, tmp, ES_FORMAT_AUTO, &md));
-    check_arrays(&md, 8, cube_xyz, 12, cube_faces, "es_mesh_write");
+    check_arrays(&md, 8, cube_xyz, 12, cube_faces, "es_meshio_write");
     es_meshdata_clear(ctx, &md);
     double moved[24];
     uint8_t rgb[24];
@@ -546,8 +546,8 @@ static void test_mesh(es_ctx *ctx)
         moved[i] = cube_xyz[i] * 0.1 + 1.0 / 3.0;
         rgb[i] = (uint8_t)(i * 10);
     }
-    ES_CHECK_OK(ctx, es_mesh_write(ctx, tmp, ES_FORMAT_PLY_ASCII, mesh, moved, rgb));
-    ES_CHECK_OK(ctx, es_mesh_read(ctx, tmp, &m2));
+    ES_CHECK_OK(ctx, es_meshio_write(ctx, tmp, ES_FORMAT_PLY_ASCII, mesh, moved, rgb));
+    ES_CHECK_OK(ctx, es_meshio_read(ctx, tmp, &m2));
     if (m2) {
         ES_CHECK(!memcmp(es_mesh_xyz(m2), moved, sizeof moved));
         ES_CHECK(!memcmp(es_mesh_faces(m2), cube_faces, sizeof cube_faces));
@@ -556,7 +556,7 @@ static void test_mesh(es_ctx *ctx)
     m2 = NULL;
 
     /* a parse error and a topology error both name the file */
-    ES_CHECK_FAILS(ctx, es_mesh_read(ctx, SRC "/malformed/obj_face_2.obj", &m2), ES_EFORMAT,
+    ES_CHECK_FAILS(ctx, es_meshio_read(ctx, SRC "/malformed/obj_face_2.obj", &m2), ES_EFORMAT,
                    "obj_face_2.obj:5:");
     ES_CHECK(m2 == NULL);
     FILE *f = fopen(ES_BUILD_ROOT "/test_io_nonmanifold.obj", "w");
@@ -564,7 +564,7 @@ static void test_mesh(es_ctx *ctx)
         fputs("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 1\n"
               "f 1 2 3\nf 1 2 4\nf 2 1 5\n", f);   /* edge 1-2 in three faces */
         fclose(f);
-        ES_CHECK_FAILS(ctx, es_mesh_read(ctx, ES_BUILD_ROOT "/test_io_nonmanifold.obj", &m2),
+        ES_CHECK_FAILS(ctx, es_meshio_read(ctx, ES_BUILD_ROOT "/test_io_nonmanifold.obj", &m2),
                        ES_ETOPOLOGY, "test_io_nonmanifold.obj: ");
         ES_CHECK(m2 == NULL);
         remove(ES_BUILD_ROOT "/test_io_nonmanifold.obj");
@@ -633,7 +633,7 @@ static void test_shared(es_ctx *ctx)
         es_meshdata_clear(ctx, &md);
         /* and they are oriented manifolds */
         es_mesh *mesh = NULL;
-        ES_CHECK_OK(ctx, es_mesh_read(ctx, path, &mesh));
+        ES_CHECK_OK(ctx, es_meshio_read(ctx, path, &mesh));
         ES_CHECK(mesh && es_mesh_nfaces(mesh) == sets[i].nf);
         es_mesh_free(mesh);
     }

@@ -28,7 +28,7 @@ static double aligned_rms(es_ctx *ctx, int64_t nv, const double *a, const double
 {
     double *c = malloc(3 * (size_t)nv * sizeof *c), rms = INFINITY;
     memcpy(c, a, 3 * (size_t)nv * sizeof *c);
-    if (es_kabsch_align(ctx, nv, c, b, NULL, &rms) != ES_OK) rms = INFINITY;
+    if (es_embed_align(ctx, nv, c, b, NULL, &rms) != ES_OK) rms = INFINITY;
     free(c);
     return rms / es_bbox_diagonal(nv, b);
 }
@@ -71,7 +71,7 @@ int main(void)
         rms = rep.rms_ratio, mx = rep.max_rel;
         memcpy(avg, in[1], 3 * (size_t)nv * sizeof *avg);
         double fit;
-        ES_CHECK_OK(ctx, es_kabsch_align(ctx, nv, avg, in[0], NULL, &fit));
+        ES_CHECK_OK(ctx, es_embed_align(ctx, nv, avg, in[0], NULL, &fit));
         for (int64_t i = 0; i < 3 * nv; i++) avg[i] = 0.5 * (avg[i] + in[0][i]);
         double d = aligned_rms(ctx, nv, out, avg), d0 = aligned_rms(ctx, nv, in[0], avg);
         double d1 = aligned_rms(ctx, nv, in[1], avg);

@@ -31,7 +31,7 @@ static double aligned_rms(es_ctx *ctx, const es_mesh *m, const double *a, const 
     int64_t nv = es_mesh_nverts(m);
     double *c = malloc(3 * (size_t)nv * sizeof *c), rms = INFINITY;
     memcpy(c, a, 3 * (size_t)nv * sizeof *c);
-    if (es_kabsch_align_parts(ctx, nv, c, b, NULL, es_mesh_vertex_component(m), &rms) != ES_OK)
+    if (es_embed_align_parts(ctx, nv, c, b, NULL, es_mesh_vertex_component(m), &rms) != ES_OK)
         rms = INFINITY;
     free(c);
     return rms / es_bbox_diagonal(nv, b);

@@ -95,7 +95,7 @@ static void test_tube(es_ctx *ctx)
         for (int64_t i = 0; i < 3 * nv; i++) d = fmax(d, fabs(x[i] - set.xyz[i]));
         ES_CHECK_MSG(d < 1e-9 * diag, "frame 0 is %g x diag from A", d / diag);
         memcpy(b, set.xyz + 6 * nv, 3 * (size_t)nv * sizeof *b);
-        ES_CHECK_OK(ctx, es_kabsch_align(ctx, nv, b, set.xyz, NULL, &rms));
+        ES_CHECK_OK(ctx, es_embed_align(ctx, nv, b, set.xyz, NULL, &rms));
         ES_CHECK_OK(ctx, es_shape_space_frame(ctx, ss, NULL, 1, x));
         d = 0;
         for (int64_t i = 0; i < 3 * nv; i++) d = fmax(d, fabs(x[i] - b[i]));
@@ -106,7 +106,7 @@ static void test_tube(es_ctx *ctx)
         ES_CHECK_OK(ctx, es_embed_length_error(ctx, m, x, l, 0, &rms, &mx, &p99));
         es_shape_space_get_info(ss, &info);
         memcpy(b, set.xyz + 3 * nv, 3 * (size_t)nv * sizeof *b);
-        ES_CHECK_OK(ctx, es_kabsch_align(ctx, nv, x, b, NULL, &d));
+        ES_CHECK_OK(ctx, es_embed_align(ctx, nv, x, b, NULL, &d));
         fprintf(stderr, "closed tube 0 -> 180 deg, t = 0.5: shape space rms %.3g%%, max %.3g%%, "
                 "%.3g%% of diag from the 90 degree member; %lld of %lld dual arcs in the tree, "
                 "%lld candidates (at most %lld per vertex)\n", 100 * rms, 100 * mx,

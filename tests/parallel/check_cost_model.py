@@ -7,7 +7,7 @@ into a new store and appended to it) and P, it compares with the model's
 function for the same sizes:
   - the bytes each rank read (the row source's callback, or ingest's count of
     mesh-file bytes), rank by rank: exact;
-  - rank 0's messages (es_ctx_parallel_traffic): exact;
+  - rank 0's messages (es_parallel_traffic): exact;
   - rank 0's bytes sent: exact. One term of ingest's is the length of the
     store's working copy's path, which rank 0 broadcasts: its name holds the pid
     and the clock (.<name>.tmp-<pid>-<pointer><ns><n>), so parallel_counts finds

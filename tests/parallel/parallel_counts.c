@@ -9,7 +9,7 @@
  * callback for PCA; for ingest the library's own count of mesh-file bytes,
  * es_ingest_report.bytes_read_rank, whose files' sizes the line lists), and
  * messages and sent (what this rank sent in the library's collectives,
- * es_ctx_parallel_traffic, before and after the call). Routes: PCA's Gram
+ * es_parallel_traffic, before and after the call). Routes: PCA's Gram
  * route on rows exchanged all-to-all, the randomized route, GPA on the exact
  * and the power-iteration Ten Berge routes and partial GPA (es_gpa_align_ranks;
  * each rank is handed its share, so GPA reads nothing here), and ingest of
@@ -52,7 +52,7 @@ static es_status read_rows(es_ctx *ctx, const es_source *src, int64_t row0, int6
 static void traffic_since(es_ctx *job, int64_t *m, int64_t *b)
 {
     int64_t m1, b1;
-    es_ctx_parallel_traffic(job, &m1, &b1);
+    es_parallel_traffic(job, &m1, &b1);
     *m = m1 - *m;
     *b = b1 - *b;
 }
@@ -68,7 +68,7 @@ static void pca_route(es_ctx *job, rows *d, es_pca_method method, int64_t K, int
     o.method = method;
     o.ncomp = K;
     d->bytes = 0;
-    es_ctx_parallel_traffic(job, &m, &b);
+    es_parallel_traffic(job, &m, &b);
     ES_CHECK_OK(job, es_pca_fit(job, &src, &o, &p));
     traffic_since(job, &m, &b);
     /* the Gram route sends the components it found (K, or fewer for a
@@ -87,7 +87,7 @@ static void gpa_route(es_ctx *job, int64_t k, int d, int64_t n, int scale, const
     int64_t lo, hi, m = 0, b = 0;
     es_gpa_opts o;
     es_gpa_report rep;
-    es_ctx_share(job, n, &lo, &hi);
+    es_parallel_share(job, n, &lo, &hi);
     double *x = es_test_configurations(k, d, n, 11 + (uint64_t)n);
     double *mine = malloc((size_t)(kd * (hi - lo) + 1) * 8);
     double *res = calloc((size_t)(kd + (3 + d * d + d) * n), sizeof *res);
@@ -98,7 +98,7 @@ static void gpa_route(es_ctx *job, int64_t k, int d, int64_t n, int scale, const
     es_gpa_opts_init(&o);
     o.scale = scale;
     memset(&rep, 0, sizeof rep);
-    es_ctx_parallel_traffic(job, &m, &b);
+    es_parallel_traffic(job, &m, &b);
     ES_CHECK_OK(job, es_gpa_align_ranks(job, k, d, n, (es_mat){mine, kd, hi - lo, kd}, &o, &go,
                                         &rep));
     traffic_since(job, &m, &b);
@@ -149,7 +149,7 @@ static void ingest_route(es_ctx *job, const char *dir, char **files, const int *
     o.block_rows = block;
     o.threads = 1;
     memset(&rep, 0, sizeof rep);
-    es_ctx_parallel_traffic(job, &m, &b);
+    es_parallel_traffic(job, &m, &b);
     ES_CHECK_OK(job, es_ingest_files(job, store, n, (const char *const *)files, &o, &rep));
     traffic_since(job, &m, &b);
     es_ctx_set_progress(job, NULL, NULL);
@@ -231,7 +231,7 @@ int main(int argc, char **argv)
             if (!known[i]) ES_CHECK(es_test_write_torus(more[i], 14, 8, 20 + i) == 0);
         }
     }
-    ES_CHECK_OK(run.job, es_ctx_barrier(run.job));   /* the files are there for every rank */
+    ES_CHECK_OK(run.job, es_parallel_barrier(run.job));   /* the files are there for every rank */
     ingest_route(run.job, dir, files, none, 11, 2, "ingest_new");
     ingest_route(run.job, dir, more, known, 11, 3, "ingest_append");
     for (int i = 0; i < 11; i++) {

@@ -33,7 +33,7 @@ static void check(es_ctx *job, es_ctx *alone, int64_t k, int d, int64_t n, int s
     es_gpa_opts o;
     es_gpa_opts_init(&o);
     o.scale = scale;
-    es_ctx_share(job, n, &lo, &hi);
+    es_parallel_share(job, n, &lo, &hi);
     double *x = es_test_configurations(k, d, n, 7 + (uint64_t)n);
     double *mine = malloc((size_t)(kd * (hi - lo) + 1) * 8);
     memcpy(mine, x + lo * kd, (size_t)(kd * (hi - lo)) * sizeof *x);
@@ -92,7 +92,7 @@ int main(int argc, char **argv)
     {
         const int64_t k = 10, kd = 30, n = 13;
         int64_t lo, hi;
-        es_ctx_share(job, n, &lo, &hi);
+        es_parallel_share(job, n, &lo, &hi);
         double *x = es_test_configurations(k, 3, n, 3);
         for (int64_t v = 0; v < kd; v++) x[(n - 1) * kd + v] = 1.0;
         ES_CHECK_FAILS(job, es_gpa_align_ranks(job, k, 3, n, (es_mat){x + lo * kd, kd, hi - lo, kd},
@@ -101,7 +101,7 @@ int main(int argc, char **argv)
         free(x);
     }
     int64_t msgs = 0, bytes = 0;
-    es_ctx_parallel_traffic(job, &msgs, &bytes);
+    es_parallel_traffic(job, &msgs, &bytes);
     ES_CHECK(P == 1 ? msgs == 0 : msgs > 0);
     if (me == 0) printf("rank 0 sent %lld messages, %lld bytes\n", (long long)msgs, (long long)bytes);
     return es_test_job_end(&run);

@@ -179,7 +179,7 @@ int main(int argc, char **argv)
     }
     free(d.X);
     int64_t msgs = 0, bytes = 0;
-    es_ctx_parallel_traffic(job, &msgs, &bytes);
+    es_parallel_traffic(job, &msgs, &bytes);
     ES_CHECK(P == 1 ? msgs == 0 && bytes == 0 : msgs > 0 && bytes > 0);
     if (me == 0) printf("rank 0 sent %lld messages, %lld bytes\n", (long long)msgs, (long long)bytes);
     return es_test_job_end(&run);

@@ -46,7 +46,7 @@ static double fitted_distance(es_ctx *ctx, const es_mesh *m, const double *xyz,
         for (int64_t e = 0; e < ne; e++) s1 += l[e];
         for (int64_t i = 0; i < 3 * nv; i++) b[i] *= s1 / s0;
     }
-    if (es_kabsch_align(ctx, nv, a, b, NULL, &rms) != ES_OK) rms = INFINITY;
+    if (es_embed_align(ctx, nv, a, b, NULL, &rms) != ES_OK) rms = INFINITY;
     double d = rms / es_bbox_diagonal(nv, b);
     free(a), free(b), free(l);
     return d;
@@ -133,7 +133,7 @@ static void evaluate(es_ctx *ctx, const char *store, int64_t nheld, char **held,
     for (int64_t i = 0; i < nheld; i++) {
         snprintf(point, sizeof point, "file:%s", held[i]);
         if (!embed_point(ctx, s, point, xyz, &r)) continue;
-        ES_CHECK_OK(ctx, es_mesh_read_positions(ctx, m, held[i], truth));
+        ES_CHECK_OK(ctx, es_meshio_read_positions(ctx, m, held[i], truth));
         double d = fitted_distance(ctx, m, xyz, truth, 0);
         fprintf(stderr, "a %-40s %.4f %% bbox from the real mesh, max edge %.3f %%, length RMS "
                 "%.4f %%, bending %.4f\n", strrchr(held[i], '/') + 1, 100 * d, 100 * r.max_rel,

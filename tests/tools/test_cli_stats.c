@@ -219,7 +219,7 @@ int main(void)
             for (int64_t e = 0; e < n1; e++) ES_CHECK_CLOSE(pt[e], g->means[e] + dm[e], 1e-14, 1e-17);
             ES_CHECK(n3 == 1 && sc[0] == g->scales[0]);
         }
-        es_group_result_free(g);
+        es_study_group_result_free(g);
         g = NULL;
         /* library-level refusals */
         es_pca *pp = NULL;

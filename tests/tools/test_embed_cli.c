@@ -26,7 +26,7 @@ static void check_frames_do_not_jump(const char *dir, const char *stem, int widt
             for (int64_t k = 0; k < 3 * cur.nverts; k++)
                 raw += (cur.xyz[k] - prev.xyz[k]) * (cur.xyz[k] - prev.xyz[k]);
             raw = sqrt(raw / (double)cur.nverts);
-            ES_CHECK_OK(ctx, es_kabsch_align(ctx, cur.nverts, cur.xyz, prev.xyz, NULL, &fitted));
+            ES_CHECK_OK(ctx, es_embed_align(ctx, cur.nverts, cur.xyz, prev.xyz, NULL, &fitted));
             ES_CHECK_MSG(raw <= fitted * (1 + 1e-6) + 1e-9, "%s: %g from the frame before, %g "
                          "after a rigid fit", name, raw, fitted);
         }
@@ -261,7 +261,7 @@ int main(void)
             snprintf(w2, sizeof w2, "%s/walk_2.obj", dir);
             double *xw = es_test_obj_positions(w2, &nw), worst = 0;
             ES_CHECK(es_ctx_new(&c2) == ES_OK);
-            if (c2) ES_CHECK_OK(c2, es_mesh_read(c2, p, &m2));
+            if (c2) ES_CHECK_OK(c2, es_meshio_read(c2, p, &m2));
             if (m2 && xw && nw == es_mesh_nverts(m2)) {
                 int64_t ne = es_mesh_nedges(m2);
                 double *l0 = malloc((size_t)ne * sizeof *l0), *l1 = malloc((size_t)ne * sizeof *l1);

@@ -144,7 +144,7 @@ static void run(es_ctx *ctx, const char *dir, const char *a, const char *b, int 
             double *prior = malloc((3 * (size_t)nv + 2 * (size_t)ne) * sizeof *prior);
             double *a2 = malloc(2 * (size_t)ne * sizeof *a2);
             memcpy(bb, xyz + 3 * nv, 3 * (size_t)nv * sizeof *bb);
-            es_kabsch_align(ctx, nv, bb, xyz, NULL, &rms);
+            es_embed_align(ctx, nv, bb, xyz, NULL, &rms);
             es_dihedral_angles(ctx, mesh, xyz, a2);
             es_dihedral_angles(ctx, mesh, bb, a2 + ne);
             const double *rows[2] = {xyz, bb}, *alr[2] = {a2, a2 + ne};

@@ -81,7 +81,7 @@ static void run(es_ctx *ctx, const char *file, int closed)
                 w0 = bench_wall_s();
                 if (es_embed_solve(ctx, emb, len, 0, al, NULL, NULL, out, &r)) goto fail;
                 w0 = bench_wall_s() - w0;
-                es_kabsch_align(ctx, nv, out, md.xyz, NULL, &rms);
+                es_embed_align(ctx, nv, out, md.xyz, NULL, &rms);
                 print_row(file, nv, sigma, seed, "", &r, rms / diag, w0);
                 if (long_runs && level) {
                     es_embed_opts o;
@@ -94,7 +94,7 @@ static void run(es_ctx *ctx, const char *file, int closed)
                     w0 = bench_wall_s();
                     if (es_embed_solve(ctx, emb, len, 0, al, NULL, &o, out, &r)) goto fail;
                     w0 = bench_wall_s() - w0;
-                    es_kabsch_align(ctx, nv, out, md.xyz, NULL, &rms);
+                    es_embed_align(ctx, nv, out, md.xyz, NULL, &rms);
                     print_row(file, nv, sigma, seed, " long", &r, rms / diag, w0);
                 }
             }
@@ -112,7 +112,7 @@ static void run(es_ctx *ctx, const char *file, int closed)
                 for (int64_t i = 0; i < 3 * nv; i++)
                     x0[i] = md.xyz[i] + moves[m] * diag * es_rng_normal(&rng);
                 if (es_embed_solve(ctx, emb, len, 0, NULL, x0, &o, out, &r)) goto fail;
-                es_kabsch_align(ctx, nv, out, md.xyz, NULL, &rms);
+                es_embed_align(ctx, nv, out, md.xyz, NULL, &rms);
                 printf("%-34s %6lld  moved %.0e x diag               %9.2e %9.2e  %9.2e  %3s "
                        "%3lld\n",
                        file, (long long)nv, moves[m], r.rms_ratio, r.max_rel, rms / diag, "-",

@@ -188,7 +188,7 @@ int main(int argc, char **argv)
         free(b.faces);
     }
 
-    /* the other formats, on the first mesh written by es_mesh_write */
+    /* the other formats, on the first mesh written by es_meshio_write */
     static const struct { const char *ext; es_mesh_format fmt; } other[] = {
         {"ply", ES_FORMAT_PLY}, {"ply", ES_FORMAT_PLY_ASCII}, {"off", ES_FORMAT_OFF},
         {"obj", ES_FORMAT_OBJ}};
@@ -206,7 +206,7 @@ int main(int argc, char **argv)
             file *x = NULL;
             int nx = 0, reps = 20;
             snprintf(tmp, sizeof tmp, "/tmp/bench_parse_%d.%s", (int)getpid(), other[k].ext);
-            if (es_mesh_write(ctx, tmp, other[k].fmt, mesh, md.xyz, NULL) ||
+            if (es_meshio_write(ctx, tmp, other[k].fmt, mesh, md.xyz, NULL) ||
                 add_file(&x, &nx, tmp))
                 return 1;
             remove(tmp);
@@ -248,7 +248,7 @@ int main(int argc, char **argv)
     printf("results identical : %s\n", mismatches ? "NO" : "yes");
     for (int k = 0; k < 4; k++)
         printf("%-18s: %8.1f MB/s  %8.1f meshes/s  (first mesh as written by "
-               "es_mesh_write)\n", k == 0 ? "PLY binary LE" : k == 1 ? "PLY ascii" :
+               "es_meshio_write)\n", k == 0 ? "PLY binary LE" : k == 1 ? "PLY ascii" :
                k == 2 ? "OFF" : "OBJ (%.17g)", other_mbs[k], other_ms[k]);
     printf("peak RSS          : %.1f MB (inputs held in memory: %.1f MB)\n",
            (double)ru.ru_maxrss / 1024.0, mb);

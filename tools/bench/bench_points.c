@@ -218,7 +218,7 @@ int main(int argc, char **argv)
         snprintf(file, sizeof file, "file:%s", held);
         pts[8] = file;
         truth = malloc(sizeof(double) * (size_t)(3 * nv));
-        if (es_mesh_read_positions(ctx, mesh, held, truth) != ES_OK) fail(ctx, held);
+        if (es_meshio_read_positions(ctx, mesh, held, truth) != ES_OK) fail(ctx, held);
     }
     es_embed_opts dflt, lm, fast;
     es_embed_opts_init(&dflt);
@@ -244,7 +244,7 @@ int main(int argc, char **argv)
                 es_edge_lengths(ctx, mesh, out, l);
                 for (int64_t e = 0; e < ne; e++) s1 += l[e];
                 for (int64_t i = 0; i < 3 * nv; i++) c[i] = truth[i] * s1 / s0;
-                es_kabsch_align(ctx, nv, out, c, NULL, &r2);
+                es_embed_align(ctx, nv, out, c, NULL, &r2);
                 d = r2 / es_bbox_diagonal(nv, c);
                 free(c), free(l);
             }

@@ -14,7 +14,7 @@ Defaults: the issue's cohort, 100,000 subjects x 175,000 edges (closed meshes of
 V = (E + 6) / 3 vertices), top 20 (p = 10, q = 4), P = 1 ... 256.
 
 "messages" and "sent" are rank 0's, counted as the library counts them
-(es_ctx_parallel_traffic, lib/parallel/parallel.c): an agreement (es_ctx_agree,
+(es_parallel_traffic, lib/parallel/parallel.c): an agreement (es_parallel_agree,
 one all-reduce of an int) is 1 message of 4 bytes; the root of a broadcast
 sends P - 1 messages of its bytes (Open MPI sends along a tree: the count is of
 the copies the other ranks receive); a reduction or gather to rank 0

@@ -85,15 +85,15 @@ int cmd_gpa(int argc, char **argv)
     /* on the ranks of an MPI job every rank reads and aligns its share of
      * the rows, rank 0 alone writes; a refusal before the fit (a taken
      * name) and the outcome are agreed on by all */
-    const int writer = es_ctx_rank(ctx) == 0;
+    const int writer = es_parallel_rank(ctx) == 0;
     es_status rc = es_store_open(ctx, argv[optind], writer ? wmode : ES_STORE_READ, &s);
     if (rc == ES_OK && where && *where) rc = es_store_select(ctx, s, where, &rows, &nrows);
     if (rc == ES_OK && writer) rc = es_store_result_check(ctx, s, "gpa", name);
-    rc = es_ctx_agree(ctx, rc);
+    rc = es_parallel_agree(ctx, rc);
     if (rc == ES_OK)
         rc = es_study_gpa(ctx, s, writer ? name : NULL, rows, nrows, &o, npc, cmd, &rep);
     if (rc == ES_OK && writer) rc = es_store_commit(ctx, s);
-    rc = es_ctx_agree(ctx, rc);
+    rc = es_parallel_agree(ctx, rc);
     if (rc != ES_OK) {
         cli_fail("gpa", ctx, rc);
         es_store_abort(s);

@@ -91,7 +91,7 @@ int cmd_mean(int argc, char **argv)
     if (name) fprintf(out, "stored as /analysis/mean/%s\n", name);
     ret = CLI_OK;
 done:
-    es_group_result_free(r);
+    es_study_group_result_free(r);
     if (ret == CLI_OK) es_store_close(st);
     else es_store_abort(st);   /* leave the store as it was */
     free(cmdline);

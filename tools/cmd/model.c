@@ -169,10 +169,10 @@ int cmd_model(int argc, char **argv)
      * evaluating its share of every term's permutations (es_model_fit);
      * rank 0 alone writes the store and the files. A taken name is refused
      * before the fit, agreed on by all ranks, so none is left in a sum. */
-    const int writer = es_ctx_rank(ctx) == 0;
+    const int writer = es_parallel_rank(ctx) == 0;
     es_status rc = es_store_open(ctx, argv[optind], o.name && writer ? wmode : ES_STORE_READ, &st);
     if (rc == ES_OK && o.name && writer) rc = es_store_result_check(ctx, st, "model", o.name);
-    rc = es_ctx_agree(ctx, rc);
+    rc = es_parallel_agree(ctx, rc);
     if (!writer) o.name = NULL;
     if (rc == ES_OK) rc = es_study_model(ctx, st, &o, &r);
     if (rc == ES_OK && writer) rc = es_store_commit(ctx, st);

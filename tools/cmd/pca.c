@@ -97,10 +97,10 @@ int cmd_pca(int argc, char **argv)
     int ret = CLI_FAIL;
     /* on the ranks of an MPI job every rank reads and fits (collectively),
      * rank 0 alone writes; a refusal before the fit is agreed on by all */
-    const int writer = es_ctx_rank(ctx) == 0;
+    const int writer = es_parallel_rank(ctx) == 0;
     es_status rc = es_store_open(ctx, argv[optind], writer ? wmode : ES_STORE_READ, &st);
     if (rc == ES_OK && writer) rc = es_store_result_check(ctx, st, "pca", name);
-    rc = es_ctx_agree(ctx, rc);
+    rc = es_parallel_agree(ctx, rc);
     if (rc == ES_OK)
         rc = es_study_pca(ctx, st, writer ? name : NULL, where, &o, cmdline, &p, &rows, &nrows);
     if (rc != ES_OK) {

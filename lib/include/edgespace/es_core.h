@@ -3,7 +3,12 @@
  * The contract every public header of libedgespace follows, written once here
  * (after cholmod.h and sqlite.h.in):
  *
- *  - Public symbols are es_<module>_<verb>; macros and enum values ES_*.
+ *  - Public functions are es_<family>_<verb>: the family is the module's
+ *    name (es_store_, es_meshio_, es_parallel_) or a type or word the module
+ *    owns (es_mesh_, es_pca_, es_ctx_, es_rng_), never another module's, and
+ *    the function is declared in that module's header, so the name says
+ *    where to look (tests/layout/check_layout.py lists the families).
+ *    Macros and enum values are ES_*.
  *  - Every fallible function takes an es_ctx * first and returns es_status.
  *    ES_OK is 0. On failure the message is on the context
  *    (es_ctx_errmsg), owned by it and overwritten by the next failure.

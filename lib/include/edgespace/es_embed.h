@@ -310,17 +310,17 @@ ES_API es_status es_embed_length_error(es_ctx *ctx, const es_mesh *mesh, const d
 /* Rigidly align xyz (3 x V, in place) onto ref (3 x V) by the proper
  * rotation and translation of least squares (Kabsch 1976); vertices with
  * weight 0 (w NULL: all 1) do not count. *rms gets the RMS distance after. */
-ES_API es_status es_kabsch_align(es_ctx *ctx, int64_t nverts, double *xyz, const double *ref,
-                                 const double *w, double *rms);
+ES_API es_status es_embed_align(es_ctx *ctx, int64_t nverts, double *xyz, const double *ref,
+                                const double *w, double *rms);
 
 /* The same for each part separately: part[v] (0-based; < 0: vertex left
  * where it is) names the rigid piece vertex v belongs to, e.g. the
  * connected components of es_mesh_vertex_component, whose relative
  * placement edge lengths do not fix. part NULL: one piece. A part whose
  * weights sum to 0 is left where it is. */
-ES_API es_status es_kabsch_align_parts(es_ctx *ctx, int64_t nverts, double *xyz,
-                                       const double *ref, const double *w, const int64_t *part,
-                                       double *rms);
+ES_API es_status es_embed_align_parts(es_ctx *ctx, int64_t nverts, double *xyz,
+                                      const double *ref, const double *w, const int64_t *part,
+                                      double *rms);
 
 /* ---- a prior from the data -------------------------------------------------
  * Where the lengths leave a surface free (every open mesh: faces with eye and

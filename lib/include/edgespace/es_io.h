@@ -54,13 +54,13 @@ ES_API void es_meshdata_clear(es_ctx *ctx, es_meshdata *md);
 /* Read a file and build its topology (positions kept as reference xyz).
  * Errors: those of es_meshdata_read, then those of es_mesh_new (e.g.
  * ES_ETOPOLOGY) with the file name put in front of the message. */
-ES_API es_status es_mesh_read(es_ctx *ctx, const char *path, es_mesh **out);
+ES_API es_status es_meshio_read(es_ctx *ctx, const char *path, es_mesh **out);
 
 /* The positions (3 x V) of a mesh file whose face list is that of `mesh`
  * (a new shape of a study's topology); ES_EMISMATCH naming the file when
  * it is not, and the errors of es_meshdata_read. */
-ES_API es_status es_mesh_read_positions(es_ctx *ctx, const es_mesh *mesh, const char *path,
-                                        double *xyz);
+ES_API es_status es_meshio_read_positions(es_ctx *ctx, const es_mesh *mesh, const char *path,
+                                          double *xyz);
 
 /* Write positions xyz (3 x V) with mesh's faces. Format from the extension
  * when ES_FORMAT_AUTO (.obj, .ply = binary little endian, .off, .stl, .glb).
@@ -72,18 +72,18 @@ ES_API es_status es_mesh_read_positions(es_ctx *ctx, const es_mesh *mesh, const 
  * The file is written beside the target (PATH.PID.part) and renamed over
  * it when complete: a failed write leaves an existing file as it was; the
  * old file's permissions are kept and a symlink is written through. */
-ES_API es_status es_mesh_write(es_ctx *ctx, const char *path, es_mesh_format format,
-                               const es_mesh *mesh, const double *xyz,
-                               const uint8_t *vertex_rgb);
+ES_API es_status es_meshio_write(es_ctx *ctx, const char *path, es_mesh_format format,
+                                 const es_mesh *mesh, const double *xyz,
+                                 const uint8_t *vertex_rgb);
 
 /* Format guessed from a path's extension (ES_FORMAT_AUTO if unknown). */
-ES_API es_mesh_format es_mesh_format_from_path(const char *path);
+ES_API es_mesh_format es_meshio_format_from_path(const char *path);
 
 
 /* Normalized edge lengths (E) and scale of a mesh file whose face list is
  * that of `mesh` (ES_EMISMATCH otherwise, naming the file). */
-ES_API es_status es_lengths_from_file(es_ctx *ctx, const es_mesh *mesh, const char *path,
-                                      double *len, double *scale);
+ES_API es_status es_meshio_lengths_from_file(es_ctx *ctx, const es_mesh *mesh, const char *path,
+                                             double *len, double *scale);
 
 #ifdef __cplusplus
 }

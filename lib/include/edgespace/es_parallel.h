@@ -7,7 +7,7 @@
  * (es_model_fit), GPA (es_gpa_align_ranks) and mesh ingest
  * (es_ingest_manifest, es_ingest_files: collective parallel-HDF5 writes)
  * on P processes ("ranks"); datasets-spec/parallel.md says what runs where. Every rank runs the same program: a
- * context joined to the job (es_ctx_join_parallel) makes those calls
+ * context joined to the job (es_parallel_join) makes those calls
  * collective, so every rank must make them, in the same order and with the
  * same arguments; each returns the same status on every rank, with the
  * message of the lowest rank that failed. Results are the same as on one
@@ -50,30 +50,30 @@ ES_API void es_parallel_finalize(void);
 /* Join ctx to the job: its collective calls run on all ranks of
  * MPI_COMM_WORLD (a private duplicate of it). A no-op without MPI, or
  * before es_parallel_init. Call it on every rank. */
-ES_API es_status es_ctx_join_parallel(es_ctx *ctx);
+ES_API es_status es_parallel_join(es_ctx *ctx);
 
 /* This rank (0 .. P-1) and the number of ranks P of ctx's job: 0 and 1 for a
  * context not joined to one. */
-ES_API int es_ctx_rank(const es_ctx *ctx);
-ES_API int es_ctx_nranks(const es_ctx *ctx);
+ES_API int es_parallel_rank(const es_ctx *ctx);
+ES_API int es_parallel_nranks(const es_ctx *ctx);
 
 /* The contiguous share [*lo, *hi) of n items (rows, configurations) that
  * this rank takes: the first n % P ranks take one more; 0 and n alone. */
-ES_API void es_ctx_share(const es_ctx *ctx, int64_t n, int64_t *lo, int64_t *hi);
+ES_API void es_parallel_share(const es_ctx *ctx, int64_t n, int64_t *lo, int64_t *hi);
 
 /* Wait for every rank of ctx's job (MPI_Barrier); ES_OK at once alone. */
-ES_API es_status es_ctx_barrier(es_ctx *ctx);
+ES_API es_status es_parallel_barrier(es_ctx *ctx);
 
 /* What this rank has sent through the library's collectives since ctx
  * joined its job: messages and bytes (0 and 0 alone): the measured side of
  * the cost model in datasets-spec/parallel.md. */
-ES_API void es_ctx_parallel_traffic(const es_ctx *ctx, int64_t *messages, int64_t *bytes);
+ES_API void es_parallel_traffic(const es_ctx *ctx, int64_t *messages, int64_t *bytes);
 
 /* The first failure of any rank, agreed on by all: every rank passes its
  * own status; all return ES_OK if every rank had ES_OK, else the status of
  * the lowest failing rank, whose message is copied onto every rank's ctx.
  * Alone: rc. */
-ES_API es_status es_ctx_agree(es_ctx *ctx, es_status rc);
+ES_API es_status es_parallel_agree(es_ctx *ctx, es_status rc);
 
 #ifdef __cplusplus
 }

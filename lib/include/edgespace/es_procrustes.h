@@ -127,7 +127,7 @@ ES_API es_status es_gpa_align(es_ctx *ctx, int64_t k, int d, es_mat x,
 /* es_gpa_align on the ranks of ctx's job (es_parallel.h; collective: every
  * rank calls it with the same k, d, n and options): n configurations in
  * all, of which x (k*d x m, ld = k*d) holds this rank's contiguous share
- * (es_ctx_share(ctx, n, ...): m = hi - lo), aligned in place. out's arrays
+ * (es_parallel_share(ctx, n, ...): m = hi - lo), aligned in place. out's arrays
  * are for all n and every rank receives all of them; the report is the
  * same on every rank. The sweep is sequential (Gauss-Seidel), so the ranks
  * take their shares in turn and hand the running sum on: the result is

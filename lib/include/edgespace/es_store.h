@@ -125,7 +125,7 @@ ES_API es_topology_kind es_store_topology_kind(const es_store *store);
 ES_API const char *es_store_path(const es_store *store);
 /* 1 if path names an existing HDF5 file (a store, say), else 0: outputs
  * that would overwrite one refuse with this. */
-ES_API int es_file_is_hdf5(const char *path);
+ES_API int es_store_is_hdf5(const char *path);
 /* Topology fingerprint (es_mesh_fingerprint of the stored faces), 16 hex
  * digits. Borrowed, valid until close. */
 ES_API const char *es_store_fingerprint(const es_store *store);

@@ -56,7 +56,7 @@ typedef struct es_group_result {
     double *centroid_sizes; /* mean centroid size per group (shapes::centroid.size of the
                                positions as ingested) */
 } es_group_result;
-ES_API void es_group_result_free(es_group_result *r);
+ES_API void es_study_group_result_free(es_group_result *r);
 
 /* Means of the rows matching `filter` (NULL/"": all), one per value of
  * label column `by` (NULL: one group "all"), stored as mean/<name> when name
