@@ -92,10 +92,8 @@ static void check_none(es_ctx *ctx, const es_landmarks *lm, const char *path)
     free(sc);
     ES_CHECK_FAILS(ctx, es_store_mesh(ctx, s, &m), ES_EINVAL, NOEDGES);
     ES_CHECK(m == NULL);
-    ES_CHECK_FAILS(ctx, es_study_pca(ctx, s, NULL, NULL, NULL, "test", NULL, NULL, NULL),
-                   ES_EINVAL, NOEDGES);
-    ES_CHECK_FAILS(ctx, es_study_mean(ctx, s, NULL, NULL, NULL, "test", NULL), ES_EINVAL,
-                   NOEDGES);
+    ES_CHECK_FAILS(ctx, es_study_pca(ctx, s, NULL, NULL, NULL, NULL), ES_EINVAL, NOEDGES);
+    ES_CHECK_FAILS(ctx, es_study_mean(ctx, s, NULL, NULL), ES_EINVAL, NOEDGES);
     es_store_close(s);
     /* GPA runs on it and its result survives the commit */
     es_gpa_opts o;
@@ -175,7 +173,11 @@ static void check_truss(es_ctx *ctx, const es_landmarks *lm, const char *path)
     /* PCA on the truss lengths: orthonormal components, scores reproduce the data */
     es_pca *p = NULL;
     int64_t *rows = NULL, nr = 0;
-    ES_CHECK_OK(ctx, es_study_pca(ctx, s, "p", NULL, NULL, "test", &p, &rows, &nr));
+    es_study_pca_opts spo;
+    es_study_pca_opts_init(&spo);
+    spo.name = "p";
+    spo.command = "test";
+    ES_CHECK_OK(ctx, es_study_pca(ctx, s, &spo, &p, &rows, &nr));
     if (p) {
         ES_CHECK(p->nedges == E && nr == lm->n && p->ncomp >= 1);
         double worst = 0;

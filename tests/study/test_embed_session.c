@@ -139,7 +139,12 @@ int main(void)
     es_pca_opts po;
     es_pca_opts_init(&po);
     po.ncomp = 4;
-    ES_CHECK_OK(ctx, es_study_pca(ctx, s, "p", NULL, &po, "test", NULL, NULL, NULL));
+    es_study_pca_opts spo;
+    es_study_pca_opts_init(&spo);
+    spo.name = "p";
+    spo.pca = po;
+    spo.command = "test";
+    ES_CHECK_OK(ctx, es_study_pca(ctx, s, &spo, NULL, NULL, NULL));
     ES_CHECK_OK(ctx, es_store_commit(ctx, s));
     int64_t nv = es_store_nverts(s), n3 = 3 * nv;
     double *ref = malloc(3 * (size_t)n3 * sizeof *ref), *got = malloc(3 * (size_t)n3 * sizeof *got);
@@ -339,9 +344,9 @@ int main(void)
             if (pca == 0) {   /* the PCA replaced (of the neutral rows, 3 components) */
                 memcpy(got + n3, ref, (size_t)n3 * sizeof *ref);
                 ES_CHECK_OK(ctx, es_store_delete_result(ctx, s, "pca", "p"));
-                po.ncomp = 3;
-                ES_CHECK_OK(ctx, es_study_pca(ctx, s, "p", "expression=neutral", &po, "test", NULL,
-                                              NULL, NULL));
+                spo.where = "expression=neutral";
+                spo.pca.ncomp = 3;
+                ES_CHECK_OK(ctx, es_study_pca(ctx, s, &spo, NULL, NULL, NULL));
                 ES_CHECK(es_store_generation(s) != gen);
             } else {
                 ES_CHECK(!same(got + n3, got, n3));   /* not the old PCA's point */

@@ -118,7 +118,12 @@ int main(void)
     if (!s) ES_TEST_END();
     es_pca_opts_init(&po);
     po.ncomp = 4;
-    ES_CHECK_OK(ctx, es_study_pca(ctx, s, "p", NULL, &po, "test", NULL, NULL, NULL));
+    es_study_pca_opts so;
+    es_study_pca_opts_init(&so);
+    so.name = "p";
+    so.pca = po;
+    so.command = "test";
+    ES_CHECK_OK(ctx, es_study_pca(ctx, s, &so, NULL, NULL, NULL));
     ES_CHECK_OK(ctx, es_study_gpa(ctx, s, "g", NULL, -1, NULL, 0, "test", NULL));
     ES_CHECK_OK(ctx, es_store_commit(ctx, s));
     V = es_store_nverts(s);

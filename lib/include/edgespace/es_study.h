@@ -58,22 +58,41 @@ typedef struct es_group_result {
 } es_group_result;
 ES_API void es_group_result_free(es_group_result *r);
 
-/* Means of the rows matching `filter` (NULL/"": all), one per value of
- * label column `by` (NULL: one group "all"), stored as mean/<name> when name
- * is non-NULL. out may be NULL. */
-ES_API es_status es_study_mean(es_ctx *ctx, es_store *store, const char *name,
-                                  const char *filter, const char *by, const char *command,
-                                  es_group_result **out);
+/* What es_study_mean does (es_study_mean_opts_init: every row, one group,
+ * nothing stored). */
+typedef struct es_study_mean_opts {
+    const char *name;       /* store as mean/<name> (NULL: store nothing) */
+    const char *where;      /* rows: "col=value,..." (NULL or "": all) */
+    const char *by;         /* label column: one mean per value (NULL: one group "all") */
+    const char *command;    /* provenance (NULL: "es_study_mean") */
+} es_study_mean_opts;
+ES_API void es_study_mean_opts_init(es_study_mean_opts *opts);
+
+/* Means of the rows matching opts->where, one per value of label column
+ * opts->by, stored as mean/<name> when opts->name is non-NULL (the store
+ * open for writing; the caller commits). opts NULL: the defaults. out may
+ * be NULL. */
+ES_API es_status es_study_mean(es_ctx *ctx, es_store *store, const es_study_mean_opts *opts,
+                               es_group_result **out);
 
 /* ---- PCA ------------------------------------------------------------------ */
 
-/* Fit a PCA of the rows matching `filter` and store it as pca/<name>.
- * *out (may be NULL) gets the fit, *rows (may be NULL) the store rows
- * used (es_free), in score order. */
-ES_API es_status es_study_pca(es_ctx *ctx, es_store *store, const char *name,
-                                 const char *filter, const es_pca_opts *opts,
-                                 const char *command, es_pca **out, int64_t **rows,
-                                 int64_t *nrows);
+/* What es_study_pca does (es_study_pca_opts_init: every row, es_pca_opts_init's
+ * fit, nothing stored). */
+typedef struct es_study_pca_opts {
+    const char *name;       /* store as pca/<name> (NULL: store nothing) */
+    const char *where;      /* rows: "col=value,..." (NULL or "": all) */
+    es_pca_opts pca;        /* the fit (es_pca_opts_init) */
+    const char *command;    /* provenance (NULL: "es_study_pca") */
+} es_study_pca_opts;
+ES_API void es_study_pca_opts_init(es_study_pca_opts *opts);
+
+/* Fit a PCA of the rows matching opts->where and store it as pca/<name>
+ * when opts->name is non-NULL (the caller commits). opts NULL: the
+ * defaults. *out (may be NULL) gets the fit, *rows (may be NULL) the store
+ * rows used (es_free), in score order. */
+ES_API es_status es_study_pca(es_ctx *ctx, es_store *store, const es_study_pca_opts *opts,
+                              es_pca **out, int64_t **rows, int64_t *nrows);
 
 /* Load pca/<name> (NULL: the only PCA in the store, else the one named
  * "default"). Scores are loaded too (nrows = rows fitted); *rows (may be
@@ -83,13 +102,23 @@ ES_API es_status es_study_pca_load(es_ctx *ctx, es_store *store, const char *nam
 
 /* ---- differences ------------------------------------------------------------ */
 
-/* Rows matching `filter` whose label `column` equals `from` or `to` are
- * paired by label `key` (es_diff_paired's rules); stored as diff/<name>.
- * Indices in the result are store rows. out may be NULL. */
-ES_API es_status es_study_diff(es_ctx *ctx, es_store *store, const char *name,
-                                  const char *filter, const char *key, const char *column,
-                                  const char *from, const char *to, const char *command,
-                                  es_diff **out);
+/* What es_study_diff does: key, column, from and to are required. */
+typedef struct es_study_diff_opts {
+    const char *name;       /* store as diff/<name> (NULL: store nothing) */
+    const char *where;      /* rows: "col=value,..." (NULL or "": all) */
+    const char *key;        /* label column that pairs the rows (the subject) */
+    const char *column;     /* label column whose values from and to are compared */
+    const char *from, *to;  /* the difference is to - from */
+    const char *command;    /* provenance (NULL: "es_study_diff") */
+} es_study_diff_opts;
+ES_API void es_study_diff_opts_init(es_study_diff_opts *opts);
+
+/* Rows matching opts->where whose label `column` equals `from` or `to` are
+ * paired by label `key` (es_diff_paired's rules); stored as diff/<name>
+ * when opts->name is non-NULL (the caller commits). Indices in the result
+ * are store rows. out may be NULL. */
+ES_API es_status es_study_diff(es_ctx *ctx, es_store *store, const es_study_diff_opts *opts,
+                               es_diff **out);
 
 /* ---- points ----------------------------------------------------------------- */
 
@@ -116,15 +145,23 @@ ES_API es_status es_study_resolve(es_ctx *ctx, void *resolver, es_point_leaf kin
                                   double *weights);
 ES_API void es_study_resolver_clear(es_ctx *ctx, es_study_resolver *r);
 
-/* Evaluate `expr` on the store (validity against the store's topology) and,
- * when name is non-NULL, store it as point/<name> (its lengths, scale and
- * row weights). scale > 0 overrides the scale rule of es_point.h. *vec (may
- * be NULL) gets the lengths (es_free); weights (may be NULL) the row weights
- * (es_store_nrows entries); info (may be NULL) the report. */
-ES_API es_status es_study_point(es_ctx *ctx, es_store *store, const char *name,
-                                const char *expr, const char *pca_name, double scale,
-                                const char *command, double **vec, double *weights,
-                                es_point_info *info);
+/* What es_study_point does: expr is required. */
+typedef struct es_study_point_opts {
+    const char *name;       /* store as point/<name> (NULL: store nothing) */
+    const char *expr;       /* the point (datasets-spec/point-syntax.md) */
+    const char *pca_name;   /* the PCA of pc:K (NULL: as es_study_pca_load) */
+    double scale;           /* > 0: overrides the scale rule of es_point.h (0) */
+    const char *command;    /* provenance (NULL: "es_study_point") */
+} es_study_point_opts;
+ES_API void es_study_point_opts_init(es_study_point_opts *opts);
+
+/* Evaluate opts->expr on the store (validity against the store's topology)
+ * and, when opts->name is non-NULL, store it as point/<name> (its lengths,
+ * scale and row weights; the caller commits). *vec (may be NULL) gets the
+ * lengths (es_free); weights (may be NULL) the row weights (es_store_nrows
+ * entries); info (may be NULL) the report. */
+ES_API es_status es_study_point(es_ctx *ctx, es_store *store, const es_study_point_opts *opts,
+                                double **vec, double *weights, es_point_info *info);
 
 /* The E scale-normalized lengths of a point as a command line names it:
  * "row:ID", the name of a stored point (/analysis/point/NAME), or an
