@@ -879,15 +879,19 @@ class Store:
         (es_study_gpa), stored as gpa/<name> and committed; the stored arrays
         come back in (specimen, landmark, dimension) order."""
         components = renamed("Store.gpa", "components", components, "npc", npc) or 0
-        o = ffi.new("es_gpa_opts *")
-        lib.es_gpa_opts_init(o)
-        o.scale, o.allow_reflection, o.tol, o.max_iter = int(scale), int(allow_reflection), \
-            float(tol), A.index(max_iter, "max_iter")
+        o = ffi.new("es_study_gpa_opts *")
+        lib.es_study_gpa_opts_init(o)
+        o.gpa.scale, o.gpa.allow_reflection, o.gpa.tol, o.gpa.max_iter = \
+            int(scale), int(allow_reflection), float(tol), A.index(max_iter, "max_iter")
         r = None if rows is None else A.indices(rows, (None,), "rows")
+        keep = [_c(name), self._command("gpa")]
+        o.name, o.command = keep
+        rp = A.iptr(r)   # kept alive through the call
+        o.rows, o.nrows = rp, -1 if r is None else len(r)
+        o.npc = A.index(components, "components")
         rep = ffi.new("es_gpa_report *")
         with self._replacing(replace):
-            self._call(lib.es_study_gpa, _s(name), A.iptr(r), -1 if r is None else len(r), o,
-                       A.index(components, "components"), self._command("gpa"), rep)
+            self._call(lib.es_study_gpa, o, rep)
         self.commit()
         return self.load_gpa(name, A.struct_dict(rep, "es_gpa_report"))
 
@@ -915,16 +919,17 @@ class Store:
         """Edge-length space against Procrustes space on a stored GPA's rows
         (es_study_compare); stored as compare/<name> (None: not stored) and
         committed; out_dir gets the CSV tables."""
-        o = ffi.new("es_compare_opts *")
-        lib.es_compare_opts_init(o)
-        o.permutations = A.index(permutations, "permutations")
-        o.top_pairs = A.index(top_pairs, "top_pairs")
-        o.normalize_lengths = int(normalize_lengths)
+        o = ffi.new("es_study_compare_opts *")
+        lib.es_study_compare_opts_init(o)
+        o.compare.permutations = A.index(permutations, "permutations")
+        o.compare.top_pairs = A.index(top_pairs, "top_pairs")
+        o.compare.normalize_lengths = int(normalize_lengths)
+        keep = [_c(gpa), _c(by or None), _c(name or None), _c(out_dir or None),
+                self._command("compare")]
+        o.gpa_name, o.by, o.name, o.out_dir, o.command = keep
         out = ffi.new("es_compare_result **")
         with self._replacing(replace):
-            self._call(lib.es_study_compare, _s(gpa), _s(by) or ffi.NULL, o,
-                          _s(name) if name else b"", _s(out_dir) or ffi.NULL,
-                          self._command("compare"), out)
+            self._call(lib.es_study_compare, o, out)
         r = A.owned(self.ctx, out[0], lib.es_compare_result_free)
         if name:
             self.commit()

@@ -96,11 +96,13 @@ static void check_none(es_ctx *ctx, const es_landmarks *lm, const char *path)
     ES_CHECK_FAILS(ctx, es_study_mean(ctx, s, NULL, NULL), ES_EINVAL, NOEDGES);
     es_store_close(s);
     /* GPA runs on it and its result survives the commit */
-    es_gpa_opts o;
+    es_study_gpa_opts o;
     es_gpa_report rep;
-    es_gpa_opts_init(&o);
+    es_study_gpa_opts_init(&o);
+    o.name = "g";
+    o.command = "test";
     ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_WRITE, &s));
-    ES_CHECK_OK(ctx, es_study_gpa(ctx, s, "g", NULL, -1, &o, 0, "test", &rep));
+    ES_CHECK_OK(ctx, es_study_gpa(ctx, s, &o, &rep));
     ES_CHECK(rep.converged && rep.rmsrho > 0 && isfinite(rep.gss));
     ES_CHECK_OK(ctx, es_store_commit(ctx, s));
     es_store_close(s);

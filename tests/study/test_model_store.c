@@ -255,9 +255,11 @@ int main(void)
     }
 
     /* ---- Procrustes space ---- */
-    es_gpa_opts go;
-    es_gpa_opts_init(&go);
-    ES_CHECK_OK(ctx, es_study_gpa(ctx, s, "g", NULL, -1, &go, 0, "test", NULL));
+    es_study_gpa_opts go;
+    es_study_gpa_opts_init(&go);
+    go.name = "g";
+    go.command = "test";
+    ES_CHECK_OK(ctx, es_study_gpa(ctx, s, &go, NULL));
     o.formula = "~ expression";
     o.gpa = "g";
     o.where = "expression=happy,subject=s01";

@@ -124,7 +124,11 @@ int main(void)
     so.pca = po;
     so.command = "test";
     ES_CHECK_OK(ctx, es_study_pca(ctx, s, &so, NULL, NULL, NULL));
-    ES_CHECK_OK(ctx, es_study_gpa(ctx, s, "g", NULL, -1, NULL, 0, "test", NULL));
+    es_study_gpa_opts go;
+    es_study_gpa_opts_init(&go);
+    go.name = "g";
+    go.command = "test";
+    ES_CHECK_OK(ctx, es_study_gpa(ctx, s, &go, NULL));
     ES_CHECK_OK(ctx, es_store_commit(ctx, s));
     V = es_store_nverts(s);
     F = es_store_nfaces(s);

@@ -242,10 +242,24 @@ ES_API const char *es_study_result_tables(const char *kind, char *buf, size_t n)
 
 /* ---- GPA and the comparison of the two spaces ----------------------------- */
 
-/* GPA of the positions of `rows` (nrows of them; rows NULL with nrows = -1:
- * every row) of an open store, with the PCA of the residual tangent
- * coordinates, written to /analysis/gpa/<name> (a taken name: as above) with
- * provenance (command; params: scale, allow_reflection, tol, max_iter):
+/* What es_study_gpa does (es_study_gpa_opts_init: every row, es_gpa_opts_init's
+ * alignment, min(10, n - 1) PCs, nothing stored). */
+typedef struct es_study_gpa_opts {
+    const char *name;       /* store as gpa/<name> (NULL: store nothing, the report
+                               alone; the ranks other than 0 of an MPI job) */
+    const int64_t *rows;    /* the store rows aligned, nrows of them (NULL with nrows -1,
+                               the default: every row) */
+    int64_t nrows;
+    es_gpa_opts gpa;        /* the alignment (es_gpa_opts_init) */
+    int64_t npc;            /* PCs of the tangent coordinates kept (<= 0: min(10, n - 1)) */
+    const char *command;    /* provenance (NULL: "es_study_gpa") */
+} es_study_gpa_opts;
+ES_API void es_study_gpa_opts_init(es_study_gpa_opts *opts);
+
+/* GPA of the positions of opts->rows of an open store, with the PCA of the
+ * residual tangent coordinates, written to /analysis/gpa/<name> when
+ * opts->name is non-NULL (a taken name: as above) with provenance (command;
+ * params: scale, allow_reflection, tol, max_iter):
  *   aligned   n x k*d   row j: configuration of input row j (x-, y-, z-block)
  *   mean      k*d       Procrustes mean;  size, rho, scale: n each
  *   rotation  n x d*d   column-major d x d per row;  centroid: n x d
@@ -253,32 +267,41 @@ ES_API const char *es_study_result_tables(const char *kind, char *buf, size_t n)
  * and attributes dim, k, iterations, converged, rot_change, scale_change,
  * gss, rmsrho, total_ss. Planar data (z = 0 in every row, e.g. ingested 2D
  * landmarks) are analysed in 2D (dim 2), so that a 3D rotation cannot act
- * as a reflection. npc <= 0: min(10, n - 1). Memory: the positions of the
- * rows (n x 3V doubles) once. The store must be open for writing; the
- * caller commits (es_store_commit / es_store_close). report may be NULL.
- * On a context joined to an MPI job it is collective: every rank reads and
- * aligns its share of the rows (es_gpa_align_ranks; the others may open the
- * store read-only and pass name NULL), rank 0 gathers them, takes the PCA
- * and writes; each rank holds 3V x n/P doubles, rank 0 all n. */
-ES_API es_status es_study_gpa(es_ctx *ctx, es_store *store, const char *name,
-                                  const int64_t *rows, int64_t nrows, const es_gpa_opts *opts,
-                                  int64_t npc, const char *command, es_gpa_report *report);
+ * as a reflection. Memory: the positions of the rows (n x 3V doubles) once.
+ * With a name the store must be open for writing; the caller commits
+ * (es_store_commit / es_store_close). opts NULL: the defaults. report may
+ * be NULL. On a context joined to an MPI job it is collective: every rank
+ * reads and aligns its share of the rows (es_gpa_align_ranks; the others
+ * may open the store read-only and pass name NULL), rank 0 gathers them,
+ * takes the PCA and writes; each rank holds 3V x n/P doubles, rank 0 all n. */
+ES_API es_status es_study_gpa(es_ctx *ctx, es_store *store, const es_study_gpa_opts *opts,
+                              es_gpa_report *report);
+
+/* What es_study_compare does: gpa_name is required. */
+typedef struct es_study_compare_opts {
+    const char *gpa_name;   /* the GPA result whose rows are compared */
+    const char *by;         /* label column of the groups (NULL: no groups) */
+    es_compare_opts compare;   /* the statistics (es_compare_opts_init) */
+    const char *name;       /* store as compare/<name> (NULL: store nothing; the
+                               `compare` command stores as its GPA's name) */
+    const char *out_dir;    /* es_study_compare_write's tables go there (NULL: none) */
+    const char *command;    /* provenance (NULL: "es_study_compare") */
+} es_study_compare_opts;
+ES_API void es_study_compare_opts_init(es_study_compare_opts *opts);
 
 /* The study on a store: the rows of GPA result /analysis/gpa/<gpa_name>
  * (their aligned configurations) against their stored normalized edge
- * lengths, grouped by label column `by` (NULL: no groups). Writes
- * /analysis/compare/<name> (name NULL: gpa_name) with provenance: datasets
+ * lengths, grouped by label column `by`. Writes, when opts->name is
+ * non-NULL, /analysis/compare/<name> with provenance: datasets
  * d_lengths, d_procrustes (n x n), group_means_lengths/_procrustes and
  * p_lengths/_procrustes (g x g), group_names, attributes spearman_rho,
  * mantel_p, nn_agreement, by, gpa (permutations in @params). out_dir (or
  * NULL) gets es_study_compare_write's tables (es_figure_compare adds the
  * figures). The result carries the row ids, groups and group names. ES_ENOTFOUND if the GPA
- * result or the column is missing; ES_EINVAL for a store without edges. The
- * store must be open for writing if name is not "" (name "": nothing is
- * written to the store). res (may be NULL) receives the result. */
-ES_API es_status es_study_compare(es_ctx *ctx, es_store *store, const char *gpa_name,
-                                  const char *by, const es_compare_opts *opts, const char *name,
-                                  const char *out_dir, const char *command,
+ * result or the column is missing; ES_EINVAL for a store without edges. With
+ * a name the store must be open for writing; the caller commits. res (may
+ * be NULL) receives the result. */
+ES_API es_status es_study_compare(es_ctx *ctx, es_store *store, const es_study_compare_opts *opts,
                                   es_compare_result **res);
 
 /* Write the study to dir (created if missing): distances_lengths.csv and
