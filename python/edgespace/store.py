@@ -754,6 +754,7 @@ class Store:
         res = ffi.new("es_study_embed_result *")
         with self._replacing(replace):
             self._call(lib.es_study_embed, o, A.dptr(xyz), res)
+        self._committed(name)   # the mesh and residual files appear with it
         return study_embedding(xyz, self.mesh.faces, res)
 
     def _session(self):
@@ -837,8 +838,8 @@ class Store:
         cb = ffi.callback("es_study_frame_fn", on_frame)
         with tempfile.TemporaryDirectory(prefix="edgespace-interp-") as d:
             pattern = output if output is not None else os.path.join(d, "frame_%04d.ply")
-            keep = [_c(from_), _c(to), _c(weights), _c(pca), _c(pattern), _c(name),
-                    self._command("interp") if name else ffi.NULL]
+            keep = [_c(from_), _c(to), _c(weights), _c(pca), _c(pattern), _c(name or None),
+                    self._command("interp")]
             setattr(o, "from", keep[0])   # a Python keyword
             o.to, o.weights, o.pca_name, o.output, o.name, o.command = keep[1:]
             o.t0, o.t1, o.steps = float(t0), float(t1), A.index(steps, "steps")
@@ -851,6 +852,7 @@ class Store:
             try:
                 with self._replacing(replace):
                     self._call(lib.es_study_interp, o)
+                self._committed(name)   # the frame files appear with it
             finally:
                 self.ctx.seed = old_seed
             out = []

@@ -18,6 +18,18 @@
  * tool version, time, rows used). A name that is taken is refused with
  * ES_EEXIST before anything is computed, unless the store was opened with
  * ES_STORE_REPLACE, which replaces it (es_store_result_check).
+ *
+ * One style for every analysis: es_study_<x>(ctx, store, opts, outputs...)
+ * with an options struct made by es_study_<x>_opts_init; opts->name NULL
+ * stores nothing (the one switch), opts->command is provenance only (NULL:
+ * "es_study_<x>"). No study call commits: the caller publishes what it
+ * stored with es_store_commit (or es_store_close) and discards it with
+ * es_store_rollback (or es_store_abort). The files es_study_embed and
+ * es_study_interp write beside a stored result (meshes, residuals, frames)
+ * ride on the store handle and are renamed into place by that commit, after
+ * the store is published, or removed by the rollback: a failed store write
+ * leaves no new file behind and an old one as it was. Without a name they
+ * are renamed into place before the call returns.
  */
 #ifndef EDGESPACE_ES_STUDY_H
 #define EDGESPACE_ES_STUDY_H
@@ -531,8 +543,8 @@ typedef struct es_study_embed_opts {
     double scale;           /* > 0: embed at this sum of lengths (0: the point's) */
     const char *output;     /* mesh file to write (OBJ/PLY/OFF by extension), or NULL */
     const char *residuals;  /* CSV of per-vertex closure and edge error, or NULL */
-    const char *name;       /* store as /analysis/embed/<name> and commit (NULL: no) */
-    const char *command;    /* provenance of the stored result */
+    const char *name;       /* store as /analysis/embed/<name> (NULL: store nothing) */
+    const char *command;    /* provenance of the stored result (NULL: "es_study_embed") */
     int cache;              /* 1 (the default): the session's cache beside the store
                                (es_study_embedder_open) */
     es_study_embedder *session;   /* an open session of this store to use (and leave
@@ -552,8 +564,11 @@ ES_API void es_study_embed_opts_init(es_study_embed_opts *opts);
 
 /* Embed a point: resolve it, initialize, solve, write the mesh and the
  * residuals, store the result with its provenance. The store must be open
- * for writing when opts->name is given. xyz (3 x V, may be NULL) receives
- * the positions. Nothing is stored when a step fails. */
+ * for writing when opts->name is given; the caller commits, and the mesh
+ * and residual files appear with that commit (es_store_commit; removed by
+ * es_store_rollback or es_store_abort). Without a name they are written at
+ * once. xyz (3 x V, may be NULL) receives the positions. Nothing is stored
+ * or written when a step fails. */
 ES_API es_status es_study_embed(es_ctx *ctx, es_store *store, const es_study_embed_opts *opts,
                                 double *xyz, es_study_embed_result *res);
 
@@ -575,9 +590,10 @@ typedef struct es_study_interp_opts {
     int64_t steps;          /* frames from t0 to t1 inclusive (9) */
     const char *output;     /* mesh file; with several frames a printf pattern with one
                                integer conversion ("cat_%02d.obj"; %% is a literal %) */
-    const char *name;       /* results /analysis/embed/<name>[_<i>] (NULL: the output's
-                               base name without the conversion) */
-    const char *command;    /* provenance; NULL: store nothing */
+    const char *name;       /* store the frames as /analysis/embed/<name>[_<i>] (NULL:
+                               store nothing; the `interp` command names them
+                               es_study_interp_default_name of the output) */
+    const char *command;    /* provenance (NULL: "es_study_interp") */
     es_embed_opts embed;
     int cold;               /* 1: every frame from its own prior (as es_study_embed of
                                the same point); 0 (default): each frame from the last
@@ -613,8 +629,11 @@ ES_API void es_study_interp_opts_init(es_study_interp_opts *opts);
  * frame; frames are aligned frame to frame so the sequence does not jump.
  * Every frame is checked before the first is written: a walk that leaves
  * edge-length space (a length <= 0 at some t) is refused naming t and the
- * edge, and nothing is written. With opts->command the frames are stored
- * and committed (the store open for writing). */
+ * edge, and nothing is written. With opts->name the frames are stored (the
+ * store open for writing); the caller commits, and the frame files appear
+ * with that commit, all together (removed by es_store_rollback or
+ * es_store_abort); without a name they appear, all together, before the
+ * call returns. A walk that fails stores nothing and writes no frame. */
 ES_API es_status es_study_interp(es_ctx *ctx, es_store *store, const es_study_interp_opts *opts);
 
 /* The file of frame i: pattern with its one %d, %Nd or %0Nd conversion
@@ -622,8 +641,14 @@ ES_API es_status es_study_interp(es_ctx *ctx, es_store *store, const es_study_in
  * the result does not fit in n bytes. */
 ES_API int es_study_frame_path(const char *pattern, int64_t i, char *out, size_t n);
 /* Where es_study_interp stores its frames, for messages: "NAME", or
- * "NAME_NN" for a sequence. Returns buf. */
+ * "NAME_NN" for a sequence (NAME: opts->name, or when NULL
+ * es_study_interp_default_name's). Returns buf. */
 ES_API const char *es_study_interp_name(const es_study_interp_opts *opts, char *buf, size_t n);
+/* The result name the `interp` command stores under when none is given:
+ * the output's base name without its extension and without the frame
+ * conversion ('cat_%02d.obj' -> 'cat'; "interp" when nothing is left).
+ * Returns buf. */
+ES_API const char *es_study_interp_default_name(const char *output, char *buf, size_t n);
 
 /* ---- shape models for other tools ---------------------------------------- */
 
