@@ -99,12 +99,6 @@ static es_status stored_point(es_ctx *ctx, es_store *store, const char *name, do
     return rc;
 }
 
-es_status es_study_point_lengths(es_ctx *ctx, es_store *store, const char *spec,
-                                 const char *pca_name, double *lengths, double *scale)
-{
-    return es_study_point_weights(ctx, store, spec, pca_name, lengths, scale, NULL);
-}
-
 es_status es_study_point_weights(es_ctx *ctx, es_store *store, const char *spec,
                                  const char *pca_name, double *lengths, double *scale,
                                  double *w)

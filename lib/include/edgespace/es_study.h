@@ -178,15 +178,12 @@ ES_API es_status es_study_point(es_ctx *ctx, es_store *store, const es_study_poi
 /* The E scale-normalized lengths of a point as a command line names it:
  * "row:ID", the name of a stored point (/analysis/point/NAME), or an
  * expression (datasets-spec/point-syntax.md; pca_name: the PCA of pc:K,
- * NULL for the only or the 'default' one). *scale gets the point's own
- * scale, else the mean scale of the store's rows. A length that is not
- * positive (extrapolated too far) is ES_EINVAL naming the edge: no mesh
- * realizes the point. */
-ES_API es_status es_study_point_lengths(es_ctx *ctx, es_store *store, const char *spec,
-                                        const char *pca_name, double *lengths, double *scale);
-/* The same with the point's row weights (es_store_nrows entries; see
- * es_study_resolver): a stored point's own, or, for one stored without
- * them, ridge regression on the rows. */
+ * NULL for the only or the 'default' one), with its row weights (weights,
+ * es_store_nrows entries, may be NULL; see es_study_resolver): a stored
+ * point's own, or, for one stored without them, ridge regression on the
+ * rows. *scale gets the point's own scale, else the mean scale of the
+ * store's rows. A length that is not positive (extrapolated too far) is
+ * ES_EINVAL naming the edge: no mesh realizes the point. */
 ES_API es_status es_study_point_weights(es_ctx *ctx, es_store *store, const char *spec,
                                         const char *pca_name, double *lengths, double *scale,
                                         double *weights);
@@ -530,7 +527,7 @@ ES_API es_status es_study_embedder_point(es_ctx *ctx, es_study_embedder *se, con
 
 /* What es_study_embed does: embed one point of the store's space. */
 typedef struct es_study_embed_opts {
-    const char *point;      /* as es_study_point_lengths reads it (required) */
+    const char *point;      /* as es_study_point_weights reads it (required) */
     const char *pca_name;   /* the PCA of pc:K in the point (NULL: the only one) */
     const char *init;       /* NULL or "prior" (the default): the prior of the point's
                                row weights (es_study_prior, es_embed_prior_solve), the
@@ -580,7 +577,7 @@ typedef void (*es_study_frame_fn)(void *userdata, int64_t i, int64_t n, const ch
 /* What es_study_interp does: a walk between two points, or one weighted
  * combination of rows. */
 typedef struct es_study_interp_opts {
-    const char *from, *to;  /* end points (t = 0 and 1) as es_study_point_lengths reads
+    const char *from, *to;  /* end points (t = 0 and 1) as es_study_point_weights reads
                                them; two rows ("row:A", "row:B") interpolate their
                                meshes (dihedrals averaged on the circle) */
     const char *weights;    /* instead: "w1*row:a + w2*row:b + ..." (two or more rows),
