@@ -17,6 +17,7 @@
  */
 #include "es_test.h"
 #include "es_test_files.h"
+#include "es_test_stores.h"
 
 #include <edgespace/edgespace.h>
 #include <stdio.h>
@@ -27,23 +28,6 @@ static int exists(const char *path)
 {
     struct stat st;
     return stat(path, &st) == 0;
-}
-
-static void make_store(es_ctx *ctx, const char *dir, const char *store)
-{
-    es_synth_set set;
-    es_synth_opts so;
-    char man[4200];
-    es_synth_opts_init(&so);
-    so.n = 6;
-    es_ctx_set_seed(ctx, 3);
-    ES_CHECK_OK(ctx, es_synth_generate(ctx, ES_SYNTH_FACE, &so, &set));
-    ES_CHECK_OK(ctx, es_synth_write(ctx, &set, dir));
-    es_synth_set_clear(ctx, &set);
-    snprintf(man, sizeof man, "%s/manifest.csv", dir);
-    es_ingest_opts io;
-    es_ingest_opts_init(&io);
-    ES_CHECK_OK(ctx, es_ingest_manifest(ctx, store, man, &io, NULL));
 }
 
 /* es_study_embed of the mean to out (and residuals res), stored as name
@@ -187,7 +171,7 @@ int main(void)
     const char *dir = es_test_tmpdir("study-commit");
     snprintf(store, sizeof store, "%s/faces.h5", dir);
     remove(store);
-    make_store(ctx, dir, store);
+    es_test_face_store(ctx, dir, store, 6, 3);
     test_embed(ctx, dir, store);
     test_interp(ctx, dir, store);
     es_ctx_free(ctx);
