@@ -886,7 +886,7 @@ class Store:
         o.gpa.scale, o.gpa.allow_reflection, o.gpa.tol, o.gpa.max_iter = \
             int(scale), int(allow_reflection), float(tol), A.index(max_iter, "max_iter")
         r = None if rows is None else A.indices(rows, (None,), "rows")
-        keep = [_c(name), self._command("gpa")]
+        keep = [_c(name if name is not None else ""), self._command("gpa")]   # required
         o.name, o.command = keep
         rp = A.iptr(r)   # kept alive through the call
         o.rows, o.nrows = rp, -1 if r is None else len(r)
