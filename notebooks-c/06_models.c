@@ -131,14 +131,18 @@ static double slopes_by_group(notebook *nb, es_store *st, const es_study_model_r
 
 static int gpa_of(notebook *nb, es_store *st)
 {
-    es_gpa_opts go;
+    es_study_gpa_opts go;
     es_gpa_report rep;
     es_status rc;
     int64_t n = es_store_nrows(st), *rows = malloc((size_t)(n > 0 ? n : 1) * sizeof *rows);
     if (!rows) return nb_fail(nb, ES_ENOMEM, "GPA");
     for (int64_t i = 0; i < n; i++) rows[i] = i;   /* every row */
-    es_gpa_opts_init(&go);
-    rc = es_study_gpa(nb->ctx, st, "gpa", rows, n, &go, 0, "notebooks-c/06_models", &rep);
+    es_study_gpa_opts_init(&go);
+    go.name = "gpa";
+    go.rows = rows;
+    go.nrows = n;
+    go.command = "notebooks-c/06_models";
+    rc = es_study_gpa(nb->ctx, st, &go, &rep);
     free(rows);
     if (rc != ES_OK) return nb_fail(nb, rc, "GPA");
     nb_p(nb, "GPA: %lld iterations, RMS rho %.4g.", (long long)rep.iterations, rep.rmsrho);

@@ -103,6 +103,11 @@ es_status es__replace_end_staged(es_ctx *ctx, es__file_replace *w, es_status rc,
 es_status es__file_set_commit(es_ctx *ctx, es__file_set *set);
 void es__file_set_abort(es_ctx *ctx, es__file_set *set);
 void es__file_set_clear(es_ctx *ctx, es__file_set *set);
+/* Append from's staged files to into: into's memory is ctx's, from's
+ * from_ctx's (two contexts may have two allocators); from is left empty.
+ * ES_ENOMEM leaves both as they were. */
+es_status es__file_set_move(es_ctx *ctx, es__file_set *into, es_ctx *from_ctx,
+                            es__file_set *from);
 /* The base name of a temporary sibling: base itself, or, when base plus
  * `extra` bytes of suffix would pass NAME_MAX (255), its first 120 bytes (at
  * a UTF-8 boundary), '~' and 16 hex digits of its FNV-1a hash: a store or

@@ -221,6 +221,38 @@ void es__file_set_abort(es_ctx *ctx, es__file_set *set)
     es__file_set_clear(ctx, set);
 }
 
+es_status es__file_set_move(es_ctx *ctx, es__file_set *into, es_ctx *from_ctx,
+                            es__file_set *from)
+{
+    const int64_t n0 = into->n;
+    if (from->n == 0) return ES_OK;
+    if (n0 + from->n > into->cap) {
+        es__file_replace *nw = es__realloc(ctx, into->w, (size_t)(n0 + from->n) * sizeof *nw);
+        if (!nw) return ES_ENOMEM;
+        into->w = nw;
+        into->cap = n0 + from->n;
+    }
+    /* the names copied into ctx's memory first: a failure undoes only them */
+    for (int64_t k = 0; k < from->n; k++) {
+        es__file_replace *d = &into->w[n0 + k];
+        *d = from->w[k];
+        d->tmp = es__strdup(ctx, from->w[k].tmp);
+        d->path = d->tmp ? es__strdup(ctx, from->w[k].path) : NULL;
+        if (!d->tmp || !d->path) {
+            for (int64_t j = 0; j <= k; j++) {
+                es__free(ctx, into->w[n0 + j].tmp);
+                es__free(ctx, (char *)into->w[n0 + j].path);
+            }
+            return ES_ENOMEM;
+        }
+    }
+    into->n = n0 + from->n;
+    /* the targets (malloc'd by realpath) move as they are */
+    for (int64_t k = 0; k < from->n; k++) from->w[k].target = NULL;
+    es__file_set_clear(from_ctx, from);
+    return ES_OK;
+}
+
 void es__file_set_clear(es_ctx *ctx, es__file_set *set)
 {
     for (int64_t k = 0; k < set->n; k++) {

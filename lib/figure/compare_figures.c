@@ -168,13 +168,12 @@ es_status es_figure_compare_write(es_ctx *ctx, const es_compare_result *r,
 }
 
 
-es_status es_figure_compare(es_ctx *ctx, es_store *store, const char *gpa_name, const char *by,
-                            const es_compare_opts *opts, const char *name, const char *out_dir,
-                            const char *command, const char *format,
-                            es_compare_result **res)
+es_status es_figure_compare(es_ctx *ctx, es_store *store, const es_study_compare_opts *opts,
+                            const char *format, es_compare_result **res)
 {
     es_compare_result *r = NULL;
-    es_status rc = es_study_compare(ctx, store, gpa_name, by, opts, name, out_dir, command, &r);
+    const char *out_dir = opts ? opts->out_dir : NULL;
+    es_status rc = es_study_compare(ctx, store, opts, &r);
     if (rc == ES_OK && out_dir)
         rc = es_figure_compare_write(ctx, r, (const char *const *)r->ids, r->group,
                                      (const char *const *)r->group_names, out_dir, format);

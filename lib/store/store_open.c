@@ -30,6 +30,7 @@ static void release(es_store *s, bool keep_work)
     if (s->file >= 0) es__h5_file_close(ctx, s->file, !(s->work && !keep_work), s->path);
     s->file = -1;
     if (s->work && !keep_work) unlink(s->work);
+    es__file_set_abort(ctx, &s->files);   /* never committed: they never appear */
     es__beside_release(s);
     es__store_free_rows(s);
     es_mesh_free(s->mesh);
@@ -311,6 +312,7 @@ es_status es_store_rollback(es_ctx *ctx, es_store *store)
 {
     es_status rc;
     if (!store) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    es__file_set_abort(store->ctx, &store->files);   /* they went with the writes */
     H5E_BEGIN_TRY { rc = rollback_impl(ctx, store); } H5E_END_TRY
     store->generation++;   /* what was read from the discarded writes is stale */
     return rc;
@@ -326,10 +328,18 @@ es_status es_store_close(es_store *store)
     es_status rc = ES_OK;
     if (!store) return ES_OK;
     H5E_BEGIN_TRY {
-        if ((store->work || es__beside_pending(store)) && !store->broken) {
+        const bool pending = store->work || es__beside_pending(store);
+        rc = pending && store->broken ? ES_EIO : ES_OK;
+        if (pending && !store->broken) {
             rc = es__store_publish(store->ctx, store);
             if (rc != ES_OK)
                 es__warn(store->ctx, "%s", es_ctx_errmsg(store->ctx));
+        }
+        /* the files riding on the handle appear with a published store only */
+        es_status frc = es__store_files_done(store->ctx, store, rc);
+        if (frc != ES_OK && rc == ES_OK) {
+            es__warn(store->ctx, "%s", es_ctx_errmsg(store->ctx));
+            rc = frc;
         }
         release(store, false);
     } H5E_END_TRY

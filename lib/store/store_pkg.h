@@ -89,6 +89,8 @@ struct es_store {
                             * mesh_nrows: its faces and row 0 cannot have changed */
     uint64_t mesh_generation;
     int64_t mesh_nrows;
+    es__file_set files;    /* staged files that appear with the next commit
+                            * (es__store_publish_with; memory of ctx above) */
 };
 
 /* ---- HDF5 helpers (store_h5.c); callers run inside H5E_BEGIN_TRY ---- */
@@ -251,6 +253,10 @@ es_status es__store_begin_write(es_store *s);
  * store), then reopen it read-only; ES_OK at once if nothing was written.
  * A failure marks the handle broken. */
 es_status es__store_publish(es_ctx *ctx, es_store *s);
+/* After a commit whose status is rc: the files riding on the handle
+ * (s->files) renamed into place when rc is ES_OK, else discarded; returns
+ * rc or the rename's error (in ctx). */
+es_status es__store_files_done(es_ctx *ctx, es_store *s, es_status rc);
 
 /* A fresh temporary sibling name for any path (the working file of a
  * result beside the store). */

@@ -47,6 +47,16 @@ es_status es__store_ranks_write(es_ctx *ctx, es__store_ranks *h, int64_t row0, i
  * handle on its working copy again. The status agreed by all. */
 es_status es__store_ranks_close(es_ctx *ctx, es_store *s, es__store_ranks *h);
 
+/* Files that appear with the next commit, not before (a study's meshes
+ * and frames beside the results it stored): set's staged files
+ * (es__replace_end_staged) move onto the handle, set is left empty.
+ * es_store_commit (and es_store_close) renames them into place once the
+ * store itself is published, and removes them when the commit fails;
+ * es_store_rollback and es_store_abort remove them. So a store write that
+ * fails leaves no new file behind and an old file as it was. On ES_ENOMEM
+ * set's files are removed. */
+es_status es__store_publish_with(es_ctx *ctx, es_store *s, es__file_set *set);
+
 /* ES_OK if kind (NULL: not checked) and name may name a result: not empty,
  * ".", "..", no '/' or control character, at most 120 bytes
  * (store_names.c); else ES_EINVAL saying which rule it breaks. The one rule

@@ -22,6 +22,7 @@
  * storing one never copies the store.
  */
 #include "store/store_pkg.h"
+#include "store/store_private.h"
 #include "core/files.h"
 
 #include <limits.h>
@@ -271,10 +272,41 @@ fail:
     return rc;
 }
 
+es_status es__store_publish_with(es_ctx *ctx, es_store *s, es__file_set *set)
+{
+    if (!s) {
+        es__file_set_abort(ctx, set);
+        ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
+    }
+    es_status rc = es__file_set_move(s->ctx, &s->files, ctx, set);
+    if (rc != ES_OK) {
+        if (ctx != s->ctx) es__fail(ctx, rc, "%s", es_ctx_errmsg(s->ctx));
+        es__file_set_abort(ctx, set);
+    }
+    return rc;
+}
+
+es_status es__store_files_done(es_ctx *ctx, es_store *s, es_status rc)
+{
+    if (s->files.n == 0) return rc;
+    if (rc != ES_OK) {
+        es__file_set_abort(s->ctx, &s->files);
+        return rc;
+    }
+    /* renames in the files' own folders: they fail only when a folder
+     * changed under us; the store is published by then, and says so */
+    if ((rc = es__file_set_commit(s->ctx, &s->files)) != ES_OK) {
+        char msg[1024];
+        snprintf(msg, sizeof msg, "%s", es_ctx_errmsg(s->ctx));
+        rc = es__fail(ctx, rc, "store: committed '%s', but %s", s->path, msg);
+    }
+    return rc;
+}
+
 es_status es_store_commit(es_ctx *ctx, es_store *store)
 {
     es_status rc;
     if (!store) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
     H5E_BEGIN_TRY { rc = es__store_publish(ctx, store); } H5E_END_TRY
-    return rc;
+    return es__store_files_done(ctx, store, rc);
 }

@@ -99,9 +99,15 @@ static es_status group_centroid_sizes(es_ctx *ctx, es_store *store, const int64_
     return rc;
 }
 
-es_status es_study_mean(es_ctx *ctx, es_store *store, const char *name, const char *filter,
-                           const char *by, const char *command, es_group_result **out)
+void es_study_mean_opts_init(es_study_mean_opts *o) { memset(o, 0, sizeof *o); }
+
+es_status es_study_mean(es_ctx *ctx, es_store *store, const es_study_mean_opts *opts,
+                        es_group_result **out)
 {
+    es_study_mean_opts o;
+    if (opts) o = *opts;
+    else es_study_mean_opts_init(&o);
+    const char *name = o.name, *filter = o.where, *by = o.by, *command = o.command;
     es_status rc;
     int64_t *rows = NULL, nrows = 0, *group = NULL, ng = 0;
     const char **labels = NULL, **gnames = NULL;
@@ -247,10 +253,19 @@ done:
     return rc;
 }
 
-es_status es_study_pca(es_ctx *ctx, es_store *store, const char *name, const char *filter,
-                          const es_pca_opts *opts, const char *command, es_pca **out,
-                          int64_t **rows_out, int64_t *nrows_out)
+void es_study_pca_opts_init(es_study_pca_opts *o)
 {
+    memset(o, 0, sizeof *o);
+    es_pca_opts_init(&o->pca);
+}
+
+es_status es_study_pca(es_ctx *ctx, es_store *store, const es_study_pca_opts *opts,
+                       es_pca **out, int64_t **rows_out, int64_t *nrows_out)
+{
+    es_study_pca_opts o;
+    if (opts) o = *opts;
+    else es_study_pca_opts_init(&o);
+    const char *name = o.name, *filter = o.where;
     int64_t *rows = NULL, nrows = 0;
     es_pca *p = NULL;
     es_source src;
@@ -261,9 +276,9 @@ es_status es_study_pca(es_ctx *ctx, es_store *store, const char *name, const cha
     es_status rc = es_store_select(ctx, store, filter, &rows, &nrows);
     if (rc != ES_OK) return rc;
     if ((rc = es_study_source(ctx, store, rows, nrows, &src)) != ES_OK ||
-        (rc = es_pca_fit(ctx, &src, opts, &p)) != ES_OK)
+        (rc = es_pca_fit(ctx, &src, &o.pca, &p)) != ES_OK)
         goto done;
-    if (name && (rc = save_pca(ctx, store, name, p, rows, filter, command)) != ES_OK) goto done;
+    if (name && (rc = save_pca(ctx, store, name, p, rows, filter, o.command)) != ES_OK) goto done;
     if (out) {
         *out = p;
         p = NULL;
@@ -379,11 +394,16 @@ done:
 
 /* ---- differences ------------------------------------------------------------------ */
 
-es_status es_study_diff(es_ctx *ctx, es_store *store, const char *name, const char *filter,
-                           const char *key, const char *column, const char *from, const char *to,
-                           const char *command, es_diff **out)
+void es_study_diff_opts_init(es_study_diff_opts *o) { memset(o, 0, sizeof *o); }
+
+es_status es_study_diff(es_ctx *ctx, es_store *store, const es_study_diff_opts *opts,
+                        es_diff **out)
 {
     if (out) *out = NULL;
+    if (!opts) ES_FAIL(ctx, ES_EINVAL, "diff: a key column, a role column, 'from' and 'to' are needed");
+    const char *name = opts->name, *filter = opts->where, *key = opts->key,
+               *column = opts->column, *from = opts->from, *to = opts->to,
+               *command = opts->command;
     CHECK_NAME(ctx, store, "diff", name);
     NEED_EDGES(ctx, store);
     if (!key || !column || !from || !to)
@@ -665,15 +685,19 @@ es_status es_study_resolve(es_ctx *ctx, void *ud, es_point_leaf kind, const char
     ES_FAIL(ctx, ES_EINVAL, "unknown leaf kind %d", (int)kind);
 }
 
-es_status es_study_point(es_ctx *ctx, es_store *store, const char *name, const char *expr,
-                         const char *pca_name, double scale, const char *command, double **vec,
-                         double *weights, es_point_info *info)
+void es_study_point_opts_init(es_study_point_opts *o) { memset(o, 0, sizeof *o); }
+
+es_status es_study_point(es_ctx *ctx, es_store *store, const es_study_point_opts *opts,
+                         double **vec, double *weights, es_point_info *info)
 {
     es_point_expr *x = NULL;
     es_mesh *mesh = NULL;
     es_point_info in;
-    es_study_resolver r = {store, NULL, pca_name, NULL, NULL, NULL, NULL};
     if (vec) *vec = NULL;
+    if (!opts || !opts->expr) ES_FAIL(ctx, ES_EINVAL, "point: no expression");
+    const char *name = opts->name, *expr = opts->expr, *command = opts->command;
+    const double scale = opts->scale;
+    es_study_resolver r = {store, NULL, opts->pca_name, NULL, NULL, NULL, NULL};
     CHECK_NAME(ctx, store, "point", name);
     NEED_EDGES(ctx, store);
     const int64_t E = es_store_nedges(store), N = es_store_nrows(store);

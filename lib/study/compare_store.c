@@ -71,25 +71,31 @@ static es_status add_rho(es_ctx *ctx, es_store *store, const char *gpa_name, es_
                           (es_mat){r->d_rho, r->n, r->n, r->n});
 }
 
-es_status es_study_compare(es_ctx *ctx, es_store *store, const char *gpa_name,
-                           const char *by, const es_compare_opts *opts, const char *name,
-                           const char *out_dir, const char *command, es_compare_result **res)
+void es_study_compare_opts_init(es_study_compare_opts *o)
 {
+    memset(o, 0, sizeof *o);
+    es_compare_opts_init(&o->compare);
+}
+
+es_status es_study_compare(es_ctx *ctx, es_store *store, const es_study_compare_opts *opts,
+                           es_compare_result **res)
+{
+    if (res) *res = NULL;
+    if (!opts) ES_FAIL(ctx, ES_EINVAL, "compare: bad GPA result name ''");
+    const char *gpa_name = opts->gpa_name, *by = opts->by, *name = opts->name,
+               *out_dir = opts->out_dir, *command = opts->command;
     char path[1024];
     es_status rc;
     es_mat al = {0}, len = {0};
     int64_t *rows = NULL, n = 0, *group = NULL, ng = 0, e = es_store_nedges(store);
     char **gnames = NULL, **ids = NULL;
     es_compare_result *r = NULL;
-    if (res) *res = NULL;
     if (!gpa_name || !*gpa_name || strchr(gpa_name, '/'))
         ES_FAIL(ctx, ES_EINVAL, "compare: bad GPA result name '%s'", gpa_name ? gpa_name : "");
     if (e < 1) ES_FAIL(ctx, ES_EINVAL, "compare: store '%s' has no edges: it holds landmarks "
                        "only; give --edges or --triangles at ingest", es_store_path(store));
     /* a taken result name is refused before the permutations run */
-    if (*(name ? name : gpa_name) &&
-        (rc = es_store_result_check(ctx, store, "compare", name ? name : gpa_name)) != ES_OK)
-        return rc;
+    if (name && (rc = es_store_result_check(ctx, store, "compare", name)) != ES_OK) return rc;
     snprintf(path, sizeof path, "gpa/%s", gpa_name);
     if (!es_store_has(store, path)) {
         char hint[400];
@@ -133,19 +139,16 @@ es_status es_study_compare(es_ctx *ctx, es_store *store, const char *gpa_name,
             ng = 0;
         }
     }
-    if ((rc = es_compare_study(ctx, len, al, ng ? group : NULL, ng, opts, &r)) != ES_OK) goto done;
+    if ((rc = es_compare_study(ctx, len, al, ng ? group : NULL, ng, &opts->compare, &r)) != ES_OK) goto done;
     if ((rc = add_rho(ctx, store, gpa_name, al, r)) != ES_OK) goto done;
     if (out_dir && (rc = es_study_compare_write(ctx, r, (const char *const *)ids,
                                                 ng ? group : NULL,
                                                 (const char *const *)gnames, out_dir)) != ES_OK)
         goto done;
-    if (!name) name = gpa_name;
-    if (*name) {
+    if (name) {
         char params[512], grp[512];
-        es_compare_opts o;
-        if (opts) o = *opts; else es_compare_opts_init(&o);
         snprintf(params, sizeof params, "gpa=%s; by=%s; permutations=%lld", gpa_name,
-                 by ? by : "", (long long)o.permutations);
+                 by ? by : "", (long long)opts->compare.permutations);
         es_provenance prov = {command ? command : "es_study_compare", rows, n, params};
         if ((rc = es_store_result_begin(ctx, store, "compare", name, &prov)) != ES_OK) goto done;
         snprintf(grp, sizeof grp, "compare/%s", name);

@@ -6,6 +6,7 @@
 #include "study/study_pkg.h"
 #include "edgespace/es_io.h"
 #include "meshio/meshio_private.h"
+#include "store/store_private.h"
 
 #include <errno.h>
 #include <math.h>
@@ -183,9 +184,10 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
                                                init_xyz, &o->embed, xyz, &res->report)) != ES_OK) {
         goto done;
     }
-    /* with a stored result the files are staged beside their targets and
-     * renamed into place after the commit: a failed store write leaves no
-     * mesh behind, and an old file as it was */
+    /* the files are staged beside their targets; with a stored result they
+     * are renamed into place by the caller's commit of the store
+     * (es__store_publish_with): a failed store write leaves no mesh behind,
+     * and an old file as it was */
     if ((o->output && (rc = es__mesh_write_staged(ctx, o->output,
                                                   es_meshio_format_from_path(o->output), mesh,
                                                   xyz, &files)) != ES_OK) ||
@@ -200,17 +202,14 @@ es_status es_study_embed(es_ctx *ctx, es_store *s, const es_study_embed_opts *o,
                               params};
         snprintf(params, sizeof params, "point=%s; scale=%.17g", o->point, res->scale);
         if ((rc = es_study_store_embedding(ctx, s, o->name, &prov, emb, target, xyz,
-                                           &res->report, res->init)) != ES_OK ||
-            (rc = es_store_commit(ctx, s)) != ES_OK)
+                                           &res->report, res->init)) != ES_OK)
             goto done;
-    }
-    if ((rc = es__file_set_commit(ctx, &files)) != ES_OK && o->name) {
-        char msg[1024];
-        snprintf(msg, sizeof msg, "%s", es_ctx_errmsg(ctx));
-        rc = es__fail(ctx, rc, "embed: stored as embed/%s, but %s", o->name, msg);
+        rc = es__store_publish_with(ctx, s, &files);
+    } else {
+        rc = es__file_set_commit(ctx, &files);   /* nothing stored: at once */
     }
 done:
-    es__file_set_abort(ctx, &files);   /* what is left of it: nothing after a commit */
+    es__file_set_abort(ctx, &files);   /* what is left of it: nothing once handed on */
     if (se) emb = NULL;   /* the session's */
     es_embedder_free(emb);
     if (se != o->session) es_study_embedder_free(se);

@@ -31,11 +31,23 @@ static void free_bufs(es_ctx *ctx, gpa_bufs *b)
     for (size_t i = 0; i < sizeof own / sizeof own[0]; i++) es__free(ctx, own[i]);
 }
 
-es_status es_study_gpa(es_ctx *ctx, es_store *store, const char *name, const int64_t *rows,
-                           int64_t nrows, const es_gpa_opts *opts, int64_t npc,
-                           const char *command, es_gpa_report *report)
+void es_study_gpa_opts_init(es_study_gpa_opts *o)
 {
-    es_gpa_opts o;
+    memset(o, 0, sizeof *o);
+    o->nrows = -1;
+    es_gpa_opts_init(&o->gpa);
+}
+
+es_status es_study_gpa(es_ctx *ctx, es_store *store, const es_study_gpa_opts *opts,
+                       es_gpa_report *report)
+{
+    es_study_gpa_opts so;
+    if (opts) so = *opts;
+    else es_study_gpa_opts_init(&so);
+    const char *name = so.name, *command = so.command;
+    const int64_t *rows = so.rows, nrows = so.nrows;
+    int64_t npc = so.npc;
+    es_gpa_opts o = so.gpa;
     es_gpa_report rep;
     es_status rc = ES_OK;
     gpa_bufs b;
@@ -44,11 +56,9 @@ es_status es_study_gpa(es_ctx *ctx, es_store *store, const char *name, const int
     const int ranks = es__par_size(ctx), writer = es__par_rank(ctx) == 0;
     memset(&b, 0, sizeof b);
     memset(&rep, 0, sizeof rep);
-    if (opts) o = *opts; else es_gpa_opts_init(&o);
-    if (writer && (!name || !*name || strchr(name, '/')))
-        rc = es__fail(ctx, ES_EINVAL, "gpa: result name '%s' is empty or has '/'",
-                      name ? name : "");
-    else if (writer) rc = es_store_result_check(ctx, store, "gpa", name);
+    if (writer && name && (!*name || strchr(name, '/')))
+        rc = es__fail(ctx, ES_EINVAL, "gpa: result name '%s' is empty or has '/'", name);
+    else if (writer && name) rc = es_store_result_check(ctx, store, "gpa", name);
     if ((rc = es__par_agree(ctx, rc)) != ES_OK) return rc;
     if (n < 2) ES_FAIL(ctx, ES_EINVAL, "gpa: needs at least 2 rows, got %lld", (long long)n);
     if (k < 1) ES_FAIL(ctx, ES_EINVAL, "gpa: the store has no vertices");
@@ -133,6 +143,8 @@ es_status es_study_gpa(es_ctx *ctx, es_store *store, const char *name, const int
     double *sct = b.scores + n * npc;   /* npc x n: stored as n x npc */
     for (int64_t j = 0; j < n; j++)
         for (int64_t c = 0; c < npc; c++) sct[c + j * npc] = b.scores[j + c * n];
+
+    if (!name) goto done;   /* nothing stored: the report alone */
 
     /* write the result */
     char params[256], path[1024], grp[512];

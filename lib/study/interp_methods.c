@@ -46,7 +46,7 @@ static double step_t(const es_study_interp_opts *o, int64_t i)
                          : o->t0 + (o->t1 - o->t0) * (double)i / (double)(o->steps - 1);
 }
 
-/* Frame i written, reported and (with a command) stored. emb: the embedder
+/* Frame i written, reported and (with a name) stored. emb: the embedder
  * that made it (data-driven), or NULL with the per-vertex values vc, ve. */
 static es_status emit(mwalk *w, int64_t i, const char *heading, const double *target,
                       const double *xyz, const es_embed_report *rep, const es_embedder *emb,
@@ -62,8 +62,9 @@ static es_status emit(mwalk *w, int64_t i, const char *heading, const double *ta
                                     w->file_mesh ? w->file_xyz : xyz, &w->files)) != ES_OK)
         return rc;
     if (o->frame) o->frame(o->userdata, i, o->steps, fname, heading, rep);
-    if (!o->command) return ES_OK;
-    es_provenance prov = {o->command, rows, w->rb < 0 ? 1 : 2, params};
+    if (!o->name) return ES_OK;
+    es_provenance prov = {o->command ? o->command : "es_study_interp", rows, w->rb < 0 ? 1 : 2,
+                          params};
     snprintf(init, sizeof init, "%s", es_morph_method_name(o->method));
     if (emb)
         return es_study_store_embedding(w->ctx, w->store, rname, &prov, emb, target, xyz, rep,

@@ -20,6 +20,7 @@
 #include "edgespace/es_io.h"
 #include "core/files.h"
 #include "meshio/meshio_private.h"
+#include "store/store_private.h"
 
 #include <ctype.h>
 #include <math.h>
@@ -113,7 +114,7 @@ static es_status emit_frame(walk *wk, int64_t i, const char *heading, const doub
                                     &wk->files)) != ES_OK)
         return rc;
     if (o->frame) o->frame(o->userdata, i, o->steps, fname, heading, rep);
-    if (!o->command) return ES_OK;
+    if (!o->name) return ES_OK;
     return es_study_store_embedding(wk->ctx, wk->store, rname, prov, wk->emb, target, xyz, rep,
                                     init);
 }
@@ -121,19 +122,26 @@ static es_status emit_frame(walk *wk, int64_t i, const char *heading, const doub
 es_status es__study_frames_done(es_ctx *ctx, es_store *store, const es_study_interp_opts *o,
                                 es_status rc, int was_pending, es__file_set *files)
 {
-    if (rc == ES_OK && o->command) rc = es_store_commit(ctx, store);
     if (rc != ES_OK) {
         char msg[1024];
         es__file_set_abort(ctx, files);
         /* frames already stored in the working copy go with the files */
         snprintf(msg, sizeof msg, "%s", es_ctx_errmsg(ctx));
-        if (o->command && !was_pending && es_store_pending(store) &&
+        if (o->name && !was_pending && es_store_pending(store) &&
             es_store_rollback(ctx, store) != ES_OK)
             es__warn(ctx, "%s", es_ctx_errmsg(ctx));
         es__fail(ctx, rc, "%s", msg);
         return rc;
     }
+    /* stored frames: the files appear with the caller's commit of the store */
+    if (o->name) return es__store_publish_with(ctx, store, files);
     return es__file_set_commit(ctx, files);
+}
+
+const char *es_study_interp_default_name(const char *output, char *buf, size_t n)
+{
+    default_name(output ? output : "", buf, n);
+    return buf;
 }
 
 const char *es_study_interp_name(const es_study_interp_opts *o, char *buf, size_t n)
@@ -209,7 +217,7 @@ static es_status embed_frame(walk *wk, int64_t i, double t, const double *v, dou
         es__free(ctx, rows);
         return rc;
     }
-    es_provenance prov = {o->command, rows, nrows, params};
+    es_provenance prov = {o->command ? o->command : "es_study_interp", rows, nrows, params};
     if (o->weights) {
         snprintf(params, sizeof params, "weights=%s", o->weights);
         snprintf(heading, sizeof heading, "weights");
@@ -276,7 +284,7 @@ es_status es_study_interp(es_ctx *ctx, es_store *store, const es_study_interp_op
     if (o->name) snprintf(wk.name, sizeof wk.name, "%s", o->name);
     else default_name(o->output, wk.name, sizeof wk.name);
     /* every frame's result name is free (or replaced) before a frame is written */
-    for (int64_t i = 0; o->command && i < (o->weights ? 1 : o->steps); i++) {
+    for (int64_t i = 0; o->name && i < (o->weights ? 1 : o->steps); i++) {
         char rn[300];
         if (!o->weights && o->steps > 1) snprintf(rn, sizeof rn, "%s_%02lld", wk.name, (long long)i);
         else snprintf(rn, sizeof rn, "%s", wk.name);

@@ -99,12 +99,6 @@ static es_status stored_point(es_ctx *ctx, es_store *store, const char *name, do
     return rc;
 }
 
-es_status es_study_point_lengths(es_ctx *ctx, es_store *store, const char *spec,
-                                 const char *pca_name, double *lengths, double *scale)
-{
-    return es_study_point_weights(ctx, store, spec, pca_name, lengths, scale, NULL);
-}
-
 es_status es_study_point_weights(es_ctx *ctx, es_store *store, const char *spec,
                                  const char *pca_name, double *lengths, double *scale,
                                  double *w)
@@ -151,8 +145,12 @@ es_status es__study_point_weights_via(es_ctx *ctx, es_store *store, const char *
     } else {   /* an expression (es_point.h syntax) */
         es_point_info info;
         double *v = NULL;
-        if ((rc = es_study_point(ctx, store, NULL, spec, pca_name, 0, "edgespace", &v, w,
-                                 &info)) == ES_OK) {
+        es_study_point_opts po;
+        es_study_point_opts_init(&po);
+        po.expr = spec;
+        po.pca_name = pca_name;
+        po.command = "edgespace";
+        if ((rc = es_study_point(ctx, store, &po, &v, w, &info)) == ES_OK) {
             memcpy(lengths, v, (size_t)ne * sizeof *lengths);
             if (isfinite(info.scale) && info.scale > 0) *scale = info.scale;
         }

@@ -576,10 +576,13 @@ class Store:
         `by` (es_study_mean); stored as mean/<name> when name is given
         (replace=True: over one of that name, as every storing call)."""
         where = renamed("Store.mean", "where", where, "filter", filter)
+        o = ffi.new("es_study_mean_opts *")
+        lib.es_study_mean_opts_init(o)
+        keep = [_c(name or None), _c(where or None), _c(by or None), self._command("mean")]
+        o.name, o.where, o.by, o.command = keep
         out = ffi.new("es_group_result **")
         with self._replacing(replace):
-            self._call(lib.es_study_mean, _s(name) or ffi.NULL,
-                      _s(where) or ffi.NULL, _s(by) or ffi.NULL, self._command("mean"), out)
+            self._call(lib.es_study_mean, o, out)
         r = A.owned(self.ctx, out[0], lib.es_study_group_result_free)
         G, E = int(r.ngroups), int(r.nedges)
         res = MeanResult(groups=[A.string(r.names[g]) for g in range(G)],
@@ -596,15 +599,16 @@ class Store:
         given. Returns a PCA with .rows."""
         where = renamed("Store.pca", "where", where, "filter", filter)
         components = renamed("Store.pca", "components", components, "ncomp", ncomp) or 0
-        o = ffi.new("es_pca_opts *")
-        lib.es_pca_opts_init(o)
-        o.ncomp, o.method = A.index(components, "components"), _pca_method(method)
-        o.oversample = A.index(oversample, "oversample")
-        o.power_iters = A.index(power_iters, "power_iters")
+        o = ffi.new("es_study_pca_opts *")
+        lib.es_study_pca_opts_init(o)
+        keep = [_c(name or None), _c(where or None), self._command("pca")]
+        o.name, o.where, o.command = keep
+        o.pca.ncomp, o.pca.method = A.index(components, "components"), _pca_method(method)
+        o.pca.oversample = A.index(oversample, "oversample")
+        o.pca.power_iters = A.index(power_iters, "power_iters")
         out, rows, n = ffi.new("es_pca **"), ffi.new("int64_t **"), ffi.new("int64_t *")
         with self._replacing(replace):
-            self._call(lib.es_study_pca, _s(name) or ffi.NULL, _s(where) or ffi.NULL,
-                          o, self._command("pca"), out, rows, n)
+            self._call(lib.es_study_pca, o, out, rows, n)
         r = np.array(A.view(rows[0], (n[0],), A.Freed(self.ctx, rows[0]), "i8"))
         self._committed(name)
         return PCA(self.ctx, out[0], r)
@@ -623,10 +627,16 @@ class Store:
         --from, --to, --where); stored as diff/<name> when name is given."""
         pair_by = renamed("Store.diff", "pair_by", pair_by, "key", key)
         where = renamed("Store.diff", "where", where, "filter", filter)
+        o = ffi.new("es_study_diff_opts *")
+        lib.es_study_diff_opts_init(o)
+        keep = [_c(name or None), _c(where or None), _c(pair_by), _c(column), _c(from_), _c(to),
+                self._command("diff")]
+        o.name, o.where, o.key, o.column = keep[:4]
+        setattr(o, "from", keep[4])   # a Python keyword
+        o.to, o.command = keep[5:]
         out = ffi.new("es_diff **")
         with self._replacing(replace):
-            self._call(lib.es_study_diff, _s(name) or ffi.NULL, _s(where) or ffi.NULL,
-                          _s(pair_by), _s(column), _s(from_), _s(to), self._command("diff"), out)
+            self._call(lib.es_study_diff, o, out)
         d = A.owned(self.ctx, out[0], lib.es_diff_free)
         E, P, U = int(d.nedges), int(d.npairs), int(d.nunpaired)
         res = Diff(mean=A.view(d.mean, (E,), d), sd=A.view(d.sd, (E,), d),
@@ -644,10 +654,13 @@ class Store:
         vec = ffi.new("double **")
         w = np.empty(self.nrows)
         info = ffi.new("es_point_info *")
+        o = ffi.new("es_study_point_opts *")
+        lib.es_study_point_opts_init(o)
+        keep = [_c(name or None), _c(expr), _c(pca or None), self._command("point")]
+        o.name, o.expr, o.pca_name, o.command = keep
+        o.scale = float(scale)
         with self._replacing(replace):
-            self._call(lib.es_study_point, _s(name) or ffi.NULL, _s(expr),
-                          _s(pca) or ffi.NULL, float(scale), self._command("point"), vec, A.dptr(w),
-                          info)
+            self._call(lib.es_study_point, o, vec, A.dptr(w), info)
         lengths = np.array(A.view(vec[0], (self.nedges,), A.Freed(self.ctx, vec[0])))
         inf = A.struct_dict(info, "es_point_info")
         inf["validity"] = A.struct_dict(info.validity, "es_validity")
@@ -741,6 +754,7 @@ class Store:
         res = ffi.new("es_study_embed_result *")
         with self._replacing(replace):
             self._call(lib.es_study_embed, o, A.dptr(xyz), res)
+        self._committed(name)   # the mesh and residual files appear with it
         return study_embedding(xyz, self.mesh.faces, res)
 
     def _session(self):
@@ -824,8 +838,8 @@ class Store:
         cb = ffi.callback("es_study_frame_fn", on_frame)
         with tempfile.TemporaryDirectory(prefix="edgespace-interp-") as d:
             pattern = output if output is not None else os.path.join(d, "frame_%04d.ply")
-            keep = [_c(from_), _c(to), _c(weights), _c(pca), _c(pattern), _c(name),
-                    self._command("interp") if name else ffi.NULL]
+            keep = [_c(from_), _c(to), _c(weights), _c(pca), _c(pattern), _c(name or None),
+                    self._command("interp")]
             setattr(o, "from", keep[0])   # a Python keyword
             o.to, o.weights, o.pca_name, o.output, o.name, o.command = keep[1:]
             o.t0, o.t1, o.steps = float(t0), float(t1), A.index(steps, "steps")
@@ -838,6 +852,7 @@ class Store:
             try:
                 with self._replacing(replace):
                     self._call(lib.es_study_interp, o)
+                self._committed(name)   # the frame files appear with it
             finally:
                 self.ctx.seed = old_seed
             out = []
@@ -866,15 +881,19 @@ class Store:
         (es_study_gpa), stored as gpa/<name> and committed; the stored arrays
         come back in (specimen, landmark, dimension) order."""
         components = renamed("Store.gpa", "components", components, "npc", npc) or 0
-        o = ffi.new("es_gpa_opts *")
-        lib.es_gpa_opts_init(o)
-        o.scale, o.allow_reflection, o.tol, o.max_iter = int(scale), int(allow_reflection), \
-            float(tol), A.index(max_iter, "max_iter")
+        o = ffi.new("es_study_gpa_opts *")
+        lib.es_study_gpa_opts_init(o)
+        o.gpa.scale, o.gpa.allow_reflection, o.gpa.tol, o.gpa.max_iter = \
+            int(scale), int(allow_reflection), float(tol), A.index(max_iter, "max_iter")
         r = None if rows is None else A.indices(rows, (None,), "rows")
+        keep = [_c(name if name is not None else ""), self._command("gpa")]   # required
+        o.name, o.command = keep
+        rp = A.iptr(r)   # kept alive through the call
+        o.rows, o.nrows = rp, -1 if r is None else len(r)
+        o.npc = A.index(components, "components")
         rep = ffi.new("es_gpa_report *")
         with self._replacing(replace):
-            self._call(lib.es_study_gpa, _s(name), A.iptr(r), -1 if r is None else len(r), o,
-                       A.index(components, "components"), self._command("gpa"), rep)
+            self._call(lib.es_study_gpa, o, rep)
         self.commit()
         return self.load_gpa(name, A.struct_dict(rep, "es_gpa_report"))
 
@@ -902,16 +921,17 @@ class Store:
         """Edge-length space against Procrustes space on a stored GPA's rows
         (es_study_compare); stored as compare/<name> (None: not stored) and
         committed; out_dir gets the CSV tables."""
-        o = ffi.new("es_compare_opts *")
-        lib.es_compare_opts_init(o)
-        o.permutations = A.index(permutations, "permutations")
-        o.top_pairs = A.index(top_pairs, "top_pairs")
-        o.normalize_lengths = int(normalize_lengths)
+        o = ffi.new("es_study_compare_opts *")
+        lib.es_study_compare_opts_init(o)
+        o.compare.permutations = A.index(permutations, "permutations")
+        o.compare.top_pairs = A.index(top_pairs, "top_pairs")
+        o.compare.normalize_lengths = int(normalize_lengths)
+        keep = [_c(gpa), _c(by or None), _c(name or None), _c(out_dir or None),
+                self._command("compare")]
+        o.gpa_name, o.by, o.name, o.out_dir, o.command = keep
         out = ffi.new("es_compare_result **")
         with self._replacing(replace):
-            self._call(lib.es_study_compare, _s(gpa), _s(by) or ffi.NULL, o,
-                          _s(name) if name else b"", _s(out_dir) or ffi.NULL,
-                          self._command("compare"), out)
+            self._call(lib.es_study_compare, o, out)
         r = A.owned(self.ctx, out[0], lib.es_compare_result_free)
         if name:
             self.commit()

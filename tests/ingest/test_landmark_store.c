@@ -92,17 +92,17 @@ static void check_none(es_ctx *ctx, const es_landmarks *lm, const char *path)
     free(sc);
     ES_CHECK_FAILS(ctx, es_store_mesh(ctx, s, &m), ES_EINVAL, NOEDGES);
     ES_CHECK(m == NULL);
-    ES_CHECK_FAILS(ctx, es_study_pca(ctx, s, NULL, NULL, NULL, "test", NULL, NULL, NULL),
-                   ES_EINVAL, NOEDGES);
-    ES_CHECK_FAILS(ctx, es_study_mean(ctx, s, NULL, NULL, NULL, "test", NULL), ES_EINVAL,
-                   NOEDGES);
+    ES_CHECK_FAILS(ctx, es_study_pca(ctx, s, NULL, NULL, NULL, NULL), ES_EINVAL, NOEDGES);
+    ES_CHECK_FAILS(ctx, es_study_mean(ctx, s, NULL, NULL), ES_EINVAL, NOEDGES);
     es_store_close(s);
     /* GPA runs on it and its result survives the commit */
-    es_gpa_opts o;
+    es_study_gpa_opts o;
     es_gpa_report rep;
-    es_gpa_opts_init(&o);
+    es_study_gpa_opts_init(&o);
+    o.name = "g";
+    o.command = "test";
     ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_WRITE, &s));
-    ES_CHECK_OK(ctx, es_study_gpa(ctx, s, "g", NULL, -1, &o, 0, "test", &rep));
+    ES_CHECK_OK(ctx, es_study_gpa(ctx, s, &o, &rep));
     ES_CHECK(rep.converged && rep.rmsrho > 0 && isfinite(rep.gss));
     ES_CHECK_OK(ctx, es_store_commit(ctx, s));
     es_store_close(s);
@@ -175,7 +175,11 @@ static void check_truss(es_ctx *ctx, const es_landmarks *lm, const char *path)
     /* PCA on the truss lengths: orthonormal components, scores reproduce the data */
     es_pca *p = NULL;
     int64_t *rows = NULL, nr = 0;
-    ES_CHECK_OK(ctx, es_study_pca(ctx, s, "p", NULL, NULL, "test", &p, &rows, &nr));
+    es_study_pca_opts spo;
+    es_study_pca_opts_init(&spo);
+    spo.name = "p";
+    spo.command = "test";
+    ES_CHECK_OK(ctx, es_study_pca(ctx, s, &spo, &p, &rows, &nr));
     if (p) {
         ES_CHECK(p->nedges == E && nr == lm->n && p->ncomp >= 1);
         double worst = 0;

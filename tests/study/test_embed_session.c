@@ -20,6 +20,7 @@
  */
 #include "es_test.h"
 #include "es_test_files.h"
+#include "es_test_stores.h"
 
 #include <edgespace/edgespace.h>
 #include <math.h>
@@ -37,23 +38,6 @@ static void log_fn(void *ud, es_log_level lv, const char *msg)
     if (!strstr(msg, "cache")) return;
     if (!saw_cache_note++) cache_notes[0] = '\0';
     strncat(cache_notes, msg, sizeof cache_notes - strlen(cache_notes) - 1);
-}
-
-static void make_store(es_ctx *ctx, const char *dir, const char *store)
-{
-    es_synth_set set;
-    es_synth_opts so;
-    char man[4200];
-    es_synth_opts_init(&so);
-    so.n = 8;
-    es_ctx_set_seed(ctx, 7);
-    ES_CHECK_OK(ctx, es_synth_generate(ctx, ES_SYNTH_FACE, &so, &set));
-    ES_CHECK_OK(ctx, es_synth_write(ctx, &set, dir));
-    es_synth_set_clear(ctx, &set);
-    snprintf(man, sizeof man, "%s/manifest.csv", dir);
-    es_ingest_opts io;
-    es_ingest_opts_init(&io);
-    ES_CHECK_OK(ctx, es_ingest_manifest(ctx, store, man, &io, NULL));
 }
 
 static const char *const points[3] = {"mean", "mean + 2*pc:1",
@@ -133,13 +117,18 @@ int main(void)
     const char *dir = es_test_tmpdir("embed-session");
     snprintf(store, sizeof store, "%s/faces.h5", dir);
     snprintf(cache, sizeof cache, "%s.es-cache", store);
-    make_store(ctx, dir, store);
+    es_test_face_store(ctx, dir, store, 8, 7);
     ES_CHECK_OK(ctx, es_store_open(ctx, store, ES_STORE_WRITE, &s));
     if (!s) ES_TEST_END();
     es_pca_opts po;
     es_pca_opts_init(&po);
     po.ncomp = 4;
-    ES_CHECK_OK(ctx, es_study_pca(ctx, s, "p", NULL, &po, "test", NULL, NULL, NULL));
+    es_study_pca_opts spo;
+    es_study_pca_opts_init(&spo);
+    spo.name = "p";
+    spo.pca = po;
+    spo.command = "test";
+    ES_CHECK_OK(ctx, es_study_pca(ctx, s, &spo, NULL, NULL, NULL));
     ES_CHECK_OK(ctx, es_store_commit(ctx, s));
     int64_t nv = es_store_nverts(s), n3 = 3 * nv;
     double *ref = malloc(3 * (size_t)n3 * sizeof *ref), *got = malloc(3 * (size_t)n3 * sizeof *got);
@@ -339,9 +328,9 @@ int main(void)
             if (pca == 0) {   /* the PCA replaced (of the neutral rows, 3 components) */
                 memcpy(got + n3, ref, (size_t)n3 * sizeof *ref);
                 ES_CHECK_OK(ctx, es_store_delete_result(ctx, s, "pca", "p"));
-                po.ncomp = 3;
-                ES_CHECK_OK(ctx, es_study_pca(ctx, s, "p", "expression=neutral", &po, "test", NULL,
-                                              NULL, NULL));
+                spo.where = "expression=neutral";
+                spo.pca.ncomp = 3;
+                ES_CHECK_OK(ctx, es_study_pca(ctx, s, &spo, NULL, NULL, NULL));
                 ES_CHECK(es_store_generation(s) != gen);
             } else {
                 ES_CHECK(!same(got + n3, got, n3));   /* not the old PCA's point */

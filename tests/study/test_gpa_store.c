@@ -83,13 +83,22 @@ static void test_barbells(es_ctx *ctx)
     ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_WRITE, &s));
     if (!s) { es_synth_set_clear(ctx, &set); return; }
     es_gpa_report rep;
-    ES_CHECK_OK(ctx, es_study_gpa(ctx, s, "full", NULL, -1, NULL, 0, "test", &rep));
+    es_study_gpa_opts go;
+    es_study_gpa_opts_init(&go);
+    go.name = "full";
+    go.command = "test";
+    ES_CHECK_OK(ctx, es_study_gpa(ctx, s, &go, &rep));
     ES_CHECK(rep.converged);
-    es_compare_opts o;
-    es_compare_opts_init(&o);
-    o.permutations = 23;   /* 4 shapes: 24 relabellings */
+    es_study_compare_opts o;
+    es_study_compare_opts_init(&o);
+    o.gpa_name = "full";
+    o.by = "end";
+    o.compare.permutations = 23;   /* 4 shapes: 24 relabellings */
+    o.name = "full";
+    o.out_dir = dir;
+    o.command = "test";
     es_compare_result *r = NULL;
-    ES_CHECK_OK(ctx, es_study_compare(ctx, s, "full", "end", &o, NULL, dir, "test", &r));
+    ES_CHECK_OK(ctx, es_study_compare(ctx, s, &o, &r));
     ES_CHECK_OK(ctx, es_store_commit(ctx, s));
     if (r) {
         int64_t ss = member(&set, "sphere", "short"), cs = member(&set, "cube", "short");
@@ -128,10 +137,15 @@ static void test_results(es_ctx *ctx)
     ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_WRITE, &s));
     if (!s) { es_synth_set_clear(ctx, &set); return; }
     int64_t rows[3] = {4, 1, 2}, k = set.nverts, kd = 3 * k;
-    es_gpa_opts go;
-    es_gpa_opts_init(&go);
-    go.scale = 0;
-    ES_CHECK_OK(ctx, es_study_gpa(ctx, s, "partial", rows, 3, &go, 2, "test", NULL));
+    es_study_gpa_opts go;
+    es_study_gpa_opts_init(&go);
+    go.name = "partial";
+    go.rows = rows;
+    go.nrows = 3;
+    go.gpa.scale = 0;
+    go.npc = 2;
+    go.command = "test";
+    ES_CHECK_OK(ctx, es_study_gpa(ctx, s, &go, NULL));
     es_mat al = {0};
     int64_t *ir = NULL, nir = 0, nv = 0;
     double *rho = NULL, *sdev = NULL;
@@ -151,7 +165,7 @@ static void test_results(es_ctx *ctx)
     for (int j = 0; j < 3; j++) es_procrustes_from_xyz(k, set.xyz + kd * rows[j], x + kd * j);
     es_gpa_out out = {0};
     out.rho = rho2;
-    ES_CHECK_OK(ctx, es_gpa_align(ctx, k, 3, (es_mat){x, kd, 3, kd}, &go, &out, NULL));
+    ES_CHECK_OK(ctx, es_gpa_align(ctx, k, 3, (es_mat){x, kd, 3, kd}, &go.gpa, &out, NULL));
     if (al.data && rho) {
         double worst = 0;
         for (int64_t i = 0; i < kd * 3; i++) worst = fmax(worst, fabs(x[i] - al.data[i]));
@@ -164,13 +178,21 @@ static void test_results(es_ctx *ctx)
     es_free(ctx, rho);
     es_free(ctx, sdev);
     /* errors */
-    ES_CHECK_FAILS(ctx, es_study_compare(ctx, s, "nope", NULL, NULL, "", NULL, "t", NULL),
+    ES_CHECK_FAILS(ctx, es_study_compare(ctx, s, &(es_study_compare_opts){.gpa_name = "nope"},
+                                         NULL),
                    ES_ENOTFOUND, "no GPA result 'nope'");
-    ES_CHECK_FAILS(ctx, es_study_compare(ctx, s, "partial", "colour", NULL, "", NULL, "t", NULL), ES_ENOTFOUND, "no label column 'colour'");
-    ES_CHECK_FAILS(ctx, es_study_gpa(ctx, s, "a/b", NULL, -1, NULL, 0, "t", NULL), ES_EINVAL,
-                   "has '/'");
-    ES_CHECK_FAILS(ctx, es_study_gpa(ctx, s, "one", rows, 1, NULL, 0, "t", NULL), ES_EINVAL,
-                   "at least 2 rows");
+    ES_CHECK_FAILS(ctx, es_study_compare(ctx, s,
+                                         &(es_study_compare_opts){.gpa_name = "partial",
+                                                                  .by = "colour"},
+                                         NULL),
+                   ES_ENOTFOUND, "no label column 'colour'");
+    es_study_gpa_opts_init(&go);
+    go.name = "a/b";
+    ES_CHECK_FAILS(ctx, es_study_gpa(ctx, s, &go, NULL), ES_EINVAL, "has '/'");
+    go.name = "one";
+    go.rows = rows;
+    go.nrows = 1;
+    ES_CHECK_FAILS(ctx, es_study_gpa(ctx, s, &go, NULL), ES_EINVAL, "at least 2 rows");
     es_store_close(s);
 
     /* planar positions (z = 0) are analysed in 2D */
@@ -182,7 +204,10 @@ static void test_results(es_ctx *ctx)
     s = NULL;
     ES_CHECK_OK(ctx, es_store_open(ctx, path, ES_STORE_WRITE, &s));
     if (s) {
-        ES_CHECK_OK(ctx, es_study_gpa(ctx, s, "flat", NULL, -1, NULL, 0, "test", NULL));
+        es_study_gpa_opts_init(&go);
+        go.name = "flat";
+        go.command = "test";
+        ES_CHECK_OK(ctx, es_study_gpa(ctx, s, &go, NULL));
         ES_CHECK_OK(ctx, es_store_get_attr(ctx, s, "gpa/flat", "dim", buf, sizeof buf));
         ES_CHECK(!strcmp(buf, "2"));
         es_store_close(s);

@@ -175,8 +175,10 @@ int main(void)
     {
         double *vec = NULL, *w = calloc((size_t)n, sizeof *w), *coef = malloc(sizeof(double) * (size_t)E);
         es_point_info info;
-        ES_CHECK_OK(ctx, es_study_point(ctx, s, NULL, "mean + 2*coef:m:expression=happy", NULL,
-                                        0, NULL, &vec, w, &info));
+        ES_CHECK_OK(ctx, es_study_point(ctx, s,
+                                        &(es_study_point_opts){
+                                            .expr = "mean + 2*coef:m:expression=happy"},
+                                        &vec, w, &info));
         ES_CHECK_OK(ctx, es_study_model_coef(ctx, s, "m", "expression=happy", coef, NULL));
         if (vec) {
             double worst = 0, wsum = 0;
@@ -194,11 +196,13 @@ int main(void)
         }
         es_free(ctx, vec);
         vec = NULL;
-        ES_CHECK_FAILS(ctx, es_study_point(ctx, s, NULL, "mean + coef:m:expression=sad", NULL, 0,
-                                           NULL, &vec, NULL, NULL),
+        ES_CHECK_FAILS(ctx, es_study_point(ctx, s,
+                                           &(es_study_point_opts){
+                                               .expr = "mean + coef:m:expression=sad"},
+                                           &vec, NULL, NULL),
                        ES_ENOTFOUND, "point: coef:m:expression=sad: model 'm' has no coefficient "
                        "'expression=sad' (it has: intercept");
-        ES_CHECK_FAILS(ctx, es_study_point(ctx, s, NULL, "mean + coef:zz:age", NULL, 0, NULL,
+        ES_CHECK_FAILS(ctx, es_study_point(ctx, s, &(es_study_point_opts){.expr = "mean + coef:zz:age"},
                                            &vec, NULL, NULL), ES_ENOTFOUND, "no model named 'zz'");
         free(w);
         free(coef);
@@ -251,9 +255,11 @@ int main(void)
     }
 
     /* ---- Procrustes space ---- */
-    es_gpa_opts go;
-    es_gpa_opts_init(&go);
-    ES_CHECK_OK(ctx, es_study_gpa(ctx, s, "g", NULL, -1, &go, 0, "test", NULL));
+    es_study_gpa_opts go;
+    es_study_gpa_opts_init(&go);
+    go.name = "g";
+    go.command = "test";
+    ES_CHECK_OK(ctx, es_study_gpa(ctx, s, &go, NULL));
     o.formula = "~ expression";
     o.gpa = "g";
     o.where = "expression=happy,subject=s01";
@@ -267,8 +273,10 @@ int main(void)
     r = NULL;
     {
         double *vec = NULL;
-        ES_CHECK_FAILS(ctx, es_study_point(ctx, s, NULL, "mean + coef:pm:expression=happy", NULL,
-                                           0, NULL, &vec, NULL, NULL),
+        ES_CHECK_FAILS(ctx, es_study_point(ctx, s,
+                                           &(es_study_point_opts){
+                                               .expr = "mean + coef:pm:expression=happy"},
+                                           &vec, NULL, NULL),
                        ES_EINVAL, "model 'pm' is in procrustes space");
     }
     /* per-landmark tests in Procrustes space: a vertex's 3 coordinates together */

@@ -172,7 +172,12 @@ static void evaluate(es_ctx *ctx, const char *store, int64_t nheld, char **held,
     es_pca_opts po;
     es_pca_opts_init(&po);
     po.ncomp = 10;
-    ES_CHECK_OK(ctx, es_study_pca(ctx, s, "default", NULL, &po, "test", NULL, NULL, NULL));
+    es_study_pca_opts so;
+    es_study_pca_opts_init(&so);
+    so.name = "default";
+    so.pca = po;
+    so.command = "test";
+    ES_CHECK_OK(ctx, es_study_pca(ctx, s, &so, NULL, NULL, NULL));
     for (int k = 1; k <= 3; k++)
         for (int sg = -1; sg <= 1; sg += 2) {
             snprintf(point, sizeof point, "mean %c 2*pc:%d", sg < 0 ? '-' : '+', k);

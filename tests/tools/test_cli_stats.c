@@ -214,7 +214,7 @@ int main(void)
         ES_CHECK_OK(ctx, es_store_get_vector(ctx, st, "point/hm/lengths", &pt, &n1));
         ES_CHECK_OK(ctx, es_store_get_vector(ctx, st, "diff/smile/mean", &dm, &n2));
         ES_CHECK_OK(ctx, es_store_get_vector(ctx, st, "point/hm/scale", &sc, &n3));
-        ES_CHECK_OK(ctx, es_study_mean(ctx, st, NULL, "expression=neutral", NULL, NULL, &g));
+        ES_CHECK_OK(ctx, es_study_mean(ctx, st, &(es_study_mean_opts){.where = "expression=neutral"}, &g));
         if (pt && dm && g && n1 == n2 && n1 == es_store_nedges(st)) {
             for (int64_t e = 0; e < n1; e++) ES_CHECK_CLOSE(pt[e], g->means[e] + dm[e], 1e-14, 1e-17);
             ES_CHECK(n3 == 1 && sc[0] == g->scales[0]);
@@ -223,22 +223,29 @@ int main(void)
         g = NULL;
         /* library-level refusals */
         es_pca *pp = NULL;
-        ES_CHECK_FAILS(ctx, es_study_mean(ctx, st, NULL, NULL, "nope", NULL, &g), ES_ENOTFOUND,
-                       "no label column 'nope'");
-        ES_CHECK_FAILS(ctx, es_study_mean(ctx, st, NULL, "expression=sad", NULL, NULL, &g),
-                       ES_EINVAL, "no rows match");
-        ES_CHECK_FAILS(ctx, es_study_pca(ctx, st, "a/b", NULL, NULL, NULL, &pp, NULL, NULL),
-                       ES_EINVAL, "bad result name");
+        es_study_pca_opts so;
+        es_study_pca_opts_init(&so);
+        so.name = "a/b";
+        ES_CHECK_FAILS(ctx, es_study_mean(ctx, st, &(es_study_mean_opts){.by = "nope"}, &g),
+                       ES_ENOTFOUND, "no label column 'nope'");
+        ES_CHECK_FAILS(ctx, es_study_mean(ctx, st, &(es_study_mean_opts){.where = "expression=sad"},
+                                          &g), ES_EINVAL, "no rows match");
+        ES_CHECK_FAILS(ctx, es_study_pca(ctx, st, &so, &pp, NULL, NULL), ES_EINVAL,
+                       "bad result name");
         ES_CHECK_FAILS(ctx, es_study_pca_load(ctx, st, "missing", &pp, NULL, NULL),
                        ES_ENOTFOUND, "no PCA named 'missing'");
         ES_CHECK_FAILS(ctx, es_study_pca_load(ctx, st, NULL, &pp, NULL, NULL), ES_ENOTFOUND,
                        "several PCAs");
-        ES_CHECK_FAILS(ctx, es_study_point(ctx, st, NULL, "mean + pc:1", NULL, 0, NULL, NULL, NULL,
-                                              NULL), ES_ENOTFOUND, "point: pc:1: pca: several");
-        ES_CHECK_FAILS(ctx, es_study_point(ctx, st, NULL, "mean + pc:99", "p", 0, NULL, NULL, NULL,
-                                              NULL), ES_ENOTFOUND, "the PCA has 12 components");
-        ES_CHECK_FAILS(ctx, es_study_point(ctx, st, NULL, "diff:frown", NULL, 0, NULL, NULL, NULL,
-                                              NULL), ES_ENOTFOUND, "no difference named 'frown'");
+        ES_CHECK_FAILS(ctx, es_study_point(ctx, st, &(es_study_point_opts){.expr = "mean + pc:1"},
+                                           NULL, NULL, NULL),
+                       ES_ENOTFOUND, "point: pc:1: pca: several");
+        ES_CHECK_FAILS(ctx, es_study_point(ctx, st, &(es_study_point_opts){.expr = "mean + pc:99",
+                                                                          .pca_name = "p"},
+                                           NULL, NULL, NULL),
+                       ES_ENOTFOUND, "the PCA has 12 components");
+        ES_CHECK_FAILS(ctx, es_study_point(ctx, st, &(es_study_point_opts){.expr = "diff:frown"},
+                                           NULL, NULL, NULL),
+                       ES_ENOTFOUND, "no difference named 'frown'");
         snprintf(path, sizeof path, "%s/other.obj", dir);
         FILE *o = fopen(path, "w");
         if (o) {
@@ -247,7 +254,8 @@ int main(void)
         }
         char expr[600];
         snprintf(expr, sizeof expr, "file:%s", path);
-        ES_CHECK_FAILS(ctx, es_study_point(ctx, st, NULL, expr, NULL, 0, NULL, NULL, NULL, NULL),
+        ES_CHECK_FAILS(ctx, es_study_point(ctx, st, &(es_study_point_opts){.expr = expr}, NULL,
+                                           NULL, NULL),
                        ES_EMISMATCH, "do not match the store's topology");
         snprintf(path, sizeof path, "%s/study.h5", dir);
         es_free(ctx, pt);

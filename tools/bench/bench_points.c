@@ -182,10 +182,12 @@ int main(int argc, char **argv)
         if (es_store_append(ctx, s, &r) != ES_OK) fail(ctx, "append");
         free(len), free(faces), free(xyz);
     }
-    es_pca_opts po;
-    es_pca_opts_init(&po);
-    po.ncomp = 5;
-    if (es_study_pca(ctx, s, "bench", NULL, &po, "bench", NULL, NULL, NULL) != ES_OK ||
+    es_study_pca_opts po;
+    es_study_pca_opts_init(&po);
+    po.name = "bench";
+    po.pca.ncomp = 5;
+    po.command = "bench";
+    if (es_study_pca(ctx, s, &po, NULL, NULL, NULL) != ES_OK ||
         es_store_commit(ctx, s) != ES_OK)
         fail(ctx, "pca");
     int64_t nv = es_store_nverts(s);

@@ -143,10 +143,12 @@ int main(int argc, char **argv)
                100 * r.max_rel, r.bend_ratio);
     }
     /* a walk along PC 1 */
-    es_pca_opts po;
-    es_pca_opts_init(&po);
-    po.ncomp = 5;
-    if (es_study_pca(ctx, s, "walk", NULL, &po, "bench", NULL, NULL, NULL) != ES_OK)
+    es_study_pca_opts po;
+    es_study_pca_opts_init(&po);
+    po.name = "walk";
+    po.pca.ncomp = 5;
+    po.command = "bench";
+    if (es_study_pca(ctx, s, &po, NULL, NULL, NULL) != ES_OK)
         return fail(ctx, "pca");
     double tw = 0, tc = 0, worst_rms = 0, worst_max = 0;
     double *prev = malloc(sizeof(double) * (size_t)(3 * nv));

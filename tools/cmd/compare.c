@@ -116,17 +116,26 @@ int cmd_compare(int argc, char **argv)
     es_store *s = NULL;
     es_compare_result *r = NULL;
     char *cmd = cli_command_line(argc, argv);
+    es_study_compare_opts so;
+    es_study_compare_opts_init(&so);
+    so.gpa_name = gpa;
+    so.by = by;
+    so.compare = o;
+    /* stored as its GPA's name unless --name says (--name "": not stored) */
+    so.name = !name ? gpa : *name ? name : NULL;
+    so.out_dir = out;
+    so.command = cmd;
     es_status rc = es_store_open(ctx, argv[optind], wmode, &s);
 #if ES_HAVE_FIGURES
     if (rc == ES_OK && figures)
-        rc = es_figure_compare(ctx, s, gpa, by, &o, name, out, cmd, format, &r);
+        rc = es_figure_compare(ctx, s, &so, format, &r);
     else
 #else
     (void)figures;   /* a build without figures writes the tables only */
     (void)format;
 #endif
     if (rc == ES_OK)
-        rc = es_study_compare(ctx, s, gpa, by, &o, name, out, cmd, &r);
+        rc = es_study_compare(ctx, s, &so, &r);
     if (rc == ES_OK) rc = es_store_commit(ctx, s);
     if (rc != ES_OK) {
         cli_fail("compare", ctx, rc);

@@ -98,7 +98,16 @@ int cmd_diff(int argc, char **argv)
         }
         column = es_store_column_name(st, found);
     }
-    if ((rc = es_study_diff(ctx, st, name, where, key, column, from, to, cmdline, &d)) != ES_OK) {
+    es_study_diff_opts so;
+    es_study_diff_opts_init(&so);
+    so.name = name;
+    so.where = where;
+    so.key = key;
+    so.column = column;
+    so.from = from;
+    so.to = to;
+    so.command = cmdline;
+    if ((rc = es_study_diff(ctx, st, &so, &d)) != ES_OK) {
         cli_fail("diff", ctx, rc);
         goto done;
     }

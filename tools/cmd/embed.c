@@ -139,6 +139,7 @@ int cmd_embed(int argc, char **argv)
     if (!store_it) o.name = NULL;
     if (!(rc = es_store_open(ctx, argv[optind], store_it ? wmode : ES_STORE_READ, &s)))
         rc = es_study_embed(ctx, s, &o, NULL, &res);
+    if (!rc && store_it) rc = es_store_commit(ctx, s);   /* the mesh appears with it */
     if (rc) {
         cli_fail("embed", ctx, rc);
         es_store_abort(s);

@@ -90,8 +90,15 @@ int cmd_gpa(int argc, char **argv)
     if (rc == ES_OK && where && *where) rc = es_store_select(ctx, s, where, &rows, &nrows);
     if (rc == ES_OK && writer) rc = es_store_result_check(ctx, s, "gpa", name);
     rc = es_parallel_agree(ctx, rc);
-    if (rc == ES_OK)
-        rc = es_study_gpa(ctx, s, writer ? name : NULL, rows, nrows, &o, npc, cmd, &rep);
+    es_study_gpa_opts so;
+    es_study_gpa_opts_init(&so);
+    so.name = writer ? name : NULL;
+    so.rows = rows;
+    so.nrows = nrows;
+    so.gpa = o;
+    so.npc = npc;
+    so.command = cmd;
+    if (rc == ES_OK) rc = es_study_gpa(ctx, s, &so, &rep);
     if (rc == ES_OK && writer) rc = es_store_commit(ctx, s);
     rc = es_parallel_agree(ctx, rc);
     if (rc != ES_OK) {

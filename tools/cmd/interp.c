@@ -210,8 +210,13 @@ int cmd_interp(int argc, char **argv)
         return CLI_FAIL;
     }
     o.command = cmd;
+    /* stored under --name, else the output's base name; the frames appear
+     * with the commit */
+    char defname[256];
+    if (!store_it) o.name = NULL;
+    else if (!o.name) o.name = es_study_interp_default_name(o.output, defname, sizeof defname);
     if ((rc = es_store_open(ctx, argv[optind], store_it ? wmode : ES_STORE_READ, &s)) ||
-        (rc = es_study_interp(ctx, s, &o)))
+        (rc = es_study_interp(ctx, s, &o)) || (store_it && (rc = es_store_commit(ctx, s))))
         cli_fail("interp", ctx, rc);
     else if (store_it)
         printf("stored: /analysis/embed/%s\n", es_study_interp_name(&o, stored, sizeof stored));

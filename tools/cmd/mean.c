@@ -70,7 +70,13 @@ int cmd_mean(int argc, char **argv)
     es_group_result *r = NULL;
     int ret = CLI_FAIL;
     es_status rc = es_store_open(ctx, argv[optind], name ? wmode : ES_STORE_READ, &st);
-    if (rc == ES_OK) rc = es_study_mean(ctx, st, name, where, by, cmdline, &r);
+    es_study_mean_opts mo;
+    es_study_mean_opts_init(&mo);
+    mo.name = name;
+    mo.where = where;
+    mo.by = by;
+    mo.command = cmdline;
+    if (rc == ES_OK) rc = es_study_mean(ctx, st, &mo, &r);
     if (rc != ES_OK) {
         cli_fail("mean", ctx, rc);
         goto done;

@@ -101,8 +101,13 @@ int cmd_pca(int argc, char **argv)
     es_status rc = es_store_open(ctx, argv[optind], writer ? wmode : ES_STORE_READ, &st);
     if (rc == ES_OK && writer) rc = es_store_result_check(ctx, st, "pca", name);
     rc = es_parallel_agree(ctx, rc);
-    if (rc == ES_OK)
-        rc = es_study_pca(ctx, st, writer ? name : NULL, where, &o, cmdline, &p, &rows, &nrows);
+    es_study_pca_opts so;
+    es_study_pca_opts_init(&so);
+    so.name = writer ? name : NULL;
+    so.where = where;
+    so.pca = o;
+    so.command = cmdline;
+    if (rc == ES_OK) rc = es_study_pca(ctx, st, &so, &p, &rows, &nrows);
     if (rc != ES_OK) {
         cli_fail("pca", ctx, rc);
         goto done;

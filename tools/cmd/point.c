@@ -66,9 +66,14 @@ int cmd_point(int argc, char **argv)
     es_point_info info;
     int ret = CLI_FAIL;
     es_status rc = es_store_open(ctx, argv[optind], name ? wmode : ES_STORE_READ, &st);
-    if (rc == ES_OK)
-        rc = es_study_point(ctx, st, name, argv[optind + 1], pca, scale, cmdline, &vec, NULL,
-                            &info);
+    es_study_point_opts po;
+    es_study_point_opts_init(&po);
+    po.name = name;
+    po.expr = argv[optind + 1];
+    po.pca_name = pca;
+    po.scale = scale;
+    po.command = cmdline;
+    if (rc == ES_OK) rc = es_study_point(ctx, st, &po, &vec, NULL, &info);
     if (rc != ES_OK) {
         cli_fail("point", ctx, rc);
         goto done;

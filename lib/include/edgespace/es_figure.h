@@ -47,11 +47,9 @@ ES_API es_status es_figure_compare_heatmap(es_ctx *ctx, const es_compare_result 
                                            const char *const *group_names, const char *path,
                                            es_plot_info *info);
 
-/* es_study_compare (es_study.h) and, with out_dir, its figures (in format,
- * as es_figure_compare_write) beside its tables. */
-ES_API es_status es_figure_compare(es_ctx *ctx, es_store *store, const char *gpa_name,
-                                   const char *by, const es_compare_opts *opts,
-                                   const char *name, const char *out_dir, const char *command,
+/* es_study_compare (es_study.h) and, with opts->out_dir, its figures (in
+ * format, as es_figure_compare_write) beside its tables. */
+ES_API es_status es_figure_compare(es_ctx *ctx, es_store *store, const es_study_compare_opts *opts,
                                    const char *format, es_compare_result **res);
 
 /* ---- a figure of a CSV table (edgespace plot) -------------------------------

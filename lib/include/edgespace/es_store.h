@@ -94,12 +94,12 @@ ES_API es_status es_store_create_edges(es_ctx *ctx, const char *path, int64_t nv
  * further writes. */
 ES_API es_status es_store_commit(es_ctx *ctx, es_store *store);
 /* Commit pending writes and close; the handle is freed either way. Returns
- * the commit's status: ES_OK (also when there was nothing to commit, and
- * for a handle an earlier failure broke, whose writes are dropped: that
- * failure was reported then), or the commit's failure, its message in the
- * store's ctx and, for callers that ignore the status, a warning through
- * the log callback; the store is then as it was before the writes.
- * NULL: ES_OK. */
+ * the commit's status: ES_OK (also when there was nothing to commit), the
+ * commit's failure (its message in the store's ctx and, for callers that
+ * ignore the status, a warning through the log callback; the store is then
+ * as it was before the writes), or ES_EIO for pending writes of a handle an
+ * earlier failure broke (dropped; the ctx's message is still that
+ * failure's). NULL: ES_OK. */
 ES_API es_status es_store_close(es_store *store);
 /* Close, discarding every uncommitted write. NULL: no-op. */
 ES_API void es_store_abort(es_store *store);

@@ -18,6 +18,18 @@
  * tool version, time, rows used). A name that is taken is refused with
  * ES_EEXIST before anything is computed, unless the store was opened with
  * ES_STORE_REPLACE, which replaces it (es_store_result_check).
+ *
+ * One style for every analysis: es_study_<x>(ctx, store, opts, outputs...)
+ * with an options struct made by es_study_<x>_opts_init; opts->name NULL
+ * stores nothing (the one switch), opts->command is provenance only (NULL:
+ * "es_study_<x>"). No study call commits: the caller publishes what it
+ * stored with es_store_commit (or es_store_close) and discards it with
+ * es_store_rollback (or es_store_abort). The files es_study_embed and
+ * es_study_interp write beside a stored result (meshes, residuals, frames)
+ * ride on the store handle and are renamed into place by that commit, after
+ * the store is published, or removed by the rollback: a failed store write
+ * leaves no new file behind and an old one as it was. Without a name they
+ * are renamed into place before the call returns.
  */
 #ifndef EDGESPACE_ES_STUDY_H
 #define EDGESPACE_ES_STUDY_H
@@ -58,22 +70,41 @@ typedef struct es_group_result {
 } es_group_result;
 ES_API void es_study_group_result_free(es_group_result *r);
 
-/* Means of the rows matching `filter` (NULL/"": all), one per value of
- * label column `by` (NULL: one group "all"), stored as mean/<name> when name
- * is non-NULL. out may be NULL. */
-ES_API es_status es_study_mean(es_ctx *ctx, es_store *store, const char *name,
-                                  const char *filter, const char *by, const char *command,
-                                  es_group_result **out);
+/* What es_study_mean does (es_study_mean_opts_init: every row, one group,
+ * nothing stored). */
+typedef struct es_study_mean_opts {
+    const char *name;       /* store as mean/<name> (NULL: store nothing) */
+    const char *where;      /* rows: "col=value,..." (NULL or "": all) */
+    const char *by;         /* label column: one mean per value (NULL: one group "all") */
+    const char *command;    /* provenance (NULL: "es_study_mean") */
+} es_study_mean_opts;
+ES_API void es_study_mean_opts_init(es_study_mean_opts *opts);
+
+/* Means of the rows matching opts->where, one per value of label column
+ * opts->by, stored as mean/<name> when opts->name is non-NULL (the store
+ * open for writing; the caller commits). opts NULL: the defaults. out may
+ * be NULL. */
+ES_API es_status es_study_mean(es_ctx *ctx, es_store *store, const es_study_mean_opts *opts,
+                               es_group_result **out);
 
 /* ---- PCA ------------------------------------------------------------------ */
 
-/* Fit a PCA of the rows matching `filter` and store it as pca/<name>.
- * *out (may be NULL) gets the fit, *rows (may be NULL) the store rows
- * used (es_free), in score order. */
-ES_API es_status es_study_pca(es_ctx *ctx, es_store *store, const char *name,
-                                 const char *filter, const es_pca_opts *opts,
-                                 const char *command, es_pca **out, int64_t **rows,
-                                 int64_t *nrows);
+/* What es_study_pca does (es_study_pca_opts_init: every row, es_pca_opts_init's
+ * fit, nothing stored). */
+typedef struct es_study_pca_opts {
+    const char *name;       /* store as pca/<name> (NULL: store nothing) */
+    const char *where;      /* rows: "col=value,..." (NULL or "": all) */
+    es_pca_opts pca;        /* the fit (es_pca_opts_init) */
+    const char *command;    /* provenance (NULL: "es_study_pca") */
+} es_study_pca_opts;
+ES_API void es_study_pca_opts_init(es_study_pca_opts *opts);
+
+/* Fit a PCA of the rows matching opts->where and store it as pca/<name>
+ * when opts->name is non-NULL (the caller commits). opts NULL: the
+ * defaults. *out (may be NULL) gets the fit, *rows (may be NULL) the store
+ * rows used (es_free), in score order. */
+ES_API es_status es_study_pca(es_ctx *ctx, es_store *store, const es_study_pca_opts *opts,
+                              es_pca **out, int64_t **rows, int64_t *nrows);
 
 /* Load pca/<name> (NULL: the only PCA in the store, else the one named
  * "default"). Scores are loaded too (nrows = rows fitted); *rows (may be
@@ -83,13 +114,23 @@ ES_API es_status es_study_pca_load(es_ctx *ctx, es_store *store, const char *nam
 
 /* ---- differences ------------------------------------------------------------ */
 
-/* Rows matching `filter` whose label `column` equals `from` or `to` are
- * paired by label `key` (es_diff_paired's rules); stored as diff/<name>.
- * Indices in the result are store rows. out may be NULL. */
-ES_API es_status es_study_diff(es_ctx *ctx, es_store *store, const char *name,
-                                  const char *filter, const char *key, const char *column,
-                                  const char *from, const char *to, const char *command,
-                                  es_diff **out);
+/* What es_study_diff does: key, column, from and to are required. */
+typedef struct es_study_diff_opts {
+    const char *name;       /* store as diff/<name> (NULL: store nothing) */
+    const char *where;      /* rows: "col=value,..." (NULL or "": all) */
+    const char *key;        /* label column that pairs the rows (the subject) */
+    const char *column;     /* label column whose values from and to are compared */
+    const char *from, *to;  /* the difference is to - from */
+    const char *command;    /* provenance (NULL: "es_study_diff") */
+} es_study_diff_opts;
+ES_API void es_study_diff_opts_init(es_study_diff_opts *opts);
+
+/* Rows matching opts->where whose label `column` equals `from` or `to` are
+ * paired by label `key` (es_diff_paired's rules); stored as diff/<name>
+ * when opts->name is non-NULL (the caller commits). Indices in the result
+ * are store rows. out may be NULL. */
+ES_API es_status es_study_diff(es_ctx *ctx, es_store *store, const es_study_diff_opts *opts,
+                               es_diff **out);
 
 /* ---- points ----------------------------------------------------------------- */
 
@@ -116,28 +157,33 @@ ES_API es_status es_study_resolve(es_ctx *ctx, void *resolver, es_point_leaf kin
                                   double *weights);
 ES_API void es_study_resolver_clear(es_ctx *ctx, es_study_resolver *r);
 
-/* Evaluate `expr` on the store (validity against the store's topology) and,
- * when name is non-NULL, store it as point/<name> (its lengths, scale and
- * row weights). scale > 0 overrides the scale rule of es_point.h. *vec (may
- * be NULL) gets the lengths (es_free); weights (may be NULL) the row weights
- * (es_store_nrows entries); info (may be NULL) the report. */
-ES_API es_status es_study_point(es_ctx *ctx, es_store *store, const char *name,
-                                const char *expr, const char *pca_name, double scale,
-                                const char *command, double **vec, double *weights,
-                                es_point_info *info);
+/* What es_study_point does: expr is required. */
+typedef struct es_study_point_opts {
+    const char *name;       /* store as point/<name> (NULL: store nothing) */
+    const char *expr;       /* the point (datasets-spec/point-syntax.md) */
+    const char *pca_name;   /* the PCA of pc:K (NULL: as es_study_pca_load) */
+    double scale;           /* > 0: overrides the scale rule of es_point.h (0) */
+    const char *command;    /* provenance (NULL: "es_study_point") */
+} es_study_point_opts;
+ES_API void es_study_point_opts_init(es_study_point_opts *opts);
+
+/* Evaluate opts->expr on the store (validity against the store's topology)
+ * and, when opts->name is non-NULL, store it as point/<name> (its lengths,
+ * scale and row weights; the caller commits). *vec (may be NULL) gets the
+ * lengths (es_free); weights (may be NULL) the row weights (es_store_nrows
+ * entries); info (may be NULL) the report. */
+ES_API es_status es_study_point(es_ctx *ctx, es_store *store, const es_study_point_opts *opts,
+                                double **vec, double *weights, es_point_info *info);
 
 /* The E scale-normalized lengths of a point as a command line names it:
  * "row:ID", the name of a stored point (/analysis/point/NAME), or an
  * expression (datasets-spec/point-syntax.md; pca_name: the PCA of pc:K,
- * NULL for the only or the 'default' one). *scale gets the point's own
- * scale, else the mean scale of the store's rows. A length that is not
- * positive (extrapolated too far) is ES_EINVAL naming the edge: no mesh
- * realizes the point. */
-ES_API es_status es_study_point_lengths(es_ctx *ctx, es_store *store, const char *spec,
-                                        const char *pca_name, double *lengths, double *scale);
-/* The same with the point's row weights (es_store_nrows entries; see
- * es_study_resolver): a stored point's own, or, for one stored without
- * them, ridge regression on the rows. */
+ * NULL for the only or the 'default' one), with its row weights (weights,
+ * es_store_nrows entries, may be NULL; see es_study_resolver): a stored
+ * point's own, or, for one stored without them, ridge regression on the
+ * rows. *scale gets the point's own scale, else the mean scale of the
+ * store's rows. A length that is not positive (extrapolated too far) is
+ * ES_EINVAL naming the edge: no mesh realizes the point. */
 ES_API es_status es_study_point_weights(es_ctx *ctx, es_store *store, const char *spec,
                                         const char *pca_name, double *lengths, double *scale,
                                         double *weights);
@@ -205,10 +251,24 @@ ES_API const char *es_study_result_tables(const char *kind, char *buf, size_t n)
 
 /* ---- GPA and the comparison of the two spaces ----------------------------- */
 
-/* GPA of the positions of `rows` (nrows of them; rows NULL with nrows = -1:
- * every row) of an open store, with the PCA of the residual tangent
- * coordinates, written to /analysis/gpa/<name> (a taken name: as above) with
- * provenance (command; params: scale, allow_reflection, tol, max_iter):
+/* What es_study_gpa does (es_study_gpa_opts_init: every row, es_gpa_opts_init's
+ * alignment, min(10, n - 1) PCs, nothing stored). */
+typedef struct es_study_gpa_opts {
+    const char *name;       /* store as gpa/<name> (NULL: store nothing, the report
+                               alone; the ranks other than 0 of an MPI job) */
+    const int64_t *rows;    /* the store rows aligned, nrows of them (NULL with nrows -1,
+                               the default: every row) */
+    int64_t nrows;
+    es_gpa_opts gpa;        /* the alignment (es_gpa_opts_init) */
+    int64_t npc;            /* PCs of the tangent coordinates kept (<= 0: min(10, n - 1)) */
+    const char *command;    /* provenance (NULL: "es_study_gpa") */
+} es_study_gpa_opts;
+ES_API void es_study_gpa_opts_init(es_study_gpa_opts *opts);
+
+/* GPA of the positions of opts->rows of an open store, with the PCA of the
+ * residual tangent coordinates, written to /analysis/gpa/<name> when
+ * opts->name is non-NULL (a taken name: as above) with provenance (command;
+ * params: scale, allow_reflection, tol, max_iter):
  *   aligned   n x k*d   row j: configuration of input row j (x-, y-, z-block)
  *   mean      k*d       Procrustes mean;  size, rho, scale: n each
  *   rotation  n x d*d   column-major d x d per row;  centroid: n x d
@@ -216,32 +276,41 @@ ES_API const char *es_study_result_tables(const char *kind, char *buf, size_t n)
  * and attributes dim, k, iterations, converged, rot_change, scale_change,
  * gss, rmsrho, total_ss. Planar data (z = 0 in every row, e.g. ingested 2D
  * landmarks) are analysed in 2D (dim 2), so that a 3D rotation cannot act
- * as a reflection. npc <= 0: min(10, n - 1). Memory: the positions of the
- * rows (n x 3V doubles) once. The store must be open for writing; the
- * caller commits (es_store_commit / es_store_close). report may be NULL.
- * On a context joined to an MPI job it is collective: every rank reads and
- * aligns its share of the rows (es_gpa_align_ranks; the others may open the
- * store read-only and pass name NULL), rank 0 gathers them, takes the PCA
- * and writes; each rank holds 3V x n/P doubles, rank 0 all n. */
-ES_API es_status es_study_gpa(es_ctx *ctx, es_store *store, const char *name,
-                                  const int64_t *rows, int64_t nrows, const es_gpa_opts *opts,
-                                  int64_t npc, const char *command, es_gpa_report *report);
+ * as a reflection. Memory: the positions of the rows (n x 3V doubles) once.
+ * With a name the store must be open for writing; the caller commits
+ * (es_store_commit / es_store_close). opts NULL: the defaults. report may
+ * be NULL. On a context joined to an MPI job it is collective: every rank
+ * reads and aligns its share of the rows (es_gpa_align_ranks; the others
+ * may open the store read-only and pass name NULL), rank 0 gathers them,
+ * takes the PCA and writes; each rank holds 3V x n/P doubles, rank 0 all n. */
+ES_API es_status es_study_gpa(es_ctx *ctx, es_store *store, const es_study_gpa_opts *opts,
+                              es_gpa_report *report);
+
+/* What es_study_compare does: gpa_name is required. */
+typedef struct es_study_compare_opts {
+    const char *gpa_name;   /* the GPA result whose rows are compared */
+    const char *by;         /* label column of the groups (NULL: no groups) */
+    es_compare_opts compare;   /* the statistics (es_compare_opts_init) */
+    const char *name;       /* store as compare/<name> (NULL: store nothing; the
+                               `compare` command stores as its GPA's name) */
+    const char *out_dir;    /* es_study_compare_write's tables go there (NULL: none) */
+    const char *command;    /* provenance (NULL: "es_study_compare") */
+} es_study_compare_opts;
+ES_API void es_study_compare_opts_init(es_study_compare_opts *opts);
 
 /* The study on a store: the rows of GPA result /analysis/gpa/<gpa_name>
  * (their aligned configurations) against their stored normalized edge
- * lengths, grouped by label column `by` (NULL: no groups). Writes
- * /analysis/compare/<name> (name NULL: gpa_name) with provenance: datasets
+ * lengths, grouped by label column `by`. Writes, when opts->name is
+ * non-NULL, /analysis/compare/<name> with provenance: datasets
  * d_lengths, d_procrustes (n x n), group_means_lengths/_procrustes and
  * p_lengths/_procrustes (g x g), group_names, attributes spearman_rho,
  * mantel_p, nn_agreement, by, gpa (permutations in @params). out_dir (or
  * NULL) gets es_study_compare_write's tables (es_figure_compare adds the
  * figures). The result carries the row ids, groups and group names. ES_ENOTFOUND if the GPA
- * result or the column is missing; ES_EINVAL for a store without edges. The
- * store must be open for writing if name is not "" (name "": nothing is
- * written to the store). res (may be NULL) receives the result. */
-ES_API es_status es_study_compare(es_ctx *ctx, es_store *store, const char *gpa_name,
-                                  const char *by, const es_compare_opts *opts, const char *name,
-                                  const char *out_dir, const char *command,
+ * result or the column is missing; ES_EINVAL for a store without edges. With
+ * a name the store must be open for writing; the caller commits. res (may
+ * be NULL) receives the result. */
+ES_API es_status es_study_compare(es_ctx *ctx, es_store *store, const es_study_compare_opts *opts,
                                   es_compare_result **res);
 
 /* Write the study to dir (created if missing): distances_lengths.csv and
@@ -458,7 +527,7 @@ ES_API es_status es_study_embedder_point(es_ctx *ctx, es_study_embedder *se, con
 
 /* What es_study_embed does: embed one point of the store's space. */
 typedef struct es_study_embed_opts {
-    const char *point;      /* as es_study_point_lengths reads it (required) */
+    const char *point;      /* as es_study_point_weights reads it (required) */
     const char *pca_name;   /* the PCA of pc:K in the point (NULL: the only one) */
     const char *init;       /* NULL or "prior" (the default): the prior of the point's
                                row weights (es_study_prior, es_embed_prior_solve), the
@@ -471,8 +540,8 @@ typedef struct es_study_embed_opts {
     double scale;           /* > 0: embed at this sum of lengths (0: the point's) */
     const char *output;     /* mesh file to write (OBJ/PLY/OFF by extension), or NULL */
     const char *residuals;  /* CSV of per-vertex closure and edge error, or NULL */
-    const char *name;       /* store as /analysis/embed/<name> and commit (NULL: no) */
-    const char *command;    /* provenance of the stored result */
+    const char *name;       /* store as /analysis/embed/<name> (NULL: store nothing) */
+    const char *command;    /* provenance of the stored result (NULL: "es_study_embed") */
     int cache;              /* 1 (the default): the session's cache beside the store
                                (es_study_embedder_open) */
     es_study_embedder *session;   /* an open session of this store to use (and leave
@@ -492,8 +561,11 @@ ES_API void es_study_embed_opts_init(es_study_embed_opts *opts);
 
 /* Embed a point: resolve it, initialize, solve, write the mesh and the
  * residuals, store the result with its provenance. The store must be open
- * for writing when opts->name is given. xyz (3 x V, may be NULL) receives
- * the positions. Nothing is stored when a step fails. */
+ * for writing when opts->name is given; the caller commits, and the mesh
+ * and residual files appear with that commit (es_store_commit; removed by
+ * es_store_rollback or es_store_abort). Without a name they are written at
+ * once. xyz (3 x V, may be NULL) receives the positions. Nothing is stored
+ * or written when a step fails. */
 ES_API es_status es_study_embed(es_ctx *ctx, es_store *store, const es_study_embed_opts *opts,
                                 double *xyz, es_study_embed_result *res);
 
@@ -505,7 +577,7 @@ typedef void (*es_study_frame_fn)(void *userdata, int64_t i, int64_t n, const ch
 /* What es_study_interp does: a walk between two points, or one weighted
  * combination of rows. */
 typedef struct es_study_interp_opts {
-    const char *from, *to;  /* end points (t = 0 and 1) as es_study_point_lengths reads
+    const char *from, *to;  /* end points (t = 0 and 1) as es_study_point_weights reads
                                them; two rows ("row:A", "row:B") interpolate their
                                meshes (dihedrals averaged on the circle) */
     const char *weights;    /* instead: "w1*row:a + w2*row:b + ..." (two or more rows),
@@ -515,9 +587,10 @@ typedef struct es_study_interp_opts {
     int64_t steps;          /* frames from t0 to t1 inclusive (9) */
     const char *output;     /* mesh file; with several frames a printf pattern with one
                                integer conversion ("cat_%02d.obj"; %% is a literal %) */
-    const char *name;       /* results /analysis/embed/<name>[_<i>] (NULL: the output's
-                               base name without the conversion) */
-    const char *command;    /* provenance; NULL: store nothing */
+    const char *name;       /* store the frames as /analysis/embed/<name>[_<i>] (NULL:
+                               store nothing; the `interp` command names them
+                               es_study_interp_default_name of the output) */
+    const char *command;    /* provenance (NULL: "es_study_interp") */
     es_embed_opts embed;
     int cold;               /* 1: every frame from its own prior (as es_study_embed of
                                the same point); 0 (default): each frame from the last
@@ -553,8 +626,11 @@ ES_API void es_study_interp_opts_init(es_study_interp_opts *opts);
  * frame; frames are aligned frame to frame so the sequence does not jump.
  * Every frame is checked before the first is written: a walk that leaves
  * edge-length space (a length <= 0 at some t) is refused naming t and the
- * edge, and nothing is written. With opts->command the frames are stored
- * and committed (the store open for writing). */
+ * edge, and nothing is written. With opts->name the frames are stored (the
+ * store open for writing); the caller commits, and the frame files appear
+ * with that commit, all together (removed by es_store_rollback or
+ * es_store_abort); without a name they appear, all together, before the
+ * call returns. A walk that fails stores nothing and writes no frame. */
 ES_API es_status es_study_interp(es_ctx *ctx, es_store *store, const es_study_interp_opts *opts);
 
 /* The file of frame i: pattern with its one %d, %Nd or %0Nd conversion
@@ -562,8 +638,14 @@ ES_API es_status es_study_interp(es_ctx *ctx, es_store *store, const es_study_in
  * the result does not fit in n bytes. */
 ES_API int es_study_frame_path(const char *pattern, int64_t i, char *out, size_t n);
 /* Where es_study_interp stores its frames, for messages: "NAME", or
- * "NAME_NN" for a sequence. Returns buf. */
+ * "NAME_NN" for a sequence (NAME: opts->name, or when NULL
+ * es_study_interp_default_name's). Returns buf. */
 ES_API const char *es_study_interp_name(const es_study_interp_opts *opts, char *buf, size_t n);
+/* The result name the `interp` command stores under when none is given:
+ * the output's base name without its extension and without the frame
+ * conversion ('cat_%02d.obj' -> 'cat'; "interp" when nothing is left).
+ * Returns buf. */
+ES_API const char *es_study_interp_default_name(const char *output, char *buf, size_t n);
 
 /* ---- shape models for other tools ---------------------------------------- */
 
