@@ -1,4 +1,4 @@
-/* lib/store/statismo_read.c — a statismo shape model read back
+/* lib/ingest/statismo_read.c — a statismo shape model read back
  * (datasets-spec/statismo.md): what edgespace, statismo or scalismo wrote,
  * so that its mean and modes can be embedded, projected or compared with a
  * study's own.
@@ -13,6 +13,7 @@
  * decoder (es__h5_read_attr_text), which checks the heap libhdf5 trusts.
  * All of its HDF5 goes through lib/h5 (h5/h5_private.h). */
 #include "core/core_private.h"
+#include "edgespace/es_ingest.h"
 #include "edgespace/es_store.h"
 #include "h5/h5_private.h"
 

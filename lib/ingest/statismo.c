@@ -1,4 +1,4 @@
-/* lib/store/statismo.c — a shape model written as a statismo file (format
+/* lib/ingest/statismo.c — a shape model written as a statismo file (format
  * 0.9, datasets-spec/statismo.md), the HDF5 layout that statismo's
  * StatisticalModel IO and scalismo's StatismoIO read.
  *
@@ -12,6 +12,7 @@
  * renamed over it only when complete. All of its HDF5 goes through lib/h5
  * (h5/h5_private.h). */
 #include "core/core_private.h"
+#include "edgespace/es_ingest.h"
 #include "edgespace/es_store.h"
 #include "h5/h5_private.h"
 
