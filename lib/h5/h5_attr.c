@@ -11,35 +11,34 @@ int es__h5_attr_exists(es__h5_id obj, const char *key)
     return H5Aexists(obj, key);
 }
 
-es_status es__h5_write_attr_i64(es_ctx *ctx, hid_t obj, const char *key, int64_t v)
+/* A scalar attribute (replacing one of that name) of file type ftype from
+ * *v of memory type mtype. */
+static es_status write_scalar(es_ctx *ctx, es__h5_id obj, const char *key, hid_t ftype,
+                              hid_t mtype, const void *v)
 {
     hid_t sp = -1, a = -1;
     es_status rc = ES_OK;
     if (H5Aexists(obj, key) > 0) H5Adelete(obj, key);
     if ((sp = H5Screate(H5S_SCALAR)) < 0 ||
-        (a = H5Acreate2(obj, key, H5T_STD_I64LE, sp, H5P_DEFAULT, H5P_DEFAULT)) < 0 ||
-        H5Awrite(a, H5T_NATIVE_INT64, &v) < 0)
+        (a = H5Acreate2(obj, key, ftype, sp, H5P_DEFAULT, H5P_DEFAULT)) < 0 ||
+        H5Awrite(a, mtype, v) < 0)
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot write attribute '%s'", key);
     es__h5_close(a);
     es__h5_close(sp);
     return rc;
 }
 
-es_status es__h5_write_attr_f64(es_ctx *ctx, hid_t obj, const char *key, double v)
+es_status es__h5_write_attr_i64(es_ctx *ctx, es__h5_id obj, const char *key, int64_t v)
 {
-    hid_t sp = -1, a = -1;
-    es_status rc = ES_OK;
-    if (H5Aexists(obj, key) > 0) H5Adelete(obj, key);
-    if ((sp = H5Screate(H5S_SCALAR)) < 0 ||
-        (a = H5Acreate2(obj, key, H5T_IEEE_F64LE, sp, H5P_DEFAULT, H5P_DEFAULT)) < 0 ||
-        H5Awrite(a, H5T_NATIVE_DOUBLE, &v) < 0)
-        rc = es__h5_fail(ctx, ES_EIO, "store: cannot write attribute '%s'", key);
-    es__h5_close(a);
-    es__h5_close(sp);
-    return rc;
+    return write_scalar(ctx, obj, key, H5T_STD_I64LE, H5T_NATIVE_INT64, &v);
 }
 
-es_status es__h5_write_attr_str(es_ctx *ctx, hid_t obj, const char *key, const char *v)
+es_status es__h5_write_attr_f64(es_ctx *ctx, es__h5_id obj, const char *key, double v)
+{
+    return write_scalar(ctx, obj, key, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &v);
+}
+
+es_status es__h5_write_attr_str(es_ctx *ctx, es__h5_id obj, const char *key, const char *v)
 {
     hid_t sp = -1, a = -1, t = -1;
     es_status rc = ES_OK;
@@ -54,7 +53,7 @@ es_status es__h5_write_attr_str(es_ctx *ctx, hid_t obj, const char *key, const c
     return rc;
 }
 
-es_status es__h5_write_attr_strs(es_ctx *ctx, hid_t obj, const char *key,
+es_status es__h5_write_attr_strs(es_ctx *ctx, es__h5_id obj, const char *key,
                                  const char *const *v, int64_t n)
 {
     hsize_t d = (hsize_t)n;
@@ -72,7 +71,7 @@ es_status es__h5_write_attr_strs(es_ctx *ctx, hid_t obj, const char *key,
     return rc;
 }
 
-es_status es__h5_read_attr_i64(es_ctx *ctx, hid_t obj, const char *objname, const char *key,
+es_status es__h5_read_attr_i64(es_ctx *ctx, es__h5_id obj, const char *objname, const char *key,
                                int64_t *v)
 {
     hid_t a = H5Aopen(obj, key, H5P_DEFAULT), t = -1, sp = -1;
@@ -95,7 +94,7 @@ es_status es__h5_read_attr_i64(es_ctx *ctx, hid_t obj, const char *objname, cons
 
 /* A string attribute through the store's own decoder (h5_vlen.c); one
  * integer or real as text. */
-es_status es__h5_read_attr_text(es_ctx *ctx, es__h5_raw *raw, hid_t obj, const char *key,
+es_status es__h5_read_attr_text(es_ctx *ctx, es__h5_raw *raw, es__h5_id obj, const char *key,
                                 char *buf, size_t n)
 {
     hid_t a = -1, t = -1, sp = -1;
@@ -159,11 +158,7 @@ int es__h5_put_attr_cstr(es__h5_id obj, const char *key, const char *v)
     if (t < 0 || sp < 0 || (a = H5Acreate2(obj, key, t, sp, H5P_DEFAULT, H5P_DEFAULT)) < 0 ||
         H5Awrite(a, t, v) < 0)
         r = -1;
-    ES__H5_KEEP_ERROR({
-        es__h5_close(a);
-        es__h5_close(sp);
-        es__h5_close(t);
-    });
+    es__h5_close_kept((const hid_t[]){a, sp, t}, 3);
     return r;
 }
 
@@ -175,10 +170,6 @@ int es__h5_put_cstr(es__h5_id loc, const char *name, const char *v)
         (d = H5Dcreate2(loc, name, t, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) < 0 ||
         H5Dwrite(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) < 0)
         r = -1;
-    ES__H5_KEEP_ERROR({
-        es__h5_close(d);
-        es__h5_close(sp);
-        es__h5_close(t);
-    });
+    es__h5_close_kept((const hid_t[]){d, sp, t}, 3);
     return r;
 }

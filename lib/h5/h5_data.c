@@ -282,15 +282,9 @@ static int put(hid_t loc, const char *name, es__h5_type type, int rank, const ui
                          H5P_DEFAULT)) < 0 ||
         (total > 0 && H5Dwrite(ds, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) < 0))
         r = -1;
-    ES__H5_KEEP_ERROR({
-        es__h5_close(ds);
-        es__h5_close(sp);
-        es__h5_close(lcpl);
-        if (type == ES__H5_STR) {
-            es__h5_close(ftype);
-            es__h5_close(mtype);
-        }
-    });
+    /* (string types were made here; the others are HDF5's predefined ones) */
+    es__h5_close_kept((const hid_t[]){ds, sp, lcpl, type == ES__H5_STR ? ftype : -1,
+                                      type == ES__H5_STR ? mtype : -1}, 5);
     return r;
 }
 
@@ -348,10 +342,7 @@ int es__h5_dataset_info(es__h5_id ds, es__h5_info *info)
         r = 0;
     }
     if (r < 0) info->rank = -1;
-    ES__H5_KEEP_ERROR({
-        es__h5_close(t);
-        es__h5_close(sp);
-    });
+    es__h5_close_kept((const hid_t[]){t, sp}, 2);
     return r;
 }
 
@@ -388,44 +379,39 @@ int es__h5_read_i64(es__h5_id loc, const char *name, int64_t *out)
     return read_whole(loc, name, H5T_NATIVE_INT64, out);
 }
 
+/* The cnt block at start of open dataset ds (closed here) into the
+ * leading cnt block of memory of dims mdims, as doubles. */
+static int read_block(hid_t ds, int rank, const hsize_t *start, const hsize_t *cnt,
+                      const hsize_t *mdims, double *out)
+{
+    static const hsize_t zero[3] = {0, 0, 0};
+    hid_t fsp = -1, msp = -1;
+    int r = 0;
+    if (ds < 0) return -1;
+    if ((fsp = H5Dget_space(ds)) < 0 ||
+        H5Sselect_hyperslab(fsp, H5S_SELECT_SET, start, NULL, cnt, NULL) < 0 ||
+        (msp = H5Screate_simple(rank, mdims, NULL)) < 0 ||
+        H5Sselect_hyperslab(msp, H5S_SELECT_SET, zero, NULL, cnt, NULL) < 0 ||
+        H5Dread(ds, H5T_NATIVE_DOUBLE, msp, fsp, H5P_DEFAULT, out) < 0)
+        r = -1;
+    es__h5_close_kept((const hid_t[]){msp, fsp, ds}, 3);
+    return r;
+}
+
+/* Blocks of rows move whole chunks: no chunk cache. */
 int es__h5_read_rows_f64(es__h5_id loc, const char *name, int64_t row0, int64_t n, int64_t m,
                          double *out, int64_t ld)
 {
-    hsize_t fstart[2] = {(hsize_t)row0, 0}, cnt[2] = {(hsize_t)n, (hsize_t)m};
-    hsize_t mdims[2] = {(hsize_t)n, (hsize_t)ld}, mstart[2] = {0, 0};
-    hid_t ds = -1, fsp = -1, msp = -1;
-    int r = 0;
-    if ((ds = es__h5_open_ds_nocache(loc, name)) < 0 || (fsp = H5Dget_space(ds)) < 0 ||
-        H5Sselect_hyperslab(fsp, H5S_SELECT_SET, fstart, NULL, cnt, NULL) < 0 ||
-        (msp = H5Screate_simple(2, mdims, NULL)) < 0 ||
-        H5Sselect_hyperslab(msp, H5S_SELECT_SET, mstart, NULL, cnt, NULL) < 0 ||
-        H5Dread(ds, H5T_NATIVE_DOUBLE, msp, fsp, H5P_DEFAULT, out) < 0)
-        r = -1;
-    ES__H5_KEEP_ERROR({
-        es__h5_close(msp);
-        es__h5_close(fsp);
-        es__h5_close(ds);
-    });
-    return r;
+    const hsize_t start[2] = {(hsize_t)row0, 0}, cnt[2] = {(hsize_t)n, (hsize_t)m};
+    const hsize_t mdims[2] = {(hsize_t)n, (hsize_t)ld};
+    return read_block(es__h5_open_ds_nocache(loc, name), 2, start, cnt, mdims, out);
 }
 
 int es__h5_read_row3_f64(es__h5_id loc, const char *name, int64_t row, int64_t d1, int64_t d2,
                          double *out)
 {
-    hsize_t start[3] = {(hsize_t)row, 0, 0}, cnt[3] = {1, (hsize_t)d1, (hsize_t)d2};
-    hid_t ds = -1, fsp = -1, msp = -1;
-    int r = 0;
-    if ((ds = es__h5_open_ds(loc, name)) < 0 || (fsp = H5Dget_space(ds)) < 0 ||
-        H5Sselect_hyperslab(fsp, H5S_SELECT_SET, start, NULL, cnt, NULL) < 0 ||
-        (msp = H5Screate_simple(3, cnt, NULL)) < 0 ||
-        H5Dread(ds, H5T_NATIVE_DOUBLE, msp, fsp, H5P_DEFAULT, out) < 0)
-        r = -1;
-    ES__H5_KEEP_ERROR({
-        es__h5_close(msp);
-        es__h5_close(fsp);
-        es__h5_close(ds);
-    });
-    return r;
+    const hsize_t start[3] = {(hsize_t)row, 0, 0}, cnt[3] = {1, (hsize_t)d1, (hsize_t)d2};
+    return read_block(es__h5_open_ds(loc, name), 3, start, cnt, cnt, out);
 }
 
 /* ---- links, groups and objects ---- */

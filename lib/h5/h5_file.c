@@ -195,6 +195,13 @@ hid_t es__h5_file_access(void)
     return fapl;
 }
 
+void es__h5_close_kept(const hid_t *ids, int n)
+{
+    ES__H5_KEEP_ERROR({
+        for (int k = 0; k < n; k++) es__h5_close(ids[k]);
+    });
+}
+
 int es__h5_is_hdf5(const char *path)
 {
     return H5Fis_hdf5(path);

@@ -25,6 +25,10 @@ _Static_assert(sizeof(hid_t) == sizeof(es__h5_id), "es__h5_id holds an HDF5 hid_
         if (es__h5_err_ >= 0) H5Eset_current_stack(es__h5_err_); \
     } while (0)
 
+/* Close n ids (negative ones skipped) within ES__H5_KEEP_ERROR: after a
+ * failed call, the caller's es__h5_fail still names HDF5's reason. */
+void es__h5_close_kept(const hid_t *ids, int n);
+
 /* A variable-length UTF-8 string type (close it), or negative. */
 hid_t es__h5_str_type(void);
 /* File access: HDF5 1.8-readable format, file locking where supported. */
