@@ -105,22 +105,21 @@ static es__beside *add(es_store *s, const char *kind, const char *name)
 
 /* Open a published result file read-only and check that it is this
  * store's: ES_OK with *f = -1 when it is absent or another store's. */
-static es_status open_published(es_store *s, const char *path, hid_t *f)
+static es_status open_published(es_store *s, const char *path, es__h5_id *f)
 {
     es_ctx *ctx = s->ctx;
     char id[40];
     es__h5_raw *raw = NULL;
     es_status rc = ES_OK;
-    hid_t fapl, g = -1;
+    es__h5_id g = -1;
     *f = -1;
     if (access(path, F_OK) != 0) return ES_OK;
     /* a result file is read like a store: its superblock and the headers
-     * HDF5 decodes on opening checked first (store_headers.c) */
+     * HDF5 decodes on opening checked first (h5_headers.c) */
     if ((rc = es__h5_check_file(ctx, path)) != ES_OK) return rc;
-    fapl = es__h5_file_access();
-    hid_t file = H5Fopen(path, H5F_ACC_RDONLY, fapl);
-    es__h5_close(fapl);
-    if (file < 0) return es__h5_fail(ctx, ES_EFORMAT, "store: cannot read result file '%s'", path);
+    es__h5_id file = es__h5_file_open(path, false);
+    /* (es__fail: the store has never named HDF5's reason here) */
+    if (file < 0) return es__fail(ctx, ES_EFORMAT, "store: cannot read result file '%s'", path);
     /* the root's attributes and groups checked before HDF5 decodes them */
     if ((rc = es__h5_raw_open(ctx, file, path, &raw)) || (rc = es__h5_check_object(raw, file, "the root group")) ||
         (rc = es__h5_check_group(raw, file, "/")))
@@ -128,9 +127,9 @@ static es_status open_published(es_store *s, const char *path, hid_t *f)
     if (es__h5_read_attr_text(ctx, raw, file, "store_id", id, sizeof id) != ES_OK ||
         strcmp(id, s->store_id))
         goto done; /* another store's (or not a result): not this store's result */
-    if (H5Lexists(file, "/analysis", H5P_DEFAULT) > 0) {
+    if (es__h5_exists(file, "/analysis") > 0) {
         if ((rc = es__h5_check_named(raw, file, "/analysis"))) goto done;
-        if ((g = H5Gopen2(file, "/analysis", H5P_DEFAULT)) < 0) {
+        if ((g = es__h5_group_open(file, "/analysis")) < 0) {
             rc = es__h5_fail(ctx, ES_EFORMAT, "store: '%s': /analysis is not a group", path);
             goto done;
         }
@@ -159,7 +158,6 @@ static es_status begin_write(es_store *s, es__beside *b)
     es_ctx *ctx = s->ctx;
     es_status rc = ES_OK;
     char *top, *dir;
-    hid_t fapl;
     /* as a write into the store (store_publish.c): cancelled work stores
      * nothing, and values read before are stale from here on */
     if ((rc = es__cancelled(ctx, "a write"))) return rc;
@@ -175,12 +173,9 @@ static es_status begin_write(es_store *s, es__beside *b)
     es__store_clean_stale(es__store_target(s));   /* and the store's own, as a write would */
     if (!(b->tmp = es__store_temp_for(s, b->path))) return ES_ENOMEM;
     /* in memory until the commit writes its image (no backing store) */
-    fapl = es__h5_file_access();
-    if (fapl < 0 || H5Pset_fapl_core(fapl, (size_t)1 << 16, 0) < 0) b->file = -1;
-    else b->file = H5Fcreate(b->tmp, H5F_ACC_EXCL, H5P_DEFAULT, fapl);
-    es__h5_close(fapl);
-    if (b->file < 0) {
-        rc = es__h5_fail(ctx, ES_EIO, "store: cannot create '%s'", b->tmp);
+    if ((b->file = es__h5_file_create_memory(b->tmp)) < 0) {
+        /* (es__fail: the store has never named HDF5's reason here) */
+        rc = es__fail(ctx, ES_EIO, "store: cannot create '%s'", b->tmp);
         es__free(ctx, b->tmp);
         b->tmp = NULL;
         return rc;
@@ -194,14 +189,14 @@ static es_status begin_write(es_store *s, es__beside *b)
 }
 
 es_status es__beside_file(es_store *s, const char *kind, const char *name, bool create,
-                          hid_t *f, const char **fpath)
+                          es__h5_id *f, const char **fpath)
 {
     es_status rc;
     es__beside *b = find(s, kind, name);
     *f = -1;
     *fpath = s->path;
     if (!b) {
-        hid_t pub;
+        es__h5_id pub;
         char *path = side_path(s, kind, name);
         if (!path) return ES_ENOMEM;
         rc = open_published(s, path, &pub);
@@ -217,7 +212,7 @@ es_status es__beside_file(es_store *s, const char *kind, const char *name, bool 
         b->replaces = pub >= 0 || access(b->path, F_OK) == 0;
     }
     if (create && !b->tmp) {
-        if (b->file >= 0) H5Fclose(b->file);
+        es__h5_close(b->file);
         b->file = -1;
         if ((rc = begin_write(s, b))) return rc;
     }
@@ -242,7 +237,7 @@ es_status es__beside_delete(es_store *s, const char *kind, const char *name)
     if (!b) ES_FAIL(s->ctx, ES_ENOTFOUND, "store: no result %s/%s beside '%s'", kind, name, s->path);
     if ((rc = es__cancelled(s->ctx, "a write"))) return rc;
     s->generation++;
-    if (b->file >= 0) H5Fclose(b->file);
+    es__h5_close(b->file);
     b->file = -1;
     es__free(s->ctx, b->tmp);
     b->tmp = NULL;
@@ -279,7 +274,7 @@ static es_status push_name(es_store *s, const char *v, size_t len, char ***names
 /* Whether kind/name is a result of this store as seen through the handle. */
 static es_status visible(es_store *s, const char *kind, const char *name, bool *yes)
 {
-    hid_t f;
+    es__h5_id f;
     const char *fp;
     es_status rc = es__beside_file(s, kind, name, false, &f, &fp);
     *yes = rc == ES_OK && f >= 0;
@@ -337,17 +332,12 @@ static es_status write_image(es_ctx *ctx, es__beside *b)
 {
     es_status rc = ES_OK;
     ssize_t size;
+    size_t bytes = 0;
     char *img = NULL;
     int fd = -1;
-    if (H5Fflush(b->file, H5F_SCOPE_GLOBAL) < 0 ||
-        (size = H5Fget_file_image(b->file, NULL, 0)) < 0)
-        return es__h5_fail(ctx, ES_EIO, "store: cannot build result file '%s'", b->path);
-    if (!(img = es__malloc(ctx, size > 0 ? (size_t)size : 1))) return ES_ENOMEM;
-    if (H5Fget_file_image(b->file, img, (size_t)size) != size) {
-        es__free(ctx, img);
-        return es__h5_fail(ctx, ES_EIO, "store: cannot build result file '%s'", b->path);
-    }
-    H5Fclose(b->file);   /* in memory: nothing to fail */
+    if ((rc = es__h5_file_image(ctx, b->file, b->path, &img, &bytes))) return rc;
+    size = (ssize_t)bytes;
+    es__h5_close(b->file);   /* in memory: nothing to fail */
     b->file = -1;
     if ((fd = open(b->tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666)) < 0) {
         rc = es__fail(ctx, ES_EIO, "store: cannot create '%s': %s", b->tmp, strerror(errno));
@@ -434,7 +424,7 @@ void es__beside_release(es_store *s)
 {
     for (int64_t i = 0; i < s->nside; i++) {
         es__beside *b = &s->side[i];
-        if (b->file >= 0) H5Fclose(b->file);
+        es__h5_close(b->file);
         if (b->tmp) unlink(b->tmp);
         es__free(s->ctx, b->tmp);
         es__free(s->ctx, b->path);
@@ -450,15 +440,13 @@ void es__beside_release(es_store *s)
 static es_status move_out(es_store *s, const char *kind, const char *name)
 {
     char full[300];
-    hid_t f, lcpl = -1;
+    es__h5_id f;
     const char *fp;
     es_status rc = es__beside_file(s, kind, name, true, &f, &fp);
     if (rc) return rc;
     snprintf(full, sizeof full, "/analysis/%s/%s", kind, name);
-    if ((lcpl = H5Pcreate(H5P_LINK_CREATE)) < 0 || H5Pset_create_intermediate_group(lcpl, 1) < 0 ||
-        H5Ocopy(s->file, full, f, full, H5P_DEFAULT, lcpl) < 0)
+    if (es__h5_copy(s->file, full, f, full) < 0)
         rc = es__h5_fail(s->ctx, ES_EIO, "store: cannot copy %s to '%s'", full, fp);
-    es__h5_close(lcpl);
     return rc;
 }
 
@@ -481,7 +469,7 @@ static es_status upgrade_impl(es_ctx *ctx, es_store *s)
     for (int64_t k = 0; rc == ES_OK && k < nk; k++) {
         char g[200];
         snprintf(g, sizeof g, "/analysis/%s", kinds[k]);
-        if (H5Ldelete(s->file, g, H5P_DEFAULT) < 0)
+        if (es__h5_delete(s->file, g) < 0)
             rc = es__h5_fail(ctx, ES_EIO, "store: cannot remove %s", g);
     }
     if (rc == ES_OK &&
@@ -510,7 +498,7 @@ es_status es_store_upgrade(es_ctx *ctx, es_store *s)
     if (s->mode == ES_STORE_READ) ES_FAIL(ctx, ES_EINVAL, "store: '%s' is open read-only", s->path);
     if (s->work || es__beside_pending(s))
         ES_FAIL(ctx, ES_EINVAL, "store: commit the writes to '%s' before upgrading it", s->path);
-    H5E_BEGIN_TRY { rc = upgrade_impl(ctx, s); } H5E_END_TRY
+    ES__H5_QUIET(rc = upgrade_impl(ctx, s));
     return rc;
 }
 

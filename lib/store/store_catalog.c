@@ -14,13 +14,14 @@ int es_store_has(es_store *s, const char *path)
     int r = 0;
     if (!s || !path || !*path) return 0;
     es__result_full_path(full, sizeof full, path);
-    H5E_BEGIN_TRY {
-        bool e = false;
-        hid_t f;
-        const char *fp;
-        r = es__result_locate(s->ctx, s, path, ES__RESULT_READ, &f, &fp) == ES_OK &&
-            es__result_find_link(s->ctx, f, fp, full, &e) == ES_OK && e;
-    } H5E_END_TRY
+    es__h5_quiet q;
+    bool e = false;
+    es__h5_id f;
+    const char *fp;
+    es__h5_quiet_begin(&q);
+    r = es__result_locate(s->ctx, s, path, ES__RESULT_READ, &f, &fp) == ES_OK &&
+        es__result_find_link(s->ctx, f, fp, full, &e) == ES_OK && e;
+    es__h5_quiet_end(&q);
     return r;
 }
 
@@ -31,11 +32,9 @@ static int by_name(const void *a, const void *b)
     return strcmp(*(char *const *)a, *(char *const *)b);
 }
 
-static herr_t list_cb(hid_t g, const char *name, const H5L_info_t *info, void *data)
+static int list_cb(void *data, const char *name)
 {
     name_list *l = data;
-    (void)g;
-    (void)info;
     if (l->n == l->cap) {
         int64_t cap = l->cap ? 2 * l->cap : 16;
         char **p = es__realloc(l->ctx, l->names, (size_t)cap * sizeof *p);
@@ -53,7 +52,7 @@ static es_status list_impl(es_ctx *ctx, es_store *s, const char *kind, char ***n
 {
     char full[600];
     name_list l = {ctx, NULL, 0, 0, ES_OK};
-    hid_t g;
+    es__h5_id g;
     if (kind && *kind && es__result_name_check(ctx, NULL, kind) != ES_OK) return ES_EINVAL;
     snprintf(full, sizeof full, "/analysis%s%s", kind && *kind ? "/" : "", kind ? kind : "");
     {
@@ -62,25 +61,25 @@ static es_status list_impl(es_ctx *ctx, es_store *s, const char *kind, char ***n
         es_status rc;
         if ((rc = es__result_find_link(ctx, s->file, s->path, full, &e))) return rc;
         if (!e) goto beside;
-        if ((g = H5Gopen2(s->file, full, H5P_DEFAULT)) < 0)
+        if ((g = es__h5_group_open(s->file, full)) < 0)
             return es__h5_fail(ctx, ES_EFORMAT, "store: %s is not a group", full);
         /* the group listed is searched by HDF5 too */
         if (kind && *kind && ((rc = es__h5_raw_open(ctx, g, s->path, &raw)) ||
                               (rc = es__h5_check_group(raw, g, full)))) {
             es__h5_raw_close(raw);
-            H5Gclose(g);
+            es__h5_close(g);
             return rc;
         }
         es__h5_raw_close(raw);
     }
-    if (H5Literate(g, H5_INDEX_NAME, H5_ITER_INC, NULL, list_cb, &l) < 0) {
+    if (es__h5_list(g, false, list_cb, &l) < 0) {
         es_status rc = l.rc ? l.rc : es__h5_fail(ctx, ES_EIO, "store: cannot list %s", full);
-        H5Gclose(g);
+        es__h5_close(g);
         for (int64_t i = 0; i < l.n; i++) es__free(ctx, l.names[i]);
         es__free(ctx, l.names);
         return rc;
     }
-    H5Gclose(g);
+    es__h5_close(g);
 beside:
     /* and those beside the store (format 3), merged in name order */
     if (s->beside) {
@@ -97,39 +96,33 @@ beside:
     return ES_OK;
 }
 
-static herr_t attr_cb(hid_t loc, const char *name, const H5A_info_t *info, void *data)
-{
-    (void)info;
-    return list_cb(loc, name, NULL, data);
-}
-
 static es_status attrs_impl(es_ctx *ctx, es_store *s, const char *path, char ***keys, int64_t *n)
 {
     char parts[8][128], full[700];
     es_status rc;
     name_list l = {ctx, NULL, 0, 0, ES_OK};
-    hid_t f;
+    es__h5_id f;
     const char *fp;
     (void)parts;
     bool e;
     if ((rc = es__result_find(ctx, s, path, ES__RESULT_READ, full, sizeof full, &f, &fp, &e))) return rc;
     if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
-    hid_t obj = H5Oopen(f, full, H5P_DEFAULT);
+    es__h5_id obj = es__h5_object_open(f, full);
     if (obj < 0) return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
     /* the attribute messages checked before HDF5 decodes them */
     if ((rc = es__result_check_attrs(ctx, fp, obj, full))) {
-        H5Oclose(obj);
+        es__h5_close(obj);
         return rc;
     }
-    if (H5Aiterate2(obj, H5_INDEX_NAME, H5_ITER_INC, NULL, attr_cb, &l) < 0) {
+    if (es__h5_list(obj, true, list_cb, &l) < 0) {
         rc = l.rc ? l.rc : es__h5_fail(ctx, ES_EIO, "store: cannot list the attributes of %s",
                                        full);
-        H5Oclose(obj);
+        es__h5_close(obj);
         for (int64_t i = 0; i < l.n; i++) es__free(ctx, l.names[i]);
         es__free(ctx, l.names);
         return rc;
     }
-    H5Oclose(obj);
+    es__h5_close(obj);
     *keys = l.names;
     *n = l.n;
     return ES_OK;
@@ -142,7 +135,7 @@ es_status es_store_list_attrs(es_ctx *ctx, es_store *s, const char *path, char *
     if (!s || !keys || !n) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument");
     *keys = NULL;
     *n = 0;
-    H5E_BEGIN_TRY { rc = attrs_impl(ctx, s, path, keys, n); } H5E_END_TRY
+    ES__H5_QUIET(rc = attrs_impl(ctx, s, path, keys, n));
     return rc;
 }
 
@@ -153,7 +146,7 @@ es_status es_store_list_results(es_ctx *ctx, es_store *s, const char *kind, char
     if (!s || !names || !n) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument");
     *names = NULL;
     *n = 0;
-    H5E_BEGIN_TRY { rc = list_impl(ctx, s, kind, names, n); } H5E_END_TRY
+    ES__H5_QUIET(rc = list_impl(ctx, s, kind, names, n));
     return rc;
 }
 
@@ -165,7 +158,7 @@ static es_status delete_impl(es_ctx *ctx, es_store *s, const char *kind, const c
     snprintf(group, sizeof group, "/analysis/%s", kind);
     snprintf(full, sizeof full, "%s/%s", group, name);
     bool e;
-    hid_t f;
+    es__h5_id f;
     const char *fp;
     if ((rc = es__result_locate(ctx, s, full + 10, ES__RESULT_READ, &f, &fp)) ||
         (rc = es__result_find_link(ctx, f, fp, full, &e)))
@@ -181,20 +174,20 @@ static es_status delete_impl(es_ctx *ctx, es_store *s, const char *kind, const c
         return es__beside_delete(s, kind, name);
     }
     if ((rc = es__store_begin_write(s))) return rc;
-    if (H5Ldelete(s->file, full, H5P_DEFAULT) < 0) {
+    if (es__h5_delete(s->file, full) < 0) {
         s->broken = true;
         return es__h5_fail(ctx, ES_EIO, "store: cannot delete %s", full);
     }
     /* the last result of its kind takes the kind's group with it */
-    H5G_info_t info;
-    hid_t g = H5Gopen2(s->file, group, H5P_DEFAULT);
-    if (g < 0 || H5Gget_info(g, &info) < 0) {
+    es__h5_id g = es__h5_group_open(s->file, group);
+    int64_t nlinks = g < 0 ? -1 : es__h5_group_size(g);
+    if (nlinks < 0) {
         es__h5_close(g);
         s->broken = true;
         return es__h5_fail(ctx, ES_EIO, "store: cannot read %s", group);
     }
-    H5Gclose(g);
-    if (info.nlinks == 0 && H5Ldelete(s->file, group, H5P_DEFAULT) < 0) {
+    es__h5_close(g);
+    if (nlinks == 0 && es__h5_delete(s->file, group) < 0) {
         s->broken = true;
         return es__h5_fail(ctx, ES_EIO, "store: cannot delete %s", group);
     }
@@ -205,6 +198,6 @@ es_status es_store_delete_result(es_ctx *ctx, es_store *s, const char *kind, con
 {
     es_status rc;
     if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
-    H5E_BEGIN_TRY { rc = delete_impl(ctx, s, kind, name); } H5E_END_TRY
+    ES__H5_QUIET(rc = delete_impl(ctx, s, kind, name));
     return rc;
 }

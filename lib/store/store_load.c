@@ -10,7 +10,7 @@
  * runs once, here, before any array sized by the file is allocated or used,
  * and a failure names the store, the dataset and what disagrees. The bulk
  * data (lengths, positions) is not read at open; its readers check what
- * they read (store_rows.c). Strings go through store_vlen.c, never through
+ * they read (store_rows.c). Strings go through lib/h5/h5_vlen.c, never through
  * HDF5's global heap reader.
  */
 #include "store/store_pkg.h"
@@ -22,27 +22,25 @@
  * trailing dimensions (d1, d2), and storage for all of its rows (elem: bytes
  * per element on disk); its row count goes to *rows. what: "F x 3
  * integers", for messages. */
-static es_status check_ds(es_store *s, es__h5_raw *raw, const char *name, H5T_class_t cls,
-                          int rank, hsize_t d1, hsize_t d2, const char *what, int64_t *rows)
+static es_status check_ds(es_store *s, es__h5_raw *raw, const char *name, es__h5_class cls,
+                          int rank, uint64_t d1, uint64_t d2, const char *what, int64_t *rows)
 {
     es_ctx *ctx = s->ctx;
-    hsize_t dims[3] = {0, 0, 0};
-    hid_t ds = -1, sp = -1, t = -1;
+    es__h5_info in;
+    const uint64_t *dims = in.dims;
+    es__h5_id ds = -1;
     es_status rc = ES_OK;
     uint64_t elem = 0, need = 1, have;
     *rows = -1;
     if ((rc = es__h5_check_named(raw, s->file, name))) return rc;
-    if ((ds = H5Dopen2(s->file, name, H5P_DEFAULT)) < 0)
+    if ((ds = es__h5_dataset_open(s->file, name)) < 0)
         return es__h5_fail(ctx, ES_EFORMAT, "store: '%s': %s is missing or unreadable", s->path, name);
-    if ((sp = H5Dget_space(ds)) < 0 || (t = H5Dget_type(ds)) < 0 ||
-        H5Sget_simple_extent_ndims(sp) != rank || H5Tget_class(t) != cls ||
-        H5Sget_simple_extent_dims(sp, dims, NULL) != rank ||
+    if (es__h5_dataset_info(ds, &in) < 0 || in.rank != rank || in.cls != cls ||
         (rank > 1 && dims[1] != d1) || (rank > 2 && dims[2] != d2)) {
         rc = es__fail(ctx, ES_EFORMAT, "store: '%s': %s is not %s", s->path, name, what);
         goto done;
     }
-    elem = cls == H5T_STRING && H5Tis_variable_str(t) > 0 ? es__h5_raw_vlen_size(raw)
-                                                          : H5Tget_size(t);
+    elem = in.vlen ? es__h5_raw_vlen_size(raw) : in.size;
     if ((rc = es__h5_check_chunks(ctx, ds, s->path, name, elem))) goto done;
     for (int k = 0; k < rank; k++)
         if (__builtin_mul_overflow(need, (uint64_t)dims[k], &need)) need = UINT64_MAX;
@@ -50,7 +48,7 @@ static es_status check_ds(es_store *s, es__h5_raw *raw, const char *name, H5T_cl
     /* a count the file cannot hold (20 million rows of a 132 KB store) is
      * refused here, before anything of that size is allocated */
     have = es__h5_covered_bytes(ds, rank, elem);
-    if (dims[0] > (hsize_t)INT64_MAX || (need > 0 && have < need)) {
+    if (dims[0] > (uint64_t)INT64_MAX || (need > 0 && have < need)) {
         rc = es__fail(ctx, ES_EFORMAT, "store: '%s' is corrupt: %s claims %llu rows (%llu "
                       "bytes) but the file holds %llu bytes of it", s->path, name,
                       (unsigned long long)dims[0], (unsigned long long)need,
@@ -59,21 +57,16 @@ static es_status check_ds(es_store *s, es__h5_raw *raw, const char *name, H5T_cl
     }
     *rows = (int64_t)dims[0];
 done:
-    es__h5_close(t);
-    es__h5_close(sp);
     es__h5_close(ds);
     return rc;
 }
 
-/* A whole integer or real dataset, already checked by check_ds. */
-static es_status read_all(es_store *s, const char *name, hid_t mtype, void *buf)
+/* A whole integer (i) or real (f) dataset, already checked by check_ds. */
+static es_status read_all(es_store *s, const char *name, double *f, int64_t *i)
 {
-    hid_t ds = H5Dopen2(s->file, name, H5P_DEFAULT);
-    es_status rc = ES_OK;
-    if (ds < 0 || H5Dread(ds, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0)
-        rc = es__h5_fail(s->ctx, ES_EFORMAT, "store: cannot read %s of '%s'", name, s->path);
-    es__h5_close(ds);
-    return rc;
+    if ((f ? es__h5_read_f64(s->file, name, f) : es__h5_read_i64(s->file, name, i)) < 0)
+        return es__h5_fail(s->ctx, ES_EFORMAT, "store: cannot read %s of '%s'", name, s->path);
+    return ES_OK;
 }
 
 static int cmp_edge(const void *a, const void *b)
@@ -98,8 +91,8 @@ static es_status check_topology(es_store *s)
         rc = ES_ENOMEM;
         goto done;
     }
-    if ((F > 0 && (rc = read_all(s, "/topology/faces", H5T_NATIVE_INT64, faces))) ||
-        (E > 0 && (rc = read_all(s, "/topology/edges", H5T_NATIVE_INT64, edges))))
+    if ((F > 0 && (rc = read_all(s, "/topology/faces", NULL, faces))) ||
+        (E > 0 && (rc = read_all(s, "/topology/edges", NULL, edges))))
         goto done;
     for (int64_t f = 0; f < F; f++) {
         const int64_t *c = faces + 3 * f;
@@ -153,11 +146,11 @@ done:
 static es_status load_columns(es_store *s, es__h5_raw *raw)
 {
     es_ctx *ctx = s->ctx;
-    hid_t g = -1;
+    es__h5_id g = -1;
     char **names = NULL;
     int64_t n = 0, rows;
     es_status rc = ES_OK;
-    if ((g = H5Gopen2(s->file, "/labels", H5P_DEFAULT)) < 0)
+    if ((g = es__h5_group_open(s->file, "/labels")) < 0)
         return es__h5_fail(ctx, ES_EFORMAT, "store: '%s' has no /labels group", s->path);
     if ((rc = es__h5_read_attr_strings(ctx, raw, g, "columns", &names, &n))) {
         if (rc == ES_ENOTFOUND)
@@ -179,7 +172,8 @@ static es_status load_columns(es_store *s, es__h5_raw *raw)
                 goto done;
             }
         snprintf(full, sizeof full, "/labels/%s", names[c]);
-        if ((rc = check_ds(s, raw, full, H5T_STRING, 1, 0, 0, "N strings", &rows))) goto done;
+        if ((rc = check_ds(s, raw, full, ES__H5_CLASS_STRING, 1, 0, 0, "N strings", &rows)))
+            goto done;
         if (rows != s->nrows) {
             rc = es__fail(ctx, ES_EFORMAT, "store: '%s': %s has %lld rows, /shapes/ids %lld",
                           s->path, full, (long long)rows, (long long)s->nrows);
@@ -237,7 +231,7 @@ static es_status check_scales(es_store *s)
     es_status rc;
     if (s->nedges == 0 || s->nrows == 0) return ES_OK;
     if (!(sc = es__alloc_array(s->ctx, s->nrows, sizeof *sc))) return ES_ENOMEM;
-    if (!(rc = read_all(s, "/shapes/scales", H5T_NATIVE_DOUBLE, sc)))
+    if (!(rc = read_all(s, "/shapes/scales", sc, NULL)))
         for (int64_t i = 0; i < s->nrows; i++)
             if (!(sc[i] > 0) || !isfinite(sc[i])) {
                 rc = es__fail(s->ctx, ES_EFORMAT, "store: '%s' is corrupt: /shapes/scales row "
@@ -299,25 +293,26 @@ static es_status check_shapes(es_store *s, es__h5_raw *raw, int64_t *n)
     int64_t r;
     es_status rc;
     snprintf(what, sizeof what, "N x %lld x 3 reals", (long long)s->nverts);
-    if ((rc = check_ds(s, raw, "/shapes/positions", H5T_FLOAT, 3, (hsize_t)s->nverts, 3, what,
-                       n)))
+    if ((rc = check_ds(s, raw, "/shapes/positions", ES__H5_CLASS_FLOAT, 3, (uint64_t)s->nverts,
+                       3, what, n)))
         return rc;
     if (s->kind != ES_TOPOLOGY_NONE) {
         snprintf(what, sizeof what, "N x %lld reals", (long long)s->nedges);
-        if ((rc = check_ds(s, raw, "/shapes/lengths", H5T_FLOAT, 2, (hsize_t)s->nedges, 0, what,
-                           &r)))
+        if ((rc = check_ds(s, raw, "/shapes/lengths", ES__H5_CLASS_FLOAT, 2,
+                           (uint64_t)s->nedges, 0, what, &r)))
             return rc;
         if (r != *n)
             ES_FAIL(ctx, ES_EFORMAT, "store: '%s': /shapes/lengths has %lld rows, "
                     "/shapes/positions %lld", s->path, (long long)r, (long long)*n);
-        if ((rc = check_ds(s, raw, "/shapes/scales", H5T_FLOAT, 1, 0, 0, "N reals", &r)))
+        if ((rc = check_ds(s, raw, "/shapes/scales", ES__H5_CLASS_FLOAT, 1, 0, 0, "N reals", &r)))
             return rc;
         if (r != *n)
             ES_FAIL(ctx, ES_EFORMAT, "store: '%s': /shapes/scales does not have %lld rows",
                     s->path, (long long)*n);
     }
     for (int k = 0; k < 3; k++) {
-        if ((rc = check_ds(s, raw, strs[k], H5T_STRING, 1, 0, 0, "N strings", &r))) return rc;
+        if ((rc = check_ds(s, raw, strs[k], ES__H5_CLASS_STRING, 1, 0, 0, "N strings", &r)))
+            return rc;
         if (r != *n)
             ES_FAIL(ctx, ES_EFORMAT, "store: '%s': %s has %lld rows, /shapes/positions %lld",
                     s->path, strs[k], (long long)r, (long long)*n);
@@ -327,8 +322,8 @@ static es_status check_shapes(es_store *s, es__h5_raw *raw, int64_t *n)
 
 /* The groups every open looks names up in: the root, then each of the
  * store's groups, each header and symbol table checked before HDF5
- * searches the group, opens it or decodes its attributes (store_headers.c,
- * store_groups.c). */
+ * searches the group, opens it or decodes its attributes (h5_headers.c,
+ * h5_groups.c). */
 static es_status check_groups(es_store *s, es__h5_raw *raw)
 {
     static const char *const names[] = {"/topology", "/shapes", "/labels", "/analysis"};
@@ -341,17 +336,17 @@ es_status es__store_load(es_store *s)
     es__h5_raw *raw = NULL;
     int64_t n = 0;
     es_status rc;
-    hid_t g;
+    es__h5_id g;
     char fp[64];
     if ((rc = es__h5_raw_open(ctx, s->file, s->path, &raw))) return rc;
     if ((rc = check_groups(s, raw)) || (rc = load_kind(s, raw))) goto done;
-    if ((g = H5Gopen2(s->file, "/topology", H5P_DEFAULT)) < 0) {
+    if ((g = es__h5_group_open(s->file, "/topology")) < 0) {
         rc = es__h5_fail(ctx, ES_EFORMAT, "store: '%s' has no /topology", s->path);
         goto done;
     }
     rc = es__h5_read_attr_i64(ctx, g, "/topology", "nverts", &s->nverts);
     if (!rc) rc = es__h5_read_attr_text(ctx, raw, g, "fingerprint", fp, sizeof fp);
-    H5Gclose(g);
+    es__h5_close(g);
     if (rc) goto done;
     snprintf(s->fingerprint, sizeof s->fingerprint, "%.16s", fp);
     /* every vertex has 24 bytes of positions in each row; an empty store
@@ -361,9 +356,9 @@ es_status es__store_load(es_store *s)
                       s->path, (long long)s->nverts);
         goto done;
     }
-    if ((rc = check_ds(s, raw, "/topology/faces", H5T_INTEGER, 2, 3, 0, "F x 3 integers",
+    if ((rc = check_ds(s, raw, "/topology/faces", ES__H5_CLASS_INTEGER, 2, 3, 0, "F x 3 integers",
                        &s->nfaces)) ||
-        (rc = check_ds(s, raw, "/topology/edges", H5T_INTEGER, 2, 2, 0, "E x 2 integers",
+        (rc = check_ds(s, raw, "/topology/edges", ES__H5_CLASS_INTEGER, 2, 2, 0, "E x 2 integers",
                        &s->nedges)))
         goto done;
     if ((s->kind == ES_TOPOLOGY_MESH) != (s->nfaces > 0) ||

@@ -10,7 +10,7 @@
  * the getters never touch the file and a store that does not fit its format
  * is refused at open rather than half-way through a study.
  * Every public entry point runs with HDF5's error printing off
- * (H5E_BEGIN_TRY/H5E_END_TRY).
+ * (ES__H5_QUIET).
  */
 #include "store/store_pkg.h"
 
@@ -59,8 +59,7 @@ static es_status open_impl(es_ctx *ctx, const char *path, es_store_mode mode, es
 {
     es_store *s;
     es_status rc;
-    htri_t is;
-    hid_t fapl;
+    int is;
     *out = NULL;
     if (!path || !*path) ES_FAIL(ctx, ES_EINVAL, "store: empty path");
     if (mode != ES_STORE_READ && mode != ES_STORE_WRITE && mode != ES_STORE_REPLACE)
@@ -68,7 +67,7 @@ static es_status open_impl(es_ctx *ctx, const char *path, es_store_mode mode, es
     if (access(path, F_OK) != 0)
         ES_FAIL(ctx, errno == ENOENT ? ES_ENOTFOUND : ES_EIO, "store: cannot open '%s': %s",
                 path, strerror(errno));
-    if ((is = H5Fis_hdf5(path)) <= 0) {
+    if ((is = es__h5_is_hdf5(path)) <= 0) {
         if (is < 0) return es__h5_fail(ctx, ES_EIO, "store: cannot read '%s'", path);
         ES_FAIL(ctx, ES_EFORMAT, "store: '%s' is not an HDF5 file", path);
     }
@@ -86,11 +85,9 @@ static es_status open_impl(es_ctx *ctx, const char *path, es_store_mode mode, es
         rc = es__fail(ctx, ES_EIO, "store: cannot open '%s': %s", path, strerror(errno));
         goto fail;
     }
-    fapl = es__h5_file_access();
-    s->file = H5Fopen(path, H5F_ACC_RDONLY, fapl);
-    es__h5_close(fapl);
-    if (s->file < 0) {
-        rc = es__h5_fail(ctx, ES_EIO, "store: cannot open '%s'", path);
+    /* (es__fail: the store has never named HDF5's reason here) */
+    if ((s->file = es__h5_file_open(path, false)) < 0) {
+        rc = es__fail(ctx, ES_EIO, "store: cannot open '%s'", path);
         goto fail;
     }
     if ((rc = es__store_load(s))) goto fail;
@@ -105,27 +102,20 @@ es_status es_store_open(es_ctx *ctx, const char *path, es_store_mode mode, es_st
 {
     es_status rc;
     es__h5_init();
-    H5E_BEGIN_TRY { rc = open_impl(ctx, path, mode, out); } H5E_END_TRY
+    ES__H5_QUIET(rc = open_impl(ctx, path, mode, out));
     return rc;
 }
 
 /* /topology/<name>: n rows of `width` vertex indices, fixed size (the
  * topology never changes after creation, so it is neither chunked nor
  * extendable). */
-static es_status write_topology(es_ctx *ctx, hid_t g, const char *name, int64_t n, int width,
-                                const int64_t *data)
+static es_status write_topology(es_ctx *ctx, es__h5_id g, const char *name, int64_t n,
+                                int width, const int64_t *data)
 {
-    hsize_t d[2] = {(hsize_t)n, (hsize_t)width};
-    hid_t sp = -1, ds = -1;
-    es_status rc = ES_OK;
-    if ((sp = H5Screate_simple(2, d, NULL)) < 0 ||
-        (ds = H5Dcreate2(g, name, H5T_STD_I64LE, sp, H5P_DEFAULT, H5P_DEFAULT,
-                         H5P_DEFAULT)) < 0 ||
-        (n > 0 && H5Dwrite(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0))
-        rc = es__h5_fail(ctx, ES_EIO, "store: cannot write /topology/%s", name);
-    es__h5_close(ds);
-    es__h5_close(sp);
-    return rc;
+    const uint64_t d[2] = {(uint64_t)n, (uint64_t)width};
+    if (es__h5_put_i64(g, name, 2, d, data, false) < 0)
+        return es__h5_fail(ctx, ES_EIO, "store: cannot write /topology/%s", name);
+    return ES_OK;
 }
 
 static es_status create_impl(es_ctx *ctx, const char *path, int64_t nverts, int64_t nfaces,
@@ -134,7 +124,7 @@ static es_status create_impl(es_ctx *ctx, const char *path, int64_t nverts, int6
 {
     es_store *s;
     es_status rc = ES_OK;
-    hid_t fapl = -1, g = -1, t = -1;
+    es__h5_id g = -1;
     char when[32];
     time_t now = time(NULL);
     struct tm tmv;
@@ -175,9 +165,7 @@ static es_status create_impl(es_ctx *ctx, const char *path, int64_t nverts, int6
         goto fail;
     }
     es__store_clean_stale(path);
-    fapl = es__h5_file_access();
-    s->file = H5Fcreate(s->work, H5F_ACC_EXCL, H5P_DEFAULT, fapl);
-    if (s->file < 0) {
+    if ((s->file = es__h5_file_create(s->work, false)) < 0) {
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot create '%s'", s->work);
         goto fail;
     }
@@ -194,7 +182,7 @@ static es_status create_impl(es_ctx *ctx, const char *path, int64_t nverts, int6
                                     es_topology_kind_name(s->kind))) ||
         (rc = es__h5_write_attr_str(ctx, s->file, "store_id", s->store_id)))
         goto fail;
-    if ((g = H5Gcreate2(s->file, "/topology", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) < 0) {
+    if ((g = es__h5_group_create(s->file, "/topology", false)) < 0) {
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot create /topology");
         goto fail;
     }
@@ -206,43 +194,38 @@ static es_status create_impl(es_ctx *ctx, const char *path, int64_t nverts, int6
         goto fail;
     es__h5_close(g);
     g = -1;
-    if ((g = H5Gcreate2(s->file, "/shapes", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) < 0 ||
-        (t = es__h5_str_type()) < 0) {
+    if ((g = es__h5_group_create(s->file, "/shapes", false)) < 0) {
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot create /shapes");
         goto fail;
     }
     /* HDF5 chunks cannot be 0 wide: a store without edges has no lengths
      * (and no scales, which are sums of raw edge lengths). */
     if ((nedges > 0 &&
-         ((rc = es__h5_create_rows(ctx, g, "lengths", H5T_IEEE_F64LE, 2, (hsize_t)nedges, 0, 8)) ||
-          (rc = es__h5_create_rows(ctx, g, "scales", H5T_IEEE_F64LE, 1, 0, 0, 8)))) ||
-        (rc = es__h5_create_rows(ctx, g, "positions", H5T_IEEE_F64LE, 3, (hsize_t)nverts, 3, 8)) ||
-        (rc = es__h5_create_rows(ctx, g, "ids", t, 1, 0, 0, 16)) ||
-        (rc = es__h5_create_rows(ctx, g, "source_paths", t, 1, 0, 0, 16)) ||
-        (rc = es__h5_create_rows(ctx, g, "content_hash", t, 1, 0, 0, 16)))
+         ((rc = es__h5_create_rows(ctx, g, "lengths", ES__H5_F64, 2, (uint64_t)nedges, 0, 8)) ||
+          (rc = es__h5_create_rows(ctx, g, "scales", ES__H5_F64, 1, 0, 0, 8)))) ||
+        (rc = es__h5_create_rows(ctx, g, "positions", ES__H5_F64, 3, (uint64_t)nverts, 3, 8)) ||
+        (rc = es__h5_create_rows(ctx, g, "ids", ES__H5_STR, 1, 0, 0, 16)) ||
+        (rc = es__h5_create_rows(ctx, g, "source_paths", ES__H5_STR, 1, 0, 0, 16)) ||
+        (rc = es__h5_create_rows(ctx, g, "content_hash", ES__H5_STR, 1, 0, 0, 16)))
         goto fail;
     es__h5_close(g);
-    if ((g = H5Gcreate2(s->file, "/labels", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) < 0) {
+    if ((g = es__h5_group_create(s->file, "/labels", false)) < 0) {
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot create /labels");
         goto fail;
     }
     if ((rc = es__h5_write_attr_strs(ctx, g, "columns", NULL, 0))) goto fail;
     es__h5_close(g);
-    if ((g = H5Gcreate2(s->file, "/analysis", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) < 0) {
+    if ((g = es__h5_group_create(s->file, "/analysis", false)) < 0) {
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot create /analysis");
         goto fail;
     }
     es__h5_close(g);
     g = -1;
     if ((rc = es__store_reserve_rows(s, 1))) goto fail;
-    es__h5_close(t);
-    es__h5_close(fapl);
     *out = s;
     return ES_OK;
 fail:
-    es__h5_close(t);
     es__h5_close(g);
-    es__h5_close(fapl);
     release(s, false);
     return rc;
 }
@@ -253,23 +236,21 @@ es_status es__store_create_raw(es_ctx *ctx, const char *path, int64_t nverts, in
 {
     es_status rc;
     es__h5_init();
-    H5E_BEGIN_TRY {
-        rc = create_impl(ctx, path, nverts, nfaces, faces, nedges, edges, fingerprint, out);
-    } H5E_END_TRY
+    ES__H5_QUIET(rc = create_impl(ctx, path, nverts, nfaces, faces, nedges, edges, fingerprint,
+                                  out));
     return rc;
 }
 
 void es_store_abort(es_store *store)
 {
     if (!store) return;
-    H5E_BEGIN_TRY { release(store, false); } H5E_END_TRY
+    ES__H5_QUIET(release(store, false));
 }
 
 /* Back to the published store: the working copy is thrown away (as abort
  * does) and the handle reopens and reloads the file, as open does. */
 static es_status rollback_impl(es_ctx *ctx, es_store *s)
 {
-    hid_t fapl;
     es_status rc;
     if (!s->work) {
         /* only results beside the store written (format 3): they are
@@ -294,12 +275,9 @@ static es_status rollback_impl(es_ctx *ctx, es_store *s)
         s->broken = true;
         ES_FAIL(ctx, ES_EIO, "store: cannot reopen '%s': %s", s->path, strerror(errno));
     }
-    fapl = es__h5_file_access();
-    s->file = H5Fopen(s->path, H5F_ACC_RDONLY, fapl);
-    es__h5_close(fapl);
-    if (s->file < 0) {
+    if ((s->file = es__h5_file_open(s->path, false)) < 0) {
         s->broken = true;
-        return es__h5_fail(ctx, ES_EIO, "store: cannot reopen '%s'", s->path);
+        return es__fail(ctx, ES_EIO, "store: cannot reopen '%s'", s->path);
     }
     if ((rc = es__store_load(s)) != ES_OK) {
         s->broken = true;
@@ -313,7 +291,7 @@ es_status es_store_rollback(es_ctx *ctx, es_store *store)
     es_status rc;
     if (!store) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
     es__file_set_abort(store->ctx, &store->files);   /* they went with the writes */
-    H5E_BEGIN_TRY { rc = rollback_impl(ctx, store); } H5E_END_TRY
+    ES__H5_QUIET(rc = rollback_impl(ctx, store));
     store->generation++;   /* what was read from the discarded writes is stale */
     return rc;
 }
@@ -327,22 +305,23 @@ es_status es_store_close(es_store *store)
 {
     es_status rc = ES_OK;
     if (!store) return ES_OK;
-    H5E_BEGIN_TRY {
-        const bool pending = store->work || es__beside_pending(store);
-        rc = pending && store->broken ? ES_EIO : ES_OK;
-        if (pending && !store->broken) {
-            rc = es__store_publish(store->ctx, store);
-            if (rc != ES_OK)
-                es__warn(store->ctx, "%s", es_ctx_errmsg(store->ctx));
-        }
-        /* the files riding on the handle appear with a published store only */
-        es_status frc = es__store_files_done(store->ctx, store, rc);
-        if (frc != ES_OK && rc == ES_OK) {
+    es__h5_quiet q;
+    es__h5_quiet_begin(&q);
+    const bool pending = store->work || es__beside_pending(store);
+    rc = pending && store->broken ? ES_EIO : ES_OK;
+    if (pending && !store->broken) {
+        rc = es__store_publish(store->ctx, store);
+        if (rc != ES_OK)
             es__warn(store->ctx, "%s", es_ctx_errmsg(store->ctx));
-            rc = frc;
-        }
-        release(store, false);
-    } H5E_END_TRY
+    }
+    /* the files riding on the handle appear with a published store only */
+    es_status frc = es__store_files_done(store->ctx, store, rc);
+    if (frc != ES_OK && rc == ES_OK) {
+        es__warn(store->ctx, "%s", es_ctx_errmsg(store->ctx));
+        rc = frc;
+    }
+    release(store, false);
+    es__h5_quiet_end(&q);
     return rc;
 }
 
@@ -366,4 +345,12 @@ es_status es_store_set_replace(es_ctx *ctx, es_store *s, int replace)
                 s->path);
     s->mode = replace ? ES_STORE_REPLACE : ES_STORE_WRITE;
     return ES_OK;
+}
+
+int es_store_is_hdf5(const char *path)
+{
+    int is = 0;
+    if (!path || access(path, F_OK) != 0) return 0;
+    ES__H5_QUIET(is = es__h5_is_hdf5(path));
+    return is > 0;
 }

@@ -149,7 +149,6 @@ es_status es__store_begin_write(es_store *s)
 {
     es_ctx *ctx = s->ctx;
     es_status rc;
-    hid_t fapl;
     if (s->mode == ES_STORE_READ)
         ES_FAIL(ctx, ES_EINVAL, "store: '%s' is open read-only", s->path);
     if (s->broken)
@@ -171,14 +170,12 @@ es_status es__store_begin_write(es_store *s)
                       "opened; nothing written", s->path);
         goto fail;
     }
-    H5Fclose(s->file);
-    fapl = es__h5_file_access();
-    s->file = H5Fopen(s->work, H5F_ACC_RDWR, fapl);
-    es__h5_close(fapl);
-    if (s->file < 0) {
-        rc = es__h5_fail(ctx, ES_EIO, "store: cannot open working copy '%s'", s->work);
+    es__h5_close(s->file);
+    /* (es__fail: the store has never named HDF5's reason here) */
+    if ((s->file = es__h5_file_open(s->work, true)) < 0) {
+        rc = es__fail(ctx, ES_EIO, "store: cannot open working copy '%s'", s->work);
         unlink(s->work);
-        s->file = H5Fopen(s->path, H5F_ACC_RDONLY, H5P_DEFAULT);
+        s->file = es__h5_file_open_default(s->path);
         if (s->file < 0) s->broken = true;
         goto fail;
     }
@@ -194,7 +191,6 @@ es_status es__store_publish(es_ctx *ctx, es_store *s)
     es_status rc = ES_OK;
     struct stat now, done;
     char *dir = NULL;
-    hid_t fapl;
     if (!s->work) return es__beside_publish(ctx, s); /* the store itself unchanged */
     if (s->broken)
         ES_FAIL(ctx, ES_EIO, "store: an earlier write to '%s' failed; nothing committed",
@@ -260,11 +256,8 @@ es_status es__store_publish(es_ctx *ctx, es_store *s)
     es__free(ctx, s->work);
     s->work = NULL;
     s->is_new = false;
-    fapl = es__h5_file_access();
-    s->file = H5Fopen(s->path, H5F_ACC_RDONLY, fapl);
-    es__h5_close(fapl);
-    if (s->file < 0)
-        return es__h5_fail(ctx, ES_EIO, "store: committed '%s' but cannot reopen it", s->path);
+    if ((s->file = es__h5_file_open(s->path, false)) < 0)
+        return es__fail(ctx, ES_EIO, "store: committed '%s' but cannot reopen it", s->path);
     /* results beside it after the store: one of them may name its new rows */
     return es__beside_publish(ctx, s);
 fail:
@@ -307,6 +300,6 @@ es_status es_store_commit(es_ctx *ctx, es_store *store)
 {
     es_status rc;
     if (!store) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
-    H5E_BEGIN_TRY { rc = es__store_publish(ctx, store); } H5E_END_TRY
+    ES__H5_QUIET(rc = es__store_publish(ctx, store));
     return es__store_files_done(ctx, store, rc);
 }

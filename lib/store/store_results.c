@@ -42,11 +42,11 @@ int es__result_split(es_ctx *ctx, const char *path, char parts[8][128], es_statu
 
 /* Whether every component of full exists in file (the store's, or a
  * result file beside it: fpath names it). Each object below /analysis is
- * checked (its header by store_headers.c, a group's symbol table by
- * store_groups.c) before HDF5 looks the next name up in it or opens it: a
+ * checked (its header by h5_headers.c, a group's symbol table by
+ * h5_groups.c) before HDF5 looks the next name up in it or opens it: a
  * result's groups and datasets come from the file like everything else.
  * ES_OK with *exists, or the check's refusal. */
-es_status es__result_find_link(es_ctx *ctx, hid_t file, const char *fpath, const char *full,
+es_status es__result_find_link(es_ctx *ctx, es__h5_id file, const char *fpath, const char *full,
                                bool *exists)
 {
     char buf[1200];
@@ -61,14 +61,14 @@ es_status es__result_find_link(es_ctx *ctx, hid_t file, const char *fpath, const
         if (*p != '/' && *p != '\0') continue;
         char save = *p;
         *p = '\0';
-        if (H5Lexists(file, buf, H5P_DEFAULT) <= 0) break;
+        if (es__h5_exists(file, buf) <= 0) break;
         if (++depth >= 2) {   /* /analysis itself was checked at open */
             if ((raw || (rc = es__h5_raw_open(ctx, file, fpath, &raw)) == ES_OK) &&
                 (rc = es__h5_check_named(raw, file, buf)) == ES_OK && save) {
-                hid_t g = H5Gopen2(file, buf, H5P_DEFAULT);
+                es__h5_id g = es__h5_group_open(file, buf);
                 if (g >= 0) {
                     rc = es__h5_check_group(raw, g, buf);
-                    H5Gclose(g);
+                    es__h5_close(g);
                 }
             }
             if (rc != ES_OK) break;
@@ -95,7 +95,7 @@ void es__result_full_path(char *buf, size_t n, const char *rel)
  * the store. ES__RESULT_READ: as this handle sees it; ES__RESULT_WRITE_BEGUN: to write into a
  * result begun through this handle; ES__RESULT_CREATE: to begin one. Writes into the
  * store itself switch it to its working copy (store_publish.c). */
-es_status es__result_locate(es_ctx *ctx, es_store *s, const char *rel, int how, hid_t *f,
+es_status es__result_locate(es_ctx *ctx, es_store *s, const char *rel, int how, es__h5_id *f,
                         const char **fpath)
 {
     char parts[8][128];
@@ -110,7 +110,7 @@ es_status es__result_locate(es_ctx *ctx, es_store *s, const char *rel, int how, 
         if (how != ES__RESULT_READ && s->broken)
             ES_FAIL(ctx, ES_EIO, "store: an earlier write to '%s' failed; reopen the store",
                     s->path);
-        hid_t g;
+        es__h5_id g;
         const char *gp;
         if ((rc = es__beside_file(s, parts[0], parts[1], how == ES__RESULT_CREATE, &g, &gp))) return rc;
         if (how == ES__RESULT_WRITE_BEGUN && !es__beside_writing(s, parts[0], parts[1]))
@@ -135,7 +135,7 @@ static es_status check_free(es_ctx *ctx, es_store *s, const char *kind, const ch
     es_status rc;
     if ((rc = es__result_name_check(ctx, kind, name)) != ES_OK) return rc;
     snprintf(full, sizeof full, "/analysis/%s/%s", kind, name);
-    hid_t f;
+    es__h5_id f;
     const char *fp;
     if ((rc = es__result_locate(ctx, s, full + 10, ES__RESULT_READ, &f, &fp)) ||
         (rc = es__result_find_link(ctx, f, fp, full, exists)))
@@ -151,7 +151,7 @@ es_status es_store_result_check(es_ctx *ctx, es_store *s, const char *kind, cons
     es_status rc;
     bool exists;
     if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
-    H5E_BEGIN_TRY { rc = check_free(ctx, s, kind, name, &exists); } H5E_END_TRY
+    ES__H5_QUIET(rc = check_free(ctx, s, kind, name, &exists));
     return rc;
 }
 
@@ -159,7 +159,7 @@ static es_status result_begin_impl(es_ctx *ctx, es_store *s, const char *kind, c
                                    const es_provenance *prov)
 {
     char full[600], when[32];
-    hid_t g = -1, lcpl = -1;
+    es__h5_id g = -1;
     es_status rc;
     time_t now = time(NULL);
     struct tm tmv;
@@ -173,19 +173,18 @@ static es_status result_begin_impl(es_ctx *ctx, es_store *s, const char *kind, c
                 ES_FAIL(ctx, ES_ERANGE, "store: provenance row %lld is out of range",
                         (long long)prov->rows[i]);
     snprintf(full, sizeof full, "/analysis/%s/%s", kind, name);
-    hid_t f;
+    es__h5_id f;
     const char *fp;
     if ((rc = es__result_locate(ctx, s, full + 10, ES__RESULT_CREATE, &f, &fp))) return rc;
     /* beside the store: whether this handle's working file has it already
      * (begun twice); inside it, check_free looked in the very same bytes
      * (and a working copy is not searched raw: that flushes it) */
     if (s->beside && (rc = es__result_find_link(ctx, f, fp, full, &exists))) return rc;
-    if (exists && H5Ldelete(f, full, H5P_DEFAULT) < 0) {
+    if (exists && es__h5_delete(f, full) < 0) {
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot replace %s", full);
         goto fail;
     }
-    if ((lcpl = H5Pcreate(H5P_LINK_CREATE)) < 0 || H5Pset_create_intermediate_group(lcpl, 1) < 0 ||
-        (g = H5Gcreate2(f, full, lcpl, H5P_DEFAULT, H5P_DEFAULT)) < 0) {
+    if ((g = es__h5_group_create(f, full, true)) < 0) {
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot create %s", full);
         goto fail;
     }
@@ -201,8 +200,7 @@ static es_status result_begin_impl(es_ctx *ctx, es_store *s, const char *kind, c
         /* input_rows is a dataset, not an attribute: it can exceed 64 KiB. */
         int64_t nr = prov->rows ? prov->nrows : s->nrows;
         const int64_t *rows = prov->rows;
-        hsize_t d = (hsize_t)nr;
-        hid_t sp = -1, ds = -1;
+        const uint64_t d = (uint64_t)nr;
         if (!rows) {
             if (!(all = es__alloc_array(ctx, nr ? nr : 1, sizeof *all))) {
                 rc = ES_ENOMEM;
@@ -211,23 +209,17 @@ static es_status result_begin_impl(es_ctx *ctx, es_store *s, const char *kind, c
             for (int64_t i = 0; i < nr; i++) all[i] = i;
             rows = all;
         }
-        if ((sp = H5Screate_simple(1, &d, NULL)) < 0 ||
-            (ds = H5Dcreate2(g, "input_rows", H5T_STD_I64LE, sp, H5P_DEFAULT, H5P_DEFAULT,
-                             H5P_DEFAULT)) < 0 ||
-            (nr > 0 && H5Dwrite(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, rows) < 0))
+        if (es__h5_put_i64(g, "input_rows", 1, &d, rows, false) < 0) {
             rc = es__h5_fail(ctx, ES_EIO, "store: cannot write %s/input_rows", full);
-        es__h5_close(ds);
-        es__h5_close(sp);
-        if (rc) goto fail;
+            goto fail;
+        }
     }
     es__free(ctx, all);
     es__h5_close(g);
-    es__h5_close(lcpl);
     return ES_OK;
 fail:
     es__free(ctx, all);
     es__h5_close(g);
-    es__h5_close(lcpl);
     s->broken = true;
     return rc;
 }
@@ -237,14 +229,14 @@ es_status es_store_result_begin(es_ctx *ctx, es_store *s, const char *kind, cons
 {
     es_status rc;
     if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
-    H5E_BEGIN_TRY { rc = result_begin_impl(ctx, s, kind, name, prov); } H5E_END_TRY
+    ES__H5_QUIET(rc = result_begin_impl(ctx, s, kind, name, prov));
     return rc;
 }
 
 /* Prepare a put: the path must be kind/name/dataset inside a begun result;
  * an existing dataset of that name is removed. */
 static es_status put_prepare(es_ctx *ctx, es_store *s, const char *path, char *full, size_t n,
-                             hid_t *f)
+                             es__h5_id *f)
 {
     char parts[8][128], group[600];
     es_status rc;
@@ -261,39 +253,37 @@ static es_status put_prepare(es_ctx *ctx, es_store *s, const char *path, char *f
                 "(es_store_result_begin)", parts[0], parts[1]);
     es__result_full_path(full, n, path);
     if ((rc = es__result_find_link(ctx, *f, fp, full, &e))) return rc;
-    if (e && H5Ldelete(*f, full, H5P_DEFAULT) < 0) {
+    if (e && es__h5_delete(*f, full) < 0) {
         s->broken = true;
         return es__h5_fail(ctx, ES_EIO, "store: cannot replace %s", full);
     }
     return ES_OK;
 }
 
+/* Doubles f, integers i or strings str, as type says; rank 1 or 2. */
 static es_status put_impl(es_ctx *ctx, es_store *s, const char *path, int rank,
-                          const hsize_t *dims, hid_t ftype, hid_t mtype, const void *buf)
+                          const uint64_t *dims, es__h5_type type, const double *f,
+                          const int64_t *i, const char *const *str)
 {
     char full[700];
-    hid_t sp = -1, ds = -1, lcpl = -1, f = -1;
-    es_status rc = put_prepare(ctx, s, path, full, sizeof full, &f);
-    hsize_t total = 1;
+    es__h5_id file = -1;
+    es_status rc = put_prepare(ctx, s, path, full, sizeof full, &file);
+    int r;
     if (rc) return rc;
-    for (int k = 0; k < rank; k++) total *= dims[k];
-    if ((lcpl = H5Pcreate(H5P_LINK_CREATE)) < 0 || H5Pset_create_intermediate_group(lcpl, 1) < 0 ||
-        (sp = H5Screate_simple(rank, dims, NULL)) < 0 ||
-        (ds = H5Dcreate2(f, full, ftype, sp, lcpl, H5P_DEFAULT, H5P_DEFAULT)) < 0 ||
-        (total > 0 && H5Dwrite(ds, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0)) {
+    r = type == ES__H5_F64 ? es__h5_put_f64(file, full, rank, dims, f, true)
+        : type == ES__H5_I64 ? es__h5_put_i64(file, full, rank, dims, i, true)
+            : es__h5_put_strs(file, full, (int64_t)dims[0], str, true);
+    if (r < 0) {
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot write %s", full);
         s->broken = true;
     }
-    es__h5_close(ds);
-    es__h5_close(sp);
-    es__h5_close(lcpl);
     return rc;
 }
 
 es_status es_store_put_matrix(es_ctx *ctx, es_store *s, const char *path, es_mat m)
 {
     es_status rc;
-    hsize_t dims[2] = {(hsize_t)m.cols, (hsize_t)m.rows};
+    const uint64_t dims[2] = {(uint64_t)m.cols, (uint64_t)m.rows};
     double *packed = NULL;
     const double *src = m.data;
     if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
@@ -308,9 +298,7 @@ es_status es_store_put_matrix(es_ctx *ctx, es_store *s, const char *path, es_mat
             memcpy(packed + j * m.rows, m.data + j * m.ld, (size_t)m.rows * sizeof *packed);
         src = packed;
     }
-    H5E_BEGIN_TRY {
-        rc = put_impl(ctx, s, path, 2, dims, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, src);
-    } H5E_END_TRY
+    ES__H5_QUIET(rc = put_impl(ctx, s, path, 2, dims, ES__H5_F64, src, NULL, NULL));
     es__free(ctx, packed);
     return rc;
 }
@@ -319,10 +307,9 @@ es_status es_store_put_vector(es_ctx *ctx, es_store *s, const char *path, const 
                               int64_t n)
 {
     es_status rc;
-    hsize_t d = (hsize_t)n;
+    const uint64_t d = (uint64_t)n;
     if (!s || n < 0 || (n > 0 && !v)) ES_FAIL(ctx, ES_EINVAL, "store: bad vector argument");
-    H5E_BEGIN_TRY { rc = put_impl(ctx, s, path, 1, &d, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, v); }
-    H5E_END_TRY
+    ES__H5_QUIET(rc = put_impl(ctx, s, path, 1, &d, ES__H5_F64, v, NULL, NULL));
     return rc;
 }
 
@@ -330,10 +317,9 @@ es_status es_store_put_ints(es_ctx *ctx, es_store *s, const char *path, const in
                             int64_t n)
 {
     es_status rc;
-    hsize_t d = (hsize_t)n;
+    const uint64_t d = (uint64_t)n;
     if (!s || n < 0 || (n > 0 && !v)) ES_FAIL(ctx, ES_EINVAL, "store: bad vector argument");
-    H5E_BEGIN_TRY { rc = put_impl(ctx, s, path, 1, &d, H5T_STD_I64LE, H5T_NATIVE_INT64, v); }
-    H5E_END_TRY
+    ES__H5_QUIET(rc = put_impl(ctx, s, path, 1, &d, ES__H5_I64, NULL, v, NULL));
     return rc;
 }
 
@@ -341,18 +327,12 @@ es_status es_store_put_strings(es_ctx *ctx, es_store *s, const char *path,
                                const char *const *str, int64_t n)
 {
     es_status rc;
-    hsize_t d = (hsize_t)n;
-    hid_t t;
+    const uint64_t d = (uint64_t)n;
     if (!s || n < 0 || (n > 0 && !str)) ES_FAIL(ctx, ES_EINVAL, "store: bad strings argument");
     for (int64_t i = 0; i < n; i++)
         if (!str[i])
             ES_FAIL(ctx, ES_EINVAL, "store: string %lld of %s is NULL", (long long)i, path);
-    H5E_BEGIN_TRY {
-        t = es__h5_str_type();
-        rc = t < 0 ? es__h5_fail(ctx, ES_EIO, "store: string type") :
-                     put_impl(ctx, s, path, 1, &d, t, t, str);
-        es__h5_close(t);
-    } H5E_END_TRY
+    ES__H5_QUIET(rc = put_impl(ctx, s, path, 1, &d, ES__H5_STR, NULL, NULL, str));
     return rc;
 }
 
@@ -366,7 +346,7 @@ typedef struct attr_value {
 } attr_value;
 
 es_status es__result_find(es_ctx *ctx, es_store *s, const char *path, int how, char *full,
-                          size_t n, hid_t *f, const char **fpath, bool *exists)
+                          size_t n, es__h5_id *f, const char **fpath, bool *exists)
 {
     es_status rc = es__result_locate(ctx, s, path, how, f, fpath);
     if (rc) return rc;
@@ -374,9 +354,10 @@ es_status es__result_find(es_ctx *ctx, es_store *s, const char *path, int how, c
     return es__result_find_link(ctx, *f, *fpath, full, exists);
 }
 
-/* The header of obj, every attribute message, checked (store_headers.c)
+/* The header of obj, every attribute message, checked (h5_headers.c)
  * before HDF5 decodes any of them. */
-es_status es__result_check_attrs(es_ctx *ctx, const char *fpath, hid_t obj, const char *full)
+es_status es__result_check_attrs(es_ctx *ctx, const char *fpath, es__h5_id obj,
+                                 const char *full)
 {
     es__h5_raw *raw = NULL;
     es_status rc = es__h5_raw_open(ctx, obj, fpath, &raw);
@@ -390,24 +371,24 @@ static es_status put_attr_impl(es_ctx *ctx, es_store *s, const char *path, const
 {
     char parts[8][128], full[700];
     es_status rc;
-    hid_t obj;
+    es__h5_id obj;
     bool e;
     int np = es__result_split(ctx, path, parts, &rc);
     if (np < 0) return rc;
     if (np < 2 || !key || !*key || (v->type == 0 && !v->s))
         ES_FAIL(ctx, ES_EINVAL, "store: bad attribute '%s' on '%s'", key ? key : "", path);
-    hid_t f;
+    es__h5_id f;
     const char *fp;
     if ((rc = es__result_find(ctx, s, path, ES__RESULT_WRITE_BEGUN, full, sizeof full, &f, &fp, &e))) return rc;
     if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
-    if ((obj = H5Oopen(f, full, H5P_DEFAULT)) < 0)
+    if ((obj = es__h5_object_open(f, full)) < 0)
         return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
     rc = es__result_check_attrs(ctx, fp, obj, full);
     if (rc == ES_OK)
         rc = v->type == 1 ? es__h5_write_attr_f64(ctx, obj, key, v->d)
              : v->type == 2 ? es__h5_write_attr_i64(ctx, obj, key, v->i)
                             : es__h5_write_attr_str(ctx, obj, key, v->s);
-    H5Oclose(obj);
+    es__h5_close(obj);
     if (rc) s->broken = true;
     return rc;
 }
@@ -418,7 +399,7 @@ es_status es_store_put_attr(es_ctx *ctx, es_store *s, const char *path, const ch
     es_status rc;
     attr_value v = {0, value, 0, 0};
     if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
-    H5E_BEGIN_TRY { rc = put_attr_impl(ctx, s, path, key, &v); } H5E_END_TRY
+    ES__H5_QUIET(rc = put_attr_impl(ctx, s, path, key, &v));
     return rc;
 }
 
@@ -428,7 +409,7 @@ es_status es_store_put_attr_double(es_ctx *ctx, es_store *s, const char *path, c
     es_status rc;
     attr_value v = {1, NULL, value, 0};
     if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
-    H5E_BEGIN_TRY { rc = put_attr_impl(ctx, s, path, key, &v); } H5E_END_TRY
+    ES__H5_QUIET(rc = put_attr_impl(ctx, s, path, key, &v));
     return rc;
 }
 
@@ -438,67 +419,66 @@ es_status es_store_put_attr_int(es_ctx *ctx, es_store *s, const char *path, cons
     es_status rc;
     attr_value v = {2, NULL, 0, value};
     if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
-    H5E_BEGIN_TRY { rc = put_attr_impl(ctx, s, path, key, &v); } H5E_END_TRY
+    ES__H5_QUIET(rc = put_attr_impl(ctx, s, path, key, &v));
     return rc;
 }
 
 /* Open /analysis/<path> as a dataset of the given rank; dims out. */
-static es_status get_open(es_ctx *ctx, es_store *s, const char *path, int rank, hsize_t *dims,
-                          hid_t *ds)
+static es_status get_open(es_ctx *ctx, es_store *s, const char *path, int rank,
+                          es__h5_info *info, es__h5_id *ds)
 {
     char parts[8][128], full[700];
     es_status rc;
-    hid_t sp;
     bool e;
-    hid_t f;
+    es__h5_id f;
     const char *fp;
     (void)parts;
     if ((rc = es__result_find(ctx, s, path, ES__RESULT_READ, full, sizeof full, &f, &fp, &e))) return rc;
     if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no dataset %s", full);
-    if ((*ds = H5Dopen2(f, full, H5P_DEFAULT)) < 0)
+    if ((*ds = es__h5_dataset_open(f, full)) < 0)
         return es__h5_fail(ctx, ES_EFORMAT, "store: %s is not a dataset", full);
-    sp = H5Dget_space(*ds);
-    if (sp < 0 || H5Sget_simple_extent_ndims(sp) != rank) {
-        es__h5_close(sp);
-        H5Dclose(*ds);
+    if (es__h5_dataset_info(*ds, info) < 0 || info->rank != rank) {
+        es__h5_close(*ds);
         *ds = -1;
         ES_FAIL(ctx, ES_EFORMAT, "store: %s is not of rank %d", full, rank);
     }
-    H5Sget_simple_extent_dims(sp, dims, NULL);
-    H5Sclose(sp);
+    if (rank == 1) info->dims[1] = 1;
     return ES_OK;
 }
 
-static es_status get_impl(es_ctx *ctx, es_store *s, const char *path, int rank, hid_t mtype,
-                          size_t elem, void **data, int64_t *d0, int64_t *d1)
+/* Doubles (f64) or integers into *data. */
+static es_status get_impl(es_ctx *ctx, es_store *s, const char *path, int rank, bool f64,
+                          void **data, int64_t *d0, int64_t *d1)
 {
-    hsize_t dims[2] = {0, 1};
-    hid_t ds = -1, t = -1;
+    es__h5_info in;
+    const uint64_t *dims = in.dims;
+    es__h5_id ds = -1;
     int64_t total;
     uint64_t need;
-    es_status rc = get_open(ctx, s, path, rank, dims, &ds);
+    es_status rc = get_open(ctx, s, path, rank, &in, &ds);
     *data = NULL;
     if (rc) return rc;
     /* a number dataset whose storage holds all of it: a crafted dataspace
      * must not size an allocation the file cannot fill */
-    if ((t = H5Dget_type(ds)) < 0 ||
-        (H5Tget_class(t) != H5T_FLOAT && H5Tget_class(t) != H5T_INTEGER)) {
+    if (in.cls != ES__H5_CLASS_FLOAT && in.cls != ES__H5_CLASS_INTEGER) {
         rc = es__fail(ctx, ES_EFORMAT, "store: '%s': /analysis/%s is not numbers", s->path, path);
         goto done;
     }
-    if ((rc = es__h5_check_chunks(ctx, ds, s->path, path, H5Tget_size(t)))) goto done;
+    if ((rc = es__h5_check_chunks(ctx, ds, s->path, path, in.size))) goto done;
     if (!es__mul_i64((int64_t)dims[0], (int64_t)dims[1], &total) || total < 0 ||
-        __builtin_mul_overflow((uint64_t)total, (uint64_t)H5Tget_size(t), &need) ||
-        es__h5_covered_bytes(ds, rank, H5Tget_size(t)) < need) {
+        __builtin_mul_overflow((uint64_t)total, in.size, &need) ||
+        es__h5_covered_bytes(ds, rank, in.size) < need) {
         rc = es__fail(ctx, ES_EFORMAT, "store: '%s' is corrupt: /analysis/%s claims more values "
                       "than the file holds", s->path, path);
         goto done;
     }
-    if (!(*data = es__alloc_array(ctx, total ? total : 1, elem))) {
+    if (!(*data = es__alloc_array(ctx, total ? total : 1,
+                                  f64 ? sizeof(double) : sizeof(int64_t)))) {
         rc = ES_ENOMEM;
         goto done;
     }
-    if (total > 0 && H5Dread(ds, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, *data) < 0) {
+    if (total > 0 && (f64 ? es__h5_dataset_read_f64(ds, *data)
+                          : es__h5_dataset_read_i64(ds, *data)) < 0) {
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot read %s", path);
         es__free(ctx, *data);
         *data = NULL;
@@ -507,8 +487,7 @@ static es_status get_impl(es_ctx *ctx, es_store *s, const char *path, int rank, 
     *d0 = (int64_t)dims[0];
     if (d1) *d1 = (int64_t)dims[1];
 done:
-    es__h5_close(t);
-    H5Dclose(ds);
+    es__h5_close(ds);
     return rc;
 }
 
@@ -518,9 +497,7 @@ es_status es_store_get_matrix(es_ctx *ctx, es_store *s, const char *path, es_mat
     void *data = NULL;
     int64_t cols = 0, rows = 0;
     if (!s || !m) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument");
-    H5E_BEGIN_TRY {
-        rc = get_impl(ctx, s, path, 2, H5T_NATIVE_DOUBLE, sizeof(double), &data, &cols, &rows);
-    } H5E_END_TRY
+    ES__H5_QUIET(rc = get_impl(ctx, s, path, 2, true, &data, &cols, &rows));
     if (rc) return rc;
     m->data = data;
     m->rows = rows;
@@ -535,9 +512,7 @@ es_status es_store_get_vector(es_ctx *ctx, es_store *s, const char *path, double
     es_status rc;
     void *data = NULL;
     if (!s || !v || !n) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument");
-    H5E_BEGIN_TRY {
-        rc = get_impl(ctx, s, path, 1, H5T_NATIVE_DOUBLE, sizeof(double), &data, n, NULL);
-    } H5E_END_TRY
+    ES__H5_QUIET(rc = get_impl(ctx, s, path, 1, true, &data, n, NULL));
     *v = data;
     return rc;
 }
@@ -548,9 +523,7 @@ es_status es_store_get_ints(es_ctx *ctx, es_store *s, const char *path, int64_t 
     es_status rc;
     void *data = NULL;
     if (!s || !v || !n) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument");
-    H5E_BEGIN_TRY {
-        rc = get_impl(ctx, s, path, 1, H5T_NATIVE_INT64, sizeof(int64_t), &data, n, NULL);
-    } H5E_END_TRY
+    ES__H5_QUIET(rc = get_impl(ctx, s, path, 1, false, &data, n, NULL));
     *v = data;
     return rc;
 }
@@ -559,24 +532,24 @@ static es_status get_strings_impl(es_ctx *ctx, es_store *s, const char *path, ch
                                   int64_t *n)
 {
     char full[700];
-    hsize_t dims[2] = {0, 1};
-    hid_t ds = -1, t = -1;
+    es__h5_info in;
+    es__h5_id ds = -1;
     es__h5_raw *raw = NULL;
     char **v = NULL;
     int64_t count;
     uint64_t disk, need;
-    es_status rc = get_open(ctx, s, path, 1, dims, &ds);
+    es_status rc = get_open(ctx, s, path, 1, &in, &ds);
     if (rc) return rc;
     es__result_full_path(full, sizeof full, path);
-    count = (int64_t)dims[0];
-    if ((t = H5Dget_type(ds)) < 0 || H5Tget_class(t) != H5T_STRING) {
+    count = (int64_t)in.dims[0];
+    if (in.cls != ES__H5_CLASS_STRING) {
         rc = es__fail(ctx, ES_EFORMAT, "store: '%s': %s is not strings", s->path, full);
         goto done;
     }
     if ((rc = es__h5_raw_open(ctx, ds, s->path, &raw))) goto done;
     /* the strings' descriptors (or fixed-length strings) must be in the
      * file before an array of their count is allocated */
-    disk = H5Tis_variable_str(t) > 0 ? es__h5_raw_vlen_size(raw) : H5Tget_size(t);
+    disk = in.vlen ? es__h5_raw_vlen_size(raw) : in.size;
     if ((rc = es__h5_check_chunks(ctx, ds, s->path, path, disk))) goto done;
     if (count < 0 || __builtin_mul_overflow((uint64_t)count, disk, &need) ||
         es__h5_covered_bytes(ds, 1, disk) < need) {
@@ -588,7 +561,7 @@ static es_status get_strings_impl(es_ctx *ctx, es_store *s, const char *path, ch
         rc = ES_ENOMEM;
         goto done;
     }
-    hid_t file = H5Iget_file_id(ds);   /* the store, or the result's file beside it */
+    es__h5_id file = es__h5_file_of(ds);   /* the store, or the result's file beside it */
     rc = es__h5_read_strings(ctx, raw, file, full, count, v);
     es__h5_close(file);
     if (rc != ES_OK) {
@@ -600,8 +573,7 @@ static es_status get_strings_impl(es_ctx *ctx, es_store *s, const char *path, ch
     *n = count;
 done:
     es__h5_raw_close(raw);
-    es__h5_close(t);
-    H5Dclose(ds);
+    es__h5_close(ds);
     return rc;
 }
 
@@ -612,7 +584,7 @@ es_status es_store_get_strings(es_ctx *ctx, es_store *s, const char *path, char 
     if (!s || !v || !n) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument");
     *v = NULL;
     *n = 0;
-    H5E_BEGIN_TRY { rc = get_strings_impl(ctx, s, path, v, n); } H5E_END_TRY
+    ES__H5_QUIET(rc = get_strings_impl(ctx, s, path, v, n));
     return rc;
 }
 
@@ -621,22 +593,22 @@ static es_status get_attr_impl(es_ctx *ctx, es_store *s, const char *path, const
 {
     char parts[8][128], full[700];
     es_status rc;
-    hid_t obj;
+    es__h5_id obj;
     bool e;
-    hid_t f;
+    es__h5_id f;
     const char *fp;
     (void)parts;
     if ((rc = es__result_find(ctx, s, path, ES__RESULT_READ, full, sizeof full, &f, &fp, &e))) return rc;
     if (!e) ES_FAIL(ctx, ES_ENOTFOUND, "store: no result object %s", full);
-    if ((obj = H5Oopen(f, full, H5P_DEFAULT)) < 0)
+    if ((obj = es__h5_object_open(f, full)) < 0)
         return es__h5_fail(ctx, ES_EIO, "store: cannot open %s", full);
     /* HDF5 decodes every attribute of the object to find one: checked first */
     if ((rc = es__result_check_attrs(ctx, fp, obj, full))) {
-        H5Oclose(obj);
+        es__h5_close(obj);
         return rc;
     }
-    if (H5Aexists(obj, key) <= 0) {
-        H5Oclose(obj);
+    if (es__h5_attr_exists(obj, key) <= 0) {
+        es__h5_close(obj);
         ES_FAIL(ctx, ES_ENOTFOUND, "store: %s has no attribute '%s'", full, key);
     }
     {
@@ -645,7 +617,7 @@ static es_status get_attr_impl(es_ctx *ctx, es_store *s, const char *path, const
             rc = es__h5_read_attr_text(ctx, raw, obj, key, buf, n);
         es__h5_raw_close(raw);
     }
-    H5Oclose(obj);
+    es__h5_close(obj);
     return rc;
 }
 
@@ -654,7 +626,7 @@ es_status es_store_get_attr(es_ctx *ctx, es_store *s, const char *path, const ch
 {
     es_status rc;
     if (!s || !key || !buf) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument");
-    H5E_BEGIN_TRY { rc = get_attr_impl(ctx, s, path, key, buf, n); } H5E_END_TRY
+    ES__H5_QUIET(rc = get_attr_impl(ctx, s, path, key, buf, n));
     return rc;
 }
 

@@ -127,22 +127,11 @@ const char *es_store_label(const es_store *s, int64_t row, int64_t col)
 static es_status read_block(es_ctx *ctx, es_store *s, const char *name, int64_t row0, int64_t n,
                             int64_t m, double *buf, int64_t ld)
 {
-    hsize_t fstart[2] = {(hsize_t)row0, 0}, cnt[2] = {(hsize_t)n, (hsize_t)m};
-    hsize_t mdims[2] = {(hsize_t)n, (hsize_t)ld}, mstart[2] = {0, 0};
-    hid_t ds = -1, fsp = -1, msp = -1;
-    es_status rc = ES_OK;
     if (n == 0) return ES_OK;
-    if ((ds = es__h5_open_ds_nocache(s->file, name)) < 0 || (fsp = H5Dget_space(ds)) < 0 ||
-        H5Sselect_hyperslab(fsp, H5S_SELECT_SET, fstart, NULL, cnt, NULL) < 0 ||
-        (msp = H5Screate_simple(2, mdims, NULL)) < 0 ||
-        H5Sselect_hyperslab(msp, H5S_SELECT_SET, mstart, NULL, cnt, NULL) < 0 ||
-        H5Dread(ds, H5T_NATIVE_DOUBLE, msp, fsp, H5P_DEFAULT, buf) < 0)
-        rc = es__h5_fail(ctx, ES_EIO, "store: cannot read rows %lld..%lld of %s in '%s'",
-                         (long long)row0, (long long)(row0 + n - 1), name, s->path);
-    es__h5_close(msp);
-    es__h5_close(fsp);
-    es__h5_close(ds);
-    return rc;
+    if (es__h5_read_rows_f64(s->file, name, row0, n, m, buf, ld) < 0)
+        return es__h5_fail(ctx, ES_EIO, "store: cannot read rows %lld..%lld of %s in '%s'",
+                           (long long)row0, (long long)(row0 + n - 1), name, s->path);
+    return ES_OK;
 }
 
 static es_status no_edges(es_ctx *ctx, const es_store *s)
@@ -176,7 +165,7 @@ static es_status read_lengths_impl(es_ctx *ctx, es_store *s, int64_t row0, int64
 es_status es_store_read_lengths(es_ctx *ctx, es_store *s, int64_t row0, int64_t n, es_mat out)
 {
     es_status rc;
-    H5E_BEGIN_TRY { rc = read_lengths_impl(ctx, s, row0, n, out); } H5E_END_TRY
+    ES__H5_QUIET(rc = read_lengths_impl(ctx, s, row0, n, out));
     return rc;
 }
 
@@ -205,20 +194,17 @@ es_status es_store_read_lengths_rows(es_ctx *ctx, es_store *s, const int64_t *ro
                                      int64_t nrows, es_mat out)
 {
     es_status rc;
-    H5E_BEGIN_TRY { rc = read_lengths_rows_impl(ctx, s, rows, nrows, out); } H5E_END_TRY
+    ES__H5_QUIET(rc = read_lengths_rows_impl(ctx, s, rows, nrows, out));
     return rc;
 }
 
-static es_status read_1d(es_ctx *ctx, es_store *s, const char *name, hid_t mtype, void *buf)
+/* A whole dataset as doubles (f) or integers (i). */
+static es_status read_1d(es_ctx *ctx, es_store *s, const char *name, double *f, int64_t *i)
 {
-    hid_t ds;
-    es_status rc = ES_OK;
     if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
-    if ((ds = es__h5_open_ds(s->file, name)) < 0 ||
-        H5Dread(ds, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0)
-        rc = es__h5_fail(ctx, ES_EIO, "store: cannot read %s of '%s'", name, s->path);
-    es__h5_close(ds);
-    return rc;
+    if ((f ? es__h5_read_f64(s->file, name, f) : es__h5_read_i64(s->file, name, i)) < 0)
+        return es__h5_fail(ctx, ES_EIO, "store: cannot read %s of '%s'", name, s->path);
+    return ES_OK;
 }
 
 es_status es_store_read_scales(es_ctx *ctx, es_store *s, double *scales)
@@ -226,8 +212,7 @@ es_status es_store_read_scales(es_ctx *ctx, es_store *s, double *scales)
     es_status rc = ES_OK;
     if (s && s->nedges == 0) return no_edges(ctx, s);
     if (s && s->nrows == 0) return ES_OK;
-    H5E_BEGIN_TRY { rc = read_1d(ctx, s, "/shapes/scales", H5T_NATIVE_DOUBLE, scales); }
-    H5E_END_TRY
+    ES__H5_QUIET(rc = read_1d(ctx, s, "/shapes/scales", scales, NULL));
     return rc;
 }
 
@@ -235,8 +220,7 @@ es_status es_store_read_faces(es_ctx *ctx, es_store *s, int64_t *faces)
 {
     es_status rc;
     if (s && s->nfaces == 0) return ES_OK;
-    H5E_BEGIN_TRY { rc = read_1d(ctx, s, "/topology/faces", H5T_NATIVE_INT64, faces); }
-    H5E_END_TRY
+    ES__H5_QUIET(rc = read_1d(ctx, s, "/topology/faces", NULL, faces));
     return rc;
 }
 
@@ -244,36 +228,26 @@ es_status es_store_read_edges(es_ctx *ctx, es_store *s, int64_t *edges)
 {
     es_status rc;
     if (s && s->nedges == 0) return ES_OK;
-    H5E_BEGIN_TRY { rc = read_1d(ctx, s, "/topology/edges", H5T_NATIVE_INT64, edges); }
-    H5E_END_TRY
+    ES__H5_QUIET(rc = read_1d(ctx, s, "/topology/edges", NULL, edges));
     return rc;
 }
 
 static es_status read_positions_impl(es_ctx *ctx, es_store *s, int64_t row, double *xyz)
 {
-    hsize_t start[3] = {(hsize_t)row, 0, 0}, cnt[3] = {1, (hsize_t)s->nverts, 3};
-    hid_t ds = -1, fsp = -1, msp = -1;
-    es_status rc = ES_OK;
     if (row < 0 || row >= s->nrows)
         ES_FAIL(ctx, ES_ERANGE, "store: row %lld is out of range (store has %lld rows)",
                 (long long)row, (long long)s->nrows);
-    if ((ds = es__h5_open_ds(s->file, "/shapes/positions")) < 0 || (fsp = H5Dget_space(ds)) < 0 ||
-        H5Sselect_hyperslab(fsp, H5S_SELECT_SET, start, NULL, cnt, NULL) < 0 ||
-        (msp = H5Screate_simple(3, cnt, NULL)) < 0 ||
-        H5Dread(ds, H5T_NATIVE_DOUBLE, msp, fsp, H5P_DEFAULT, xyz) < 0)
-        rc = es__h5_fail(ctx, ES_EIO, "store: cannot read positions of row %lld in '%s'",
-                         (long long)row, s->path);
-    es__h5_close(msp);
-    es__h5_close(fsp);
-    es__h5_close(ds);
-    return rc;
+    if (es__h5_read_row3_f64(s->file, "/shapes/positions", row, s->nverts, 3, xyz) < 0)
+        return es__h5_fail(ctx, ES_EIO, "store: cannot read positions of row %lld in '%s'",
+                           (long long)row, s->path);
+    return ES_OK;
 }
 
 es_status es_store_read_positions(es_ctx *ctx, es_store *s, int64_t row, double *xyz)
 {
     es_status rc;
     if (!s) ES_FAIL(ctx, ES_EINVAL, "store: NULL store");
-    H5E_BEGIN_TRY { rc = read_positions_impl(ctx, s, row, xyz); } H5E_END_TRY
+    ES__H5_QUIET(rc = read_positions_impl(ctx, s, row, xyz));
     return rc;
 }
 
@@ -372,8 +346,7 @@ static es_status validate_rows(es_ctx *ctx, const es_store *s, const es_store_ro
 }
 
 /* Add label columns the store does not have yet ("" in existing rows). */
-static es_status add_columns(es_ctx *ctx, es_store *s, const es_store_rows *r, hid_t g,
-                             hid_t t)
+static es_status add_columns(es_ctx *ctx, es_store *s, const es_store_rows *r, es__h5_id g)
 {
     es_status rc;
     for (int64_t c = 0; c < r->ncols; c++) {
@@ -392,8 +365,10 @@ static es_status add_columns(es_ctx *ctx, es_store *s, const es_store_rows *r, h
         s->ncols++;
         for (int64_t i = 0; i < s->nrows; i++)
             if (!(vals[i] = es__strdup(ctx, ""))) return ES_ENOMEM;
-        if ((rc = es__h5_create_rows(ctx, g, name, t, 1, 0, 0, 16))) return rc;
-        if (s->nrows > 0 && (rc = es__h5_append_rows(ctx, g, name, t, s->nrows, vals))) return rc;
+        if ((rc = es__h5_create_rows(ctx, g, name, ES__H5_STR, 1, 0, 0, 16))) return rc;
+        if (s->nrows > 0 &&
+            (rc = es__h5_append_strs(ctx, g, name, s->nrows, (const char *const *)vals)))
+            return rc;
     }
     return es__h5_write_attr_strs(ctx, g, "columns", (const char *const *)s->colnames, s->ncols);
 }
@@ -401,7 +376,7 @@ static es_status add_columns(es_ctx *ctx, es_store *s, const es_store_rows *r, h
 static es_status append_impl(es_ctx *ctx, es_store *s, const es_store_rows *r, bool written)
 {
     es_status rc;
-    hid_t t = -1, g = -1;
+    es__h5_id g = -1;
     const char **tmp = NULL;
     int64_t n = r->n, n0 = s->nrows;
     if ((rc = validate_rows(ctx, s, r, written))) return rc;
@@ -409,36 +384,35 @@ static es_status append_impl(es_ctx *ctx, es_store *s, const es_store_rows *r, b
     if ((rc = es__store_begin_write(s))) return rc;
     if ((rc = es__store_reserve_rows(s, n0 + n))) return rc;
     /* From here a failure leaves the working copy half-written: mark it. */
-    if ((t = es__h5_str_type()) < 0 || (g = H5Gopen2(s->file, "/labels", H5P_DEFAULT)) < 0) {
+    if ((g = es__h5_group_open(s->file, "/labels")) < 0) {
         rc = es__h5_fail(ctx, ES_EIO, "store: cannot open /labels");
         goto done;
     }
-    if ((rc = add_columns(ctx, s, r, g, t))) goto done;
+    if ((rc = add_columns(ctx, s, r, g))) goto done;
     if ((rc = es__store_reserve_rows(s, n0 + n))) goto done;
     if (n == 0) goto done;
     if (!written && ((s->nedges > 0 &&
-         ((rc = es__h5_append_rows(ctx, s->file, "/shapes/lengths", H5T_NATIVE_DOUBLE, n,
-                                   r->lengths)) ||
-          (rc = es__h5_append_rows(ctx, s->file, "/shapes/scales", H5T_NATIVE_DOUBLE, n,
-                                   r->scales)))) ||
-        (rc = es__h5_append_rows(ctx, s->file, "/shapes/positions", H5T_NATIVE_DOUBLE, n, r->xyz))))
+         ((rc = es__h5_append_f64(ctx, s->file, "/shapes/lengths", n, r->lengths)) ||
+          (rc = es__h5_append_f64(ctx, s->file, "/shapes/scales", n, r->scales)))) ||
+        (rc = es__h5_append_f64(ctx, s->file, "/shapes/positions", n, r->xyz))))
         goto done;
     if (!(tmp = es__alloc_array(ctx, n, sizeof *tmp))) { rc = ES_ENOMEM; goto done; }
     for (int64_t i = 0; i < n; i++)
         tmp[i] = r->source_paths && r->source_paths[i] ? r->source_paths[i] : "";
-    if ((rc = es__h5_append_rows(ctx, s->file, "/shapes/ids", t, n, r->ids)) ||
-        (rc = es__h5_append_rows(ctx, s->file, "/shapes/source_paths", t, n, tmp)))
+    if ((rc = es__h5_append_strs(ctx, s->file, "/shapes/ids", n,
+                                 (const char *const *)r->ids)) ||
+        (rc = es__h5_append_strs(ctx, s->file, "/shapes/source_paths", n, tmp)))
         goto done;
     for (int64_t i = 0; i < n; i++)
         tmp[i] = r->content_hashes && r->content_hashes[i] ? r->content_hashes[i] : "";
-    if ((rc = es__h5_append_rows(ctx, s->file, "/shapes/content_hash", t, n, tmp))) goto done;
+    if ((rc = es__h5_append_strs(ctx, s->file, "/shapes/content_hash", n, tmp))) goto done;
     for (int64_t c = 0; c < s->ncols; c++) {
         int64_t rc_col = -1;
         for (int64_t k = 0; k < r->ncols; k++)
             if (!strcmp(r->colnames[k], s->colnames[c])) rc_col = k;
         for (int64_t i = 0; i < n; i++)
             tmp[i] = rc_col >= 0 ? r->labels[i * r->ncols + rc_col] : "";
-        if ((rc = es__h5_append_rows(ctx, g, s->colnames[c], t, n, tmp))) goto done;
+        if ((rc = es__h5_append_strs(ctx, g, s->colnames[c], n, tmp))) goto done;
         for (int64_t i = 0; i < n; i++)
             if (!(s->labels[c][n0 + i] = es__strdup(ctx, tmp[i]))) { rc = ES_ENOMEM; goto done; }
     }
@@ -471,7 +445,6 @@ done:
     }
     es__free(ctx, tmp);
     es__h5_close(g);
-    es__h5_close(t);
     return rc;
 }
 
@@ -479,14 +452,14 @@ es_status es_store_append(es_ctx *ctx, es_store *store, const es_store_rows *row
 {
     es_status rc;
     if (!store || !rows) ES_FAIL(ctx, ES_EINVAL, "store: NULL argument to es_store_append");
-    H5E_BEGIN_TRY { rc = append_impl(ctx, store, rows, false); } H5E_END_TRY
+    ES__H5_QUIET(rc = append_impl(ctx, store, rows, false));
     return rc;
 }
 
 es_status es__store_append_written(es_ctx *ctx, es_store *s, const es_store_rows *r)
 {
     es_status rc;
-    H5E_BEGIN_TRY { rc = append_impl(ctx, s, r, true); } H5E_END_TRY
+    ES__H5_QUIET(rc = append_impl(ctx, s, r, true));
     return rc;
 }
 
@@ -494,20 +467,18 @@ es_status es__store_reserve_values(es_ctx *ctx, es_store *s, int64_t n)
 {
     es_status rc;
     if ((rc = es__store_begin_write(s))) return rc;
-    H5E_BEGIN_TRY {
-        if ((s->nedges > 0 &&
-             ((rc = es__h5_append_rows(ctx, s->file, "/shapes/lengths", H5T_NATIVE_DOUBLE, n,
-                                       NULL)) ||
-              (rc = es__h5_append_rows(ctx, s->file, "/shapes/scales", H5T_NATIVE_DOUBLE, n,
-                                       NULL)))) ||
-            (rc = es__h5_append_rows(ctx, s->file, "/shapes/positions", H5T_NATIVE_DOUBLE, n,
-                                     NULL)) ||
-            (s->nedges > 0 &&
-             ((rc = es__h5_allocate_rows(ctx, s->file, "/shapes/lengths", s->nrows, n)) ||
-              (rc = es__h5_allocate_rows(ctx, s->file, "/shapes/scales", s->nrows, n)))) ||
-            (rc = es__h5_allocate_rows(ctx, s->file, "/shapes/positions", s->nrows, n)))
-            s->broken = true;
-    } H5E_END_TRY
+    es__h5_quiet q;
+    es__h5_quiet_begin(&q);
+    if ((s->nedges > 0 &&
+         ((rc = es__h5_append_room(ctx, s->file, "/shapes/lengths", n)) ||
+          (rc = es__h5_append_room(ctx, s->file, "/shapes/scales", n)))) ||
+        (rc = es__h5_append_room(ctx, s->file, "/shapes/positions", n)) ||
+        (s->nedges > 0 &&
+         ((rc = es__h5_allocate_rows(ctx, s->file, "/shapes/lengths", s->nrows, n)) ||
+          (rc = es__h5_allocate_rows(ctx, s->file, "/shapes/scales", s->nrows, n)))) ||
+        (rc = es__h5_allocate_rows(ctx, s->file, "/shapes/positions", s->nrows, n)))
+        s->broken = true;
+    es__h5_quiet_end(&q);
     return rc;
 }
 

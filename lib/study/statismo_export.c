@@ -15,6 +15,7 @@
  * positions: its mean, tangent loadings and sdev^2 are the model as they
  * are. */
 #include "study/study_pkg.h"
+#include "edgespace/es_ingest.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -1,5 +1,5 @@
 /* tests/store/test_store_headers.c — object-header messages are checked
- * before HDF5 decodes them (lib/store/store_headers.c).
+ * before HDF5 decodes them (lib/h5/h5_headers.c).
  *
  * 1. The audit's store (issue 25): the base store with the version byte of
  *    /shapes/content_hash's layout message changed from 3 to 1 made libhdf5

@@ -1,5 +1,6 @@
 /* lib/include/edgespace/es_ingest.h — manifests, ingest and export: meshes
- * in correspondence (plus their labels) into an HDF5 store, and back out.
+ * in correspondence (plus their labels) into an HDF5 store, and back out;
+ * statismo shape models written and read (at the end).
  *
  * A manifest (datasets-spec/manifest-format.md) is a CSV file read with
  * libcsv: a header row with a `file` column (mesh paths relative to the
@@ -124,6 +125,67 @@ ES_API es_status es_export_lengths_csv(es_ctx *ctx, es_store *store, const int64
  * created, with any missing parents, if absent. */
 ES_API es_status es_export_meshes(es_ctx *ctx, es_store *store, const int64_t *rows,
                                   int64_t nrows, const char *dir, es_mesh_format format);
+
+/* ---- statismo shape models --------------------------------------------
+ * A linear shape model mean + sum_k b_k sqrt(variance_k) basis_k (b ~
+ * N(0, I)) over one triangle mesh, written in the statismo 0.9 HDF5 layout
+ * that statismo (StatisticalModel IO) and scalismo (StatismoIO) load:
+ * datasets-spec/statismo.md is the exact layout. Coordinates are
+ * vertex-interleaved (x0 y0 z0 x1 ...), as statismo's sample vectors are;
+ * they are stored in single precision, as statismo keeps them.
+ * es_study_export_statismo builds one from a stored PCA or GPA. */
+typedef struct es_statismo_model {
+    int64_t nverts, nfaces;
+    const int64_t *faces;      /* 3 x F, 0-based (the representer's cells) */
+    const double *mean;        /* 3 x V: the mean shape, also the representer's
+                                  reference mesh */
+    int64_t ncomp;             /* K >= 1 modes */
+    const double *basis;       /* 3V x K, column k = mode k (orthonormal columns) */
+    const double *variance;    /* K: variance along each mode */
+    double noise_variance;     /* the PPCA noise variance (>= 0) */
+    int64_t nscores;           /* samples with coefficients (0: none) */
+    const double *scores;      /* K x nscores: sample j's coefficients, in units of
+                                  each mode's standard deviation */
+    const char *builder;       /* modelinfo builder name (NULL: "edgespace") */
+    int64_t ndata, nparams;    /* key/value strings of the builder's dataInfo
+                                  and parameters groups */
+    const char *const *data_keys, *const *data_values;
+    const char *const *param_keys, *const *param_values;
+} es_statismo_model;
+
+/* Write m to path (replaced only once complete). ES_EINVAL on a model
+ * without vertices, faces or modes, a face index out of range, non-finite
+ * values or negative variances; ES_ERANGE beyond 2^31 vertices; ES_EEXIST
+ * if path is an HDF5 file that is not a statismo model (a store, say). */
+ES_API es_status es_statismo_write(es_ctx *ctx, const char *path, const es_statismo_model *m);
+/* ES_OK if path ends in ".h5", the only name scalismo opens a model by
+ * (StatisticalModelIOUtils); else ES_EINVAL naming the file to write
+ * instead ("model.hdf5" -> "model.h5"). es_statismo_write checks it. */
+ES_API es_status es_statismo_check_name(es_ctx *ctx, const char *path);
+
+/* A statismo model read back (es_statismo_read; owned, es_statismo_data_free):
+ * what edgespace, statismo or scalismo wrote, read as scalismo's
+ * StatismoIO.readStatismoPDM reads it. */
+typedef struct es_statismo_data {
+    es_ctx *ctx;
+    char dataset_type[32];     /* "POLYGON_MESH" or "POINT_SET" */
+    int major, minor;          /* the format version (0.8, 0.9 or 1.x) */
+    int64_t nverts, nfaces;    /* nfaces 0 for a point set */
+    int64_t *faces;            /* 3 x F (NULL for a point set) */
+    double *points;            /* 3 x V: the representer's reference points */
+    double *mean;              /* 3 x V: the model's mean, vertex-interleaved */
+    int64_t ncomp;
+    double *basis;             /* 3V x K, column k = mode k (unit; 0.8's scaled basis
+                                  divided by sqrt(variance) as scalismo does) */
+    double *variance;          /* K */
+    double noise_variance;
+} es_statismo_data;
+
+/* Read a statismo 3D shape model. ES_EFORMAT naming what is missing or
+ * inconsistent (no representer, an IMAGE or VOLUME_MESH model, sizes that
+ * disagree, a cell out of range, a non-finite value); ES_EIO if unreadable. */
+ES_API es_status es_statismo_read(es_ctx *ctx, const char *path, es_statismo_data **out);
+ES_API void es_statismo_data_free(es_statismo_data *m);
 
 #ifdef __cplusplus
 }

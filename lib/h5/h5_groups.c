@@ -1,4 +1,4 @@
-/* lib/store/store_groups.c — the groups of a store checked before HDF5
+/* lib/h5/h5_groups.c — the groups of a store checked before HDF5
  * looks a name up in them.
  *
  * An old-style HDF5 group (what every edgespace store, and h5py by default,
@@ -13,9 +13,9 @@
  * on the nodes, before HDF5 uses it (HDF5 File Format Specification 3.0,
  * III.A.1 B-trees, III.B symbol nodes, III.D local heaps, IV.A.2.r the
  * symbol table message). The messages of the group's own header are
- * checked by store_headers.c.
+ * checked by h5_headers.c.
  */
-#include "store/store_pkg.h"
+#include "h5/h5_pkg.h"
 
 enum { MAX_NODES = 100000, MAX_LEVEL = 32 };
 

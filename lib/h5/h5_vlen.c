@@ -1,4 +1,4 @@
-/* lib/store/store_vlen.c — variable-length strings read without trusting
+/* lib/h5/h5_vlen.c — variable-length strings read without trusting
  * the file: the store decodes HDF5's on-disk string descriptors and global
  * heap collections itself instead of calling H5Dread/H5Aread on them.
  *
@@ -19,7 +19,7 @@
  * pread() on HDF5's own descriptor of the file (the sec2 driver), after a
  * flush, so that what this handle wrote is seen too.
  */
-#include "store/store_pkg.h"
+#include "h5/h5_pkg.h"
 
 #include <errno.h>
 #include <stdlib.h>

@@ -1,4 +1,4 @@
-/* lib/store/statismo.c — a shape model written as a statismo file (format
+/* lib/ingest/statismo.c — a shape model written as a statismo file (format
  * 0.9, datasets-spec/statismo.md), the HDF5 layout that statismo's
  * StatisticalModel IO and scalismo's StatismoIO read.
  *
@@ -9,8 +9,12 @@
  * row-major as statismo's Eigen types are, strings are fixed-length and
  * NUL-terminated as statismo's HDF5Utils writes them, and the version and
  * noise variance are scalars. The file is written beside its name and
- * renamed over it only when complete. */
-#include "store/store_pkg.h"
+ * renamed over it only when complete. All of its HDF5 goes through lib/h5
+ * (h5/h5_private.h). */
+#include "core/core_private.h"
+#include "edgespace/es_ingest.h"
+#include "edgespace/es_store.h"
+#include "h5/h5_private.h"
 
 #include <float.h>
 #include <math.h>
@@ -21,74 +25,46 @@
 /* The statismo version of the layout below (/version). */
 enum { STATISMO_MAJOR = 0, STATISMO_MINOR = 9 };
 
-/* A fixed-length C string type of strlen(s) + 1 bytes (close it). */
-static hid_t fixed_str(const char *s)
+/* Strings are fixed-length and NUL-terminated (statismo's HDF5Utils). */
+static es_status put_str_attr(es_ctx *ctx, es__h5_id obj, const char *key, const char *v)
 {
-    hid_t t = H5Tcopy(H5T_C_S1);
-    if (t >= 0 && H5Tset_size(t, strlen(s) + 1) < 0) {
-        H5Tclose(t);
-        return -1;
-    }
-    return t;
+    if (es__h5_put_attr_cstr(obj, key, v) < 0)
+        return es__h5_fail(ctx, ES_EIO, "statismo: cannot write attribute '%s'", key);
+    return ES_OK;
 }
 
-static es_status put_str_attr(es_ctx *ctx, hid_t obj, const char *key, const char *v)
+static es_status put_str(es_ctx *ctx, es__h5_id loc, const char *name, const char *v)
 {
-    hid_t t = fixed_str(v), sp = H5Screate(H5S_SCALAR), a = -1;
-    es_status rc = ES_OK;
-    if (t < 0 || sp < 0 || (a = H5Acreate2(obj, key, t, sp, H5P_DEFAULT, H5P_DEFAULT)) < 0 ||
-        H5Awrite(a, t, v) < 0)
-        rc = es__h5_fail(ctx, ES_EIO, "statismo: cannot write attribute '%s'", key);
-    es__h5_close(a);
-    es__h5_close(sp);
-    es__h5_close(t);
-    return rc;
+    if (es__h5_put_cstr(loc, name, v) < 0)
+        return es__h5_fail(ctx, ES_EIO, "statismo: cannot write '%s'", name);
+    return ES_OK;
 }
 
-static es_status put_str(es_ctx *ctx, hid_t loc, const char *name, const char *v)
+/* A float32 (f) or int32 (i) dataset of rank 0 (dims NULL), 1 or 2,
+ * row-major. */
+static es_status put_data(es_ctx *ctx, es__h5_id loc, const char *name, int rank,
+                          const uint64_t *dims, const float *f, const int32_t *i)
 {
-    hid_t t = fixed_str(v), sp = H5Screate(H5S_SCALAR), d = -1;
-    es_status rc = ES_OK;
-    if (t < 0 || sp < 0 ||
-        (d = H5Dcreate2(loc, name, t, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) < 0 ||
-        H5Dwrite(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) < 0)
-        rc = es__h5_fail(ctx, ES_EIO, "statismo: cannot write '%s'", name);
-    es__h5_close(d);
-    es__h5_close(sp);
-    es__h5_close(t);
-    return rc;
-}
-
-/* A dataset of rank 0 (dims NULL), 1 or 2 in file type ftype from buf
- * (memory type mtype, row-major). */
-static es_status put_data(es_ctx *ctx, hid_t loc, const char *name, hid_t ftype, hid_t mtype,
-                          int rank, const hsize_t *dims, const void *buf)
-{
-    hid_t sp = rank ? H5Screate_simple(rank, dims, NULL) : H5Screate(H5S_SCALAR), d = -1;
-    es_status rc = ES_OK;
-    if (sp < 0 ||
-        (d = H5Dcreate2(loc, name, ftype, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) < 0 ||
-        H5Dwrite(d, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0)
-        rc = es__h5_fail(ctx, ES_EIO, "statismo: cannot write '%s'", name);
-    es__h5_close(d);
-    es__h5_close(sp);
-    return rc;
+    if ((f ? es__h5_put_f32(loc, name, rank, dims, f)
+           : es__h5_put_i32(loc, name, rank, dims, i)) < 0)
+        return es__h5_fail(ctx, ES_EIO, "statismo: cannot write '%s'", name);
+    return ES_OK;
 }
 
 /* rows x cols doubles, element (i, j) at src[i * rs + j * cs], as a
  * row-major float32 matrix (statismo's MatrixType); cols 0: a vector of
  * rows elements (VectorType). */
-static es_status put_matrix(es_ctx *ctx, hid_t loc, const char *name, int64_t rows,
+static es_status put_matrix(es_ctx *ctx, es__h5_id loc, const char *name, int64_t rows,
                             int64_t cols, const double *src, int64_t rs, int64_t cs)
 {
-    hsize_t dims[2] = {(hsize_t)rows, (hsize_t)cols};
+    const uint64_t dims[2] = {(uint64_t)rows, (uint64_t)cols};
     int64_t nc = cols > 0 ? cols : 1;
     float *buf = es__alloc_array(ctx, rows * nc, sizeof *buf);
     es_status rc;
     if (!buf) return ES_ENOMEM;
     for (int64_t i = 0; i < rows; i++)
         for (int64_t j = 0; j < nc; j++) buf[i * nc + j] = (float)src[i * rs + j * cs];
-    rc = put_data(ctx, loc, name, H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, cols > 0 ? 2 : 1, dims, buf);
+    rc = put_data(ctx, loc, name, cols > 0 ? 2 : 1, dims, buf, NULL);
     es__free(ctx, buf);
     return rc;
 }
@@ -131,10 +107,10 @@ static es_status check_model(es_ctx *ctx, const es_statismo_model *m)
  * or without faces as a point set (statismo's itkPointSetRepresenter:
  * datasetType POINT_SET and no cells, what scalismo's readStatismoPDM reads
  * as an UnstructuredPointsDomain). */
-static es_status put_representer(es_ctx *ctx, hid_t root, const es_statismo_model *m)
+static es_status put_representer(es_ctx *ctx, es__h5_id root, const es_statismo_model *m)
 {
-    hid_t g = H5Gcreate2(root, "representer", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), sub;
-    hsize_t dims[2] = {3, (hsize_t)m->nfaces};
+    es__h5_id g = es__h5_group_create(root, "representer", false), sub;
+    const uint64_t dims[2] = {3, (uint64_t)m->nfaces};
     int32_t *cells = NULL;
     es_status rc;
     if (g < 0) return es__h5_fail(ctx, ES_EIO, "statismo: cannot create /representer");
@@ -151,12 +127,12 @@ static es_status put_representer(es_ctx *ctx, hid_t root, const es_statismo_mode
     }
     for (int64_t f = 0; f < m->nfaces; f++)
         for (int c = 0; c < 3; c++) cells[c * m->nfaces + f] = (int32_t)m->faces[3 * f + c];
-    if ((rc = put_data(ctx, g, "cells", H5T_STD_I32LE, H5T_NATIVE_INT32, 2, dims, cells)))
+    if ((rc = put_data(ctx, g, "cells", 2, dims, NULL, cells)))
         goto done;
     /* statismo's mesh representers write (and may look for) these two */
     for (int i = 0; i < 2 && rc == ES_OK; i++) {
         const char *name = i ? "cellData" : "pointData";
-        if ((sub = H5Gcreate2(g, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) < 0)
+        if ((sub = es__h5_group_create(g, name, false)) < 0)
             rc = es__h5_fail(ctx, ES_EIO, "statismo: cannot create /representer/%s", name);
         es__h5_close(sub);
     }
@@ -168,9 +144,9 @@ done:
 
 /* /modelinfo: build time, scores (K x n, statismo's dummy 1 x 1 zero
  * without them) and one modelBuilder group with data info and parameters. */
-static es_status put_modelinfo(es_ctx *ctx, hid_t root, const es_statismo_model *m)
+static es_status put_modelinfo(es_ctx *ctx, es__h5_id root, const es_statismo_model *m)
 {
-    hid_t info = -1, b = -1, d = -1, p = -1;
+    es__h5_id info = -1, b = -1, d = -1, p = -1;
     char when[64];
     time_t now = time(NULL);
     struct tm tmv;
@@ -179,10 +155,10 @@ static es_status put_modelinfo(es_ctx *ctx, hid_t root, const es_statismo_model 
     /* statismo writes asctime(localtime()); UTC here so files do not
      * depend on the machine's zone */
     strftime(when, sizeof when, "%a %b %d %H:%M:%S %Y\n", gmtime_r(&now, &tmv));
-    if ((info = H5Gcreate2(root, "modelinfo", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) < 0 ||
-        (b = H5Gcreate2(info, "modelBuilder-0", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) < 0 ||
-        (d = H5Gcreate2(b, "dataInfo", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) < 0 ||
-        (p = H5Gcreate2(b, "parameters", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) < 0) {
+    if ((info = es__h5_group_create(root, "modelinfo", false)) < 0 ||
+        (b = es__h5_group_create(info, "modelBuilder-0", false)) < 0 ||
+        (d = es__h5_group_create(b, "dataInfo", false)) < 0 ||
+        (p = es__h5_group_create(b, "parameters", false)) < 0) {
         rc = es__h5_fail(ctx, ES_EIO, "statismo: cannot create /modelinfo");
         goto done;
     }
@@ -206,9 +182,9 @@ done:
     return rc;
 }
 
-static es_status put_model(es_ctx *ctx, hid_t root, const es_statismo_model *m)
+static es_status put_model(es_ctx *ctx, es__h5_id root, const es_statismo_model *m)
 {
-    hid_t g = H5Gcreate2(root, "model", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    es__h5_id g = es__h5_group_create(root, "model", false);
     float noise = (float)m->noise_variance;
     es_status rc;
     if (g < 0) return es__h5_fail(ctx, ES_EIO, "statismo: cannot create /model");
@@ -217,8 +193,7 @@ static es_status put_model(es_ctx *ctx, hid_t root, const es_statismo_model *m)
         !(rc = put_matrix(ctx, g, "pcaBasis", 3 * m->nverts, m->ncomp, m->basis, 1,
                           3 * m->nverts)) &&
         !(rc = put_matrix(ctx, g, "pcaVariance", m->ncomp, 0, m->variance, 1, 0)))
-        rc = put_data(ctx, g, "noiseVariance", H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, 0, NULL,
-                      &noise);
+        rc = put_data(ctx, g, "noiseVariance", 0, NULL, &noise, NULL);
     es__h5_close(g);
     return rc;
 }
@@ -243,12 +218,12 @@ es_status es_statismo_check_name(es_ctx *ctx, const char *path)
  * must not overwrite a store or another HDF5 file. */
 static es_status check_target(es_ctx *ctx, const char *path)
 {
-    hid_t f = -1;
-    htri_t is_model = 0;
+    es__h5_id f = -1;
+    int is_model = 0;
     if (!es_store_is_hdf5(path)) return ES_OK;
-    if ((f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT)) >= 0 &&
-        H5Lexists(f, "model", H5P_DEFAULT) > 0 && H5Lexists(f, "representer", H5P_DEFAULT) > 0)
-        is_model = H5Lexists(f, "model/pcaBasis", H5P_DEFAULT);
+    if ((f = es__h5_file_open_default(path)) >= 0 && es__h5_exists(f, "model") > 0 &&
+        es__h5_exists(f, "representer") > 0)
+        is_model = es__h5_exists(f, "model/pcaBasis");
     es__h5_close(f);
     if (is_model <= 0)
         ES_FAIL(ctx, ES_EEXIST, "statismo: refusing to overwrite '%s': an HDF5 file that is "
@@ -259,38 +234,32 @@ static es_status check_target(es_ctx *ctx, const char *path)
 es_status es_statismo_write(es_ctx *ctx, const char *path, const es_statismo_model *m)
 {
     es__file_replace w;
-    hid_t file = -1, fapl = -1, ver = -1;
+    es__h5_id file = -1, ver = -1;
     const int32_t major = STATISMO_MAJOR, minor = STATISMO_MINOR;
     es_status rc;
     if (!path || !*path) ES_FAIL(ctx, ES_EINVAL, "statismo: no output file");
     if ((rc = es_statismo_check_name(ctx, path)) != ES_OK || (rc = check_model(ctx, m)) != ES_OK)
         return rc;
-    H5E_BEGIN_TRY {
-        rc = check_target(ctx, path);
-    } H5E_END_TRY
+    ES__H5_QUIET(rc = check_target(ctx, path));
     if (rc != ES_OK) return rc;
     /* the part file stays empty on the FILE side; HDF5 writes it by name */
     if ((rc = es__replace_begin(ctx, path, &w)) != ES_OK) return rc;
-    H5E_BEGIN_TRY {
-        if ((fapl = es__h5_file_access()) < 0 ||
-            (file = H5Fcreate(w.tmp, H5F_ACC_TRUNC, H5P_DEFAULT, fapl)) < 0) {
-            rc = es__h5_fail(ctx, ES_EIO, "statismo: cannot create '%s'", path);
-        } else if ((ver = H5Gcreate2(file, "version", H5P_DEFAULT, H5P_DEFAULT,
-                                     H5P_DEFAULT)) < 0) {
-            rc = es__h5_fail(ctx, ES_EIO, "statismo: cannot create /version");
-        } else if (!(rc = put_data(ctx, ver, "majorVersion", H5T_STD_I32LE, H5T_NATIVE_INT32, 0,
-                                   NULL, &major)) &&
-                   !(rc = put_data(ctx, ver, "minorVersion", H5T_STD_I32LE, H5T_NATIVE_INT32,
-                                   0, NULL, &minor)) &&
-                   !(rc = put_representer(ctx, file, m)) && !(rc = put_model(ctx, file, m))) {
-            rc = put_modelinfo(ctx, file, m);
-        }
-        es__h5_close(ver);
-        /* the store's full-disk-safe close: a failed write or flush never
-         * reaches libhdf5's crash at exit */
-        if (es__h5_file_close(ctx, file, rc == ES_OK, path) != ES_OK && rc == ES_OK)
-            rc = es__fail(ctx, ES_EIO, "statismo: %s", es_ctx_errmsg(ctx));
-        es__h5_close(fapl);
-    } H5E_END_TRY
+    es__h5_quiet q;
+    es__h5_quiet_begin(&q);
+    if ((file = es__h5_file_create(w.tmp, true)) < 0) {
+        rc = es__h5_fail(ctx, ES_EIO, "statismo: cannot create '%s'", path);
+    } else if ((ver = es__h5_group_create(file, "version", false)) < 0) {
+        rc = es__h5_fail(ctx, ES_EIO, "statismo: cannot create /version");
+    } else if (!(rc = put_data(ctx, ver, "majorVersion", 0, NULL, NULL, &major)) &&
+               !(rc = put_data(ctx, ver, "minorVersion", 0, NULL, NULL, &minor)) &&
+               !(rc = put_representer(ctx, file, m)) && !(rc = put_model(ctx, file, m))) {
+        rc = put_modelinfo(ctx, file, m);
+    }
+    es__h5_close(ver);
+    /* the full-disk-safe close of lib/h5: a failed write or flush never
+     * reaches libhdf5's crash at exit */
+    if (es__h5_file_close(ctx, file, rc == ES_OK, path) != ES_OK && rc == ES_OK)
+        rc = es__fail(ctx, ES_EIO, "statismo: %s", es_ctx_errmsg(ctx));
+    es__h5_quiet_end(&q);
     return es__replace_end(ctx, &w, rc);
 }

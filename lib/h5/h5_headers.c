@@ -1,4 +1,4 @@
-/* lib/store/store_headers.c — every message of an object header checked
+/* lib/h5/h5_headers.c — every message of an object header checked
  * before HDF5 decodes any of it.
  *
  * Why: libhdf5 1.10 (Debian 12) decodes what an object header says with
@@ -16,7 +16,7 @@
  * Fletcher-32) is refused by name. The object's address comes from its
  * link, so HDF5 has not even loaded the header when it is checked.
  */
-#include "store/store_pkg.h"
+#include "h5/h5_pkg.h"
 
 #include <errno.h>
 #include <fcntl.h>

@@ -1,4 +1,4 @@
-/* lib/store/statismo_read.c — a statismo shape model read back
+/* lib/ingest/statismo_read.c — a statismo shape model read back
  * (datasets-spec/statismo.md): what edgespace, statismo or scalismo wrote,
  * so that its mean and modes can be embedded, projected or compared with a
  * study's own.
@@ -10,39 +10,45 @@
  * stored the basis scaled by sqrt(variance), which is undone as scalismo
  * undoes it. HDF5 converts whatever numeric type the file holds (statismo:
  * float32) to double. String attributes are read by the store's own
- * decoder (es__h5_read_attr_text), which checks the heap libhdf5 trusts. */
-#include "store/store_pkg.h"
+ * decoder (es__h5_read_attr_text), which checks the heap libhdf5 trusts.
+ * All of its HDF5 goes through lib/h5 (h5/h5_private.h). */
+#include "core/core_private.h"
+#include "edgespace/es_ingest.h"
+#include "edgespace/es_store.h"
+#include "h5/h5_private.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* Dataset `name` of rank 1 or 2 (dims[1] = 1 for rank 1) as doubles or
- * int64 (mtype), allocated into *out. */
-static es_status read_numeric(es_ctx *ctx, hid_t file, const char *path, const char *name,
-                              hid_t mtype, size_t elem, int64_t dims[2], void **out)
+/* Dataset `name` of rank 1 or 2 (dims[1] = 1 for rank 1) as doubles (f64)
+ * or int64, allocated into *out. */
+static es_status read_numeric(es_ctx *ctx, es__h5_id file, const char *path, const char *name,
+                              bool f64, int64_t dims[2], void **out)
 {
-    hid_t d = -1, sp = -1;
-    hsize_t hd[2] = {0, 1};
-    int rank;
+    const size_t elem = f64 ? sizeof(double) : sizeof(int64_t);
+    es__h5_id d = -1;
+    es__h5_info in;
+    uint64_t hd[2] = {0, 1};
     es_status rc = ES_OK;
     *out = NULL;
     es__h5_raw *raw = NULL;
-    if (H5Lexists(file, name, H5P_DEFAULT) <= 0)
+    if (es__h5_exists(file, name) <= 0)
         ES_FAIL(ctx, ES_EFORMAT, "statismo: '%s' has no %s: not a statismo model", path, name);
     /* a model file is input from elsewhere: its header is checked before
-     * libhdf5 decodes it, as a store's is (store_headers.c) */
+     * libhdf5 decodes it, as a store's is (h5_headers.c) */
     if ((rc = es__h5_raw_open(ctx, file, path, &raw)) == ES_OK)
         rc = es__h5_check_named(raw, file, name);
     es__h5_raw_close(raw);
     if (rc != ES_OK) return rc;
-    if ((d = H5Dopen2(file, name, H5P_DEFAULT)) < 0 || (sp = H5Dget_space(d)) < 0 ||
-        (rank = H5Sget_simple_extent_ndims(sp)) < 1 || rank > 2 ||
-        H5Sget_simple_extent_dims(sp, hd, NULL) < 0) {
+    if ((d = es__h5_dataset_open(file, name)) < 0 || es__h5_dataset_info(d, &in) < 0 ||
+        in.rank < 1 || in.rank > 2) {
         rc = es__h5_fail(ctx, ES_EFORMAT, "statismo: '%s': %s is not a vector or matrix", path,
                          name);
         goto done;
     }
+    hd[0] = in.dims[0];
+    if (in.rank == 2) hd[1] = in.dims[1];
     if (hd[0] > INT32_MAX || hd[1] > INT32_MAX || hd[0] * hd[1] == 0) {
         rc = es__fail(ctx, ES_EFORMAT, "statismo: '%s': %s is %llu x %llu", path, name,
                       (unsigned long long)hd[0], (unsigned long long)hd[1]);
@@ -55,11 +61,10 @@ static es_status read_numeric(es_ctx *ctx, hid_t file, const char *path, const c
         rc = ES_ENOMEM;
         goto done;
     }
-    if (H5Dread(d, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, *out) < 0)
+    if ((f64 ? es__h5_dataset_read_f64(d, *out) : es__h5_dataset_read_i64(d, *out)) < 0)
         rc = es__h5_fail(ctx, ES_EFORMAT, "statismo: '%s': cannot read %s as numbers", path,
                          name);
 done:
-    es__h5_close(sp);
     es__h5_close(d);
     if (rc != ES_OK) {
         es__free(ctx, *out);
@@ -68,26 +73,26 @@ done:
     return rc;
 }
 
-/* One number `name` (a dataset of exactly one element) as mtype into *v;
+/* One number `name` (a dataset of exactly one element) into *i or *f;
  * ES_ENOTFOUND when absent or not one number. Its header is checked first,
- * and the element count, so a dataset of many numbers cannot overrun v. */
-static es_status read_scalar(es_ctx *ctx, hid_t file, const char *path, const char *name,
-                             hid_t mtype, void *v)
+ * and the element count, so a dataset of many numbers cannot overrun it. */
+static es_status read_scalar(es_ctx *ctx, es__h5_id file, const char *path, const char *name,
+                             int *i, double *f)
 {
     es__h5_raw *raw = NULL;
-    hid_t d = -1, sp = -1;
+    es__h5_id d = -1;
+    es__h5_info in;
     es_status rc;
-    if (H5Lexists(file, name, H5P_DEFAULT) <= 0) return ES_ENOTFOUND;
+    if (es__h5_exists(file, name) <= 0) return ES_ENOTFOUND;
     if ((rc = es__h5_raw_open(ctx, file, path, &raw)) == ES_OK)
         rc = es__h5_check_named(raw, file, name);
     es__h5_raw_close(raw);
     if (rc != ES_OK) return rc;
     rc = ES_ENOTFOUND;
-    if ((d = H5Dopen2(file, name, H5P_DEFAULT)) >= 0 && (sp = H5Dget_space(d)) >= 0 &&
-        H5Sget_simple_extent_npoints(sp) == 1 &&
-        H5Dread(d, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) >= 0)
+    if ((d = es__h5_dataset_open(file, name)) >= 0 && es__h5_dataset_info(d, &in) >= 0 &&
+        in.npoints == 1 &&
+        (i ? es__h5_dataset_read_int(d, i) : es__h5_dataset_read_f64(d, f)) >= 0)
         rc = ES_OK;
-    es__h5_close(sp);
     es__h5_close(d);
     return rc;
 }
@@ -96,7 +101,7 @@ static es_status read_scalar(es_ctx *ctx, hid_t file, const char *path, const ch
  * /representer, /model, /version), each header and symbol table checked
  * before HDF5 searches or opens it, as a store's are (store_load.c): a model
  * file comes from elsewhere, and libhdf5 1.10 trusts what it says. */
-static es_status check_groups(es_ctx *ctx, hid_t file, const char *path)
+static es_status check_groups(es_ctx *ctx, es__h5_id file, const char *path)
 {
     static const char *const names[] = {"representer", "model", "version"};
     es__h5_raw *raw = NULL;
@@ -107,14 +112,14 @@ static es_status check_groups(es_ctx *ctx, hid_t file, const char *path)
 }
 
 /* The representer's datasetType (and name), read as scalismo does. */
-static es_status read_kind(es_ctx *ctx, hid_t file, const char *path, es_statismo_data *m)
+static es_status read_kind(es_ctx *ctx, es__h5_id file, const char *path, es_statismo_data *m)
 {
     es__h5_raw *raw = NULL;
-    hid_t g = -1;
+    es__h5_id g = -1;
     char name[64] = "";
     es_status rc;
-    if (H5Lexists(file, "representer", H5P_DEFAULT) <= 0 ||
-        (g = H5Gopen2(file, "representer", H5P_DEFAULT)) < 0)
+    if (es__h5_exists(file, "representer") <= 0 ||
+        (g = es__h5_group_open(file, "representer")) < 0)
         ES_FAIL(ctx, ES_EFORMAT, "statismo: '%s' has no /representer: not a statismo model",
                 path);
     if ((rc = es__h5_raw_open(ctx, g, path, &raw)) == ES_OK &&
@@ -136,7 +141,7 @@ static es_status read_kind(es_ctx *ctx, hid_t file, const char *path, es_statism
     return ES_OK;
 }
 
-static es_status read_impl(es_ctx *ctx, hid_t file, const char *path, es_statismo_data *m)
+static es_status read_impl(es_ctx *ctx, es__h5_id file, const char *path, es_statismo_data *m)
 {
     int64_t dm[2], db[2], dv[2], dp[2], dc[2];
     double *basis = NULL, *pts = NULL;
@@ -144,9 +149,8 @@ static es_status read_impl(es_ctx *ctx, hid_t file, const char *path, es_statism
     es_status rc;
     if ((rc = check_groups(ctx, file, path)) != ES_OK) return rc;
     if ((rc = read_kind(ctx, file, path, m)) != ES_OK) return rc;
-    if ((rc = read_scalar(ctx, file, path, "version/majorVersion", H5T_NATIVE_INT,
-                          &m->major)) == ES_OK)
-        rc = read_scalar(ctx, file, path, "version/minorVersion", H5T_NATIVE_INT, &m->minor);
+    if ((rc = read_scalar(ctx, file, path, "version/majorVersion", &m->major, NULL)) == ES_OK)
+        rc = read_scalar(ctx, file, path, "version/minorVersion", &m->minor, NULL);
     if (rc != ES_OK && rc != ES_ENOTFOUND) return rc;
     if (rc != ES_OK)
         ES_FAIL(ctx, ES_EFORMAT, "statismo: '%s' has no /version/majorVersion and minorVersion",
@@ -154,14 +158,12 @@ static es_status read_impl(es_ctx *ctx, hid_t file, const char *path, es_statism
     if (!(m->major == 1 || (m->major == 0 && (m->minor == 8 || m->minor == 9))))
         ES_FAIL(ctx, ES_EFORMAT, "statismo: '%s' is format %d.%d; 0.8, 0.9 and 1.x are read",
                 path, m->major, m->minor);
-    if ((rc = read_numeric(ctx, file, path, "model/mean", H5T_NATIVE_DOUBLE, sizeof(double), dm,
-                           (void **)&m->mean)) != ES_OK ||
-        (rc = read_numeric(ctx, file, path, "model/pcaBasis", H5T_NATIVE_DOUBLE, sizeof(double),
-                           db, (void **)&basis)) != ES_OK ||
-        (rc = read_numeric(ctx, file, path, "model/pcaVariance", H5T_NATIVE_DOUBLE,
-                           sizeof(double), dv, (void **)&m->variance)) != ES_OK ||
-        (rc = read_numeric(ctx, file, path, "representer/points", H5T_NATIVE_DOUBLE,
-                           sizeof(double), dp, (void **)&pts)) != ES_OK)
+    if ((rc = read_numeric(ctx, file, path, "model/mean", true, dm, (void **)&m->mean)) != ES_OK ||
+        (rc = read_numeric(ctx, file, path, "model/pcaBasis", true, db, (void **)&basis)) ||
+        (rc = read_numeric(ctx, file, path, "model/pcaVariance", true, dv,
+                           (void **)&m->variance)) != ES_OK ||
+        (rc = read_numeric(ctx, file, path, "representer/points", true, dp,
+                           (void **)&pts)) != ES_OK)
         goto done;
     m->nverts = dp[1];
     m->ncomp = db[1];
@@ -194,14 +196,13 @@ static es_status read_impl(es_ctx *ctx, hid_t file, const char *path, es_statism
         if (m->major == 0 && m->minor == 8)   /* stored U sqrt(variance): as scalismo undoes it */
             for (int64_t r = 0; r < db[0]; r++) m->basis[r + k * db[0]] *= sd > 1e-8 ? 1 / sd : 0;
     }
-    rc = read_scalar(ctx, file, path, "model/noiseVariance", H5T_NATIVE_DOUBLE,
-                     &m->noise_variance);
+    rc = read_scalar(ctx, file, path, "model/noiseVariance", NULL, &m->noise_variance);
     if (rc != ES_OK && rc != ES_ENOTFOUND) goto done;
     if (rc != ES_OK) m->noise_variance = 0;   /* optional: absent means none */
     rc = ES_OK;
     if (!strcmp(m->dataset_type, "POLYGON_MESH")) {
-        if ((rc = read_numeric(ctx, file, path, "representer/cells", H5T_NATIVE_INT64,
-                               sizeof(int64_t), dc, (void **)&cells)) != ES_OK)
+        if ((rc = read_numeric(ctx, file, path, "representer/cells", false, dc,
+                               (void **)&cells)) != ES_OK)
             goto done;
         if (dc[0] != 3) {
             rc = es__fail(ctx, ES_EFORMAT, "statismo: '%s': cells are %lld x %lld, not "
@@ -247,7 +248,7 @@ done:
 es_status es_statismo_read(es_ctx *ctx, const char *path, es_statismo_data **out)
 {
     es_statismo_data *m;
-    hid_t file = -1, fapl = -1;
+    es__h5_id file = -1;
     es_status rc;
     if (!path || !out) ES_FAIL(ctx, ES_EINVAL, "statismo: NULL argument");
     *out = NULL;
@@ -256,15 +257,14 @@ es_status es_statismo_read(es_ctx *ctx, const char *path, es_statismo_data **out
     if ((rc = es__h5_check_file(ctx, path)) != ES_OK) return rc;
     if (!(m = es__calloc(ctx, 1, sizeof *m))) return ES_ENOMEM;
     m->ctx = ctx;
-    H5E_BEGIN_TRY {
-        if ((fapl = es__h5_file_access()) < 0 ||
-            (file = H5Fopen(path, H5F_ACC_RDONLY, fapl)) < 0)
-            rc = es__h5_fail(ctx, ES_EIO, "statismo: cannot open '%s'", path);
-        else
-            rc = read_impl(ctx, file, path, m);
-        es__h5_close(file);
-        es__h5_close(fapl);
-    } H5E_END_TRY
+    es__h5_quiet q;
+    es__h5_quiet_begin(&q);
+    if ((file = es__h5_file_open(path, false)) < 0)
+        rc = es__h5_fail(ctx, ES_EIO, "statismo: cannot open '%s'", path);
+    else
+        rc = read_impl(ctx, file, path, m);
+    es__h5_close(file);
+    es__h5_quiet_end(&q);
     if (rc != ES_OK) {
         es_statismo_data_free(m);
         return rc;
