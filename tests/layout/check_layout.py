@@ -19,6 +19,10 @@ from the sources on every test run:
      module owns (FAMILIES: the module's name, the types it defines, a few
      words such as es_bbox_), no family owned by two modules, and it is
      declared in a public header of that module (es_core.h states the rule).
+  8. lib/README.md's module table is true: one row per module folder, in the
+     data flow's order; each row's "foreign library" cell names exactly the
+     foreign libraries its files include (README_LIBS), and its "may call"
+     cell every module its files include;
 
 Usage: check_layout.py SOURCE_ROOT. Prints every violation; exit 1 if any.
 """
@@ -65,6 +69,14 @@ FAMILIES = {
     "figure": {"colormap", "figure", "heatmap", "histogram", "lines", "palette", "plot",
                "render", "scatter", "scree"},
     "synth": {"synth"},
+}
+# lib/README.md's names of the foreign libraries -> the headers that mean
+# the module uses them
+README_LIBS = {
+    "libcsv": re.compile(r"^csv\.h$"), "Open MPI": re.compile(r"^mpi\.h$"),
+    "HDF5": re.compile(r"^(hdf5|H5[A-Za-z]*)\.h$"), "CHOLMOD": re.compile(r"^cholmod[a-z_]*\.h$"),
+    "OpenMP": re.compile(r"^omp\.h$"), "LAPACKE": re.compile(r"^lapacke[a-z_]*\.h$"),
+    "BLAS": re.compile(r"^cblas[a-z_]*\.h$"), "cairo": re.compile(r"^cairo[a-z-]*\.h$"),
 }
 PUBLIC_FN = re.compile(r"ES_API\s+[^;(]*?\b(es_[a-z0-9_]+)\s*\(", re.S)
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]', re.M)
@@ -184,6 +196,7 @@ def main(root):
                         errors.append(f"{shown}: includes the private header {inc}")
 
     errors += public_name_errors(root)
+    errors += readme_table_errors(root)
 
     # no circles in the include graph (depth-first search)
     state = {}
@@ -237,6 +250,73 @@ def public_name_errors(root):
     return errors
 
 
+def readme_table_errors(root):
+    """Rule 8: lib/README.md's module table against the sources."""
+    errors, rows = [], []
+    lib = os.path.join(root, "lib")
+    readme = os.path.join(lib, "README.md")
+    if not os.path.isfile(readme):
+        return ["lib/README.md: missing"]
+    with open(readme, encoding="utf-8") as f:
+        for line in f:
+            cells = [c.strip() for c in line.strip().strip("|").split("|")]
+            m = re.match(r"^`([a-z0-9]+)/`$", cells[0]) if len(cells) == 4 else None
+            if m:
+                rows.append((m.group(1), cells[2], cells[3]))
+    mods = [m for m, _, _ in rows]
+    folders = sorted(d for d in os.listdir(lib) if os.path.isdir(os.path.join(lib, d))
+                     and d != "include")
+    for d in folders:
+        if d not in mods:
+            errors.append(f"lib/README.md: no row for lib/{d}/")
+    for m in mods:
+        if m not in LEVEL:
+            errors.append(f"lib/README.md: row {m}/ is no module of the data flow")
+    if [m for m in mods if m in LEVEL] != [m for m in ORDER if m in mods]:
+        errors.append("lib/README.md: the rows are not in the data flow's order: " +
+                      " ".join(mods))
+    for mod, may, foreign in rows:
+        if mod not in LEVEL:
+            continue
+        above = [m for m in ORDER if LEVEL[m] < LEVEL[mod]]
+        text = re.sub(r"\([^)]*\)", "", may)        # "(its SPD sets)": prose
+        if text.strip() in ("—", "-", ""):
+            allowed = set()
+        elif "all of the above" in text:
+            allowed = set(above)
+        elif "…" in text:
+            lo, hi = [t.strip(" ,") for t in text.split("…")]
+            allowed = {m for m in ORDER if LEVEL[lo] <= LEVEL[m] <= LEVEL[hi]}
+        else:
+            allowed = {t.strip() for t in text.split(",") if t.strip()}
+        for m in sorted(allowed - set(LEVEL)):
+            errors.append(f"lib/README.md: {mod}/ may call '{m}', which is no module")
+        named = {name for name in README_LIBS if re.search(r"\b" + re.escape(name) + r"\b", foreign)}
+        used, calls = set(), set()
+        folder = os.path.join(lib, mod)
+        for name in sorted(os.listdir(folder)) if os.path.isdir(folder) else []:
+            if not name.endswith((".c", ".h")):
+                continue
+            for kind, inc in includes(os.path.join(folder, name)):
+                base = os.path.basename(inc)
+                for lname, pat in README_LIBS.items():
+                    if kind == "<" and pat.match(base):
+                        used.add(lname)
+                if kind == '"':
+                    tmod = PUBLIC.get(base) if inc.startswith("edgespace/") else inc.split("/")[0]
+                    if tmod in LEVEL and tmod != mod:
+                        calls.add(tmod)
+        for lname in sorted(used - named):
+            errors.append(f"lib/README.md: {mod}/ includes {lname}'s headers, which its row "
+                          f"does not name")
+        for lname in sorted(named - used):
+            errors.append(f"lib/README.md: {mod}/'s row names {lname}, which it does not include")
+        for m in sorted(calls - allowed):
+            errors.append(f"lib/README.md: {mod}/ includes {m}/, which its row's 'may call' "
+                          f"does not name")
+    return errors
+
+
 def self_test():
     """The checker finds each kind of violation in a small made-up tree."""
     import tempfile
@@ -256,6 +336,8 @@ def self_test():
         put("lib/mesh/x.h", '#include "mesh/y.h"\n')
         put("lib/mesh/y.h", '#include "mesh/x.h"\n')                          # circle
         put("lib/mesh/big.c", "x\n" * (LIB_MAX + 1))
+        put("lib/README.md", "| module | owns | may call | foreign library |\n|---|---|---|---|\n"
+            "| `core/` | c | — | — |\n| `embed/` | e | core | LAPACKE |\n")
         put("tools/cmd/c.c", '#include "core/core_private.h"\n' + "x\n" * CMD_MAX)
         import io
         import contextlib
@@ -268,7 +350,10 @@ def self_test():
                 "es_store.h of store", "include circle", "big.c: 801 lines",
                 "private core/core_private.h", "c.c: 251 lines",
                 "es_store_rows_of is declared in a header of stats, but es_store_ is store's",
-                "es_wobble_x: es_wobble_ is no module's family"]
+                "es_wobble_x: es_wobble_ is no module's family",
+                "core/ includes cairo's headers, which its row does not name",
+                "embed/'s row names LAPACKE, which it does not include",
+                "no row for lib/mesh/"]
         missing = [w for w in want if w not in text]
         if rc != 1 or missing:
             print(text)
