@@ -108,15 +108,18 @@ void es__file_set_clear(es_ctx *ctx, es__file_set *set);
  * ES_ENOMEM leaves both as they were. */
 es_status es__file_set_move(es_ctx *ctx, es__file_set *into, es_ctx *from_ctx,
                             es__file_set *from);
-/* The base name of a temporary sibling: base itself, or, when base plus
- * `extra` bytes of suffix would pass NAME_MAX (255), its first 120 bytes (at
- * a UTF-8 boundary), '~' and 16 hex digits of its FNV-1a hash: a store or
- * output named with 230 bytes could not be written. out: NAME_MAX + 1. */
-void es__short_base(const char *base, size_t extra, char *out, size_t n);
-/* Remove the entries of path's folder named prefix, a pid, '.' or '-',
- * ..., suffix, whose process is gone (a killed writer's part files and
- * working copies). */
-void es__remove_stale(const char *path, const char *prefix, const char *suffix);
+/* Temporary siblings, named in one place (file_replace.c): a part file
+ * (es__replace_begin's) or a working copy (the store's, published by its
+ * commit). es__temp_sibling: the name beside path for this process, with
+ * unique ("" or what keeps two of one process apart) in it; path's base is
+ * shortened when the name would pass NAME_MAX (255): its first 120 bytes
+ * (at a UTF-8 boundary), '~' and 16 hex digits of its FNV-1a hash, as a
+ * store or output named with 230 bytes could not be written. NULL:
+ * ES_ENOMEM. es__temp_clean_stale removes path's siblings of that kind
+ * whose process is gone (a killed writer's). */
+typedef enum { ES__TEMP_PART, ES__TEMP_WORKING_COPY } es__temp_kind;
+char *es__temp_sibling(es_ctx *ctx, const char *path, es__temp_kind kind, const char *unique);
+void es__temp_clean_stale(const char *path, es__temp_kind kind);
 char *es__strdup(es_ctx *ctx, const char *s);
 
 /* The k-th smallest (0-based) of a[0..n-1], k < n, NaN-free; reorders a

@@ -22,7 +22,7 @@
 #define NAME_MAX 255
 #endif
 
-void es__short_base(const char *base, size_t extra, char *out, size_t n)
+static void short_base(const char *base, size_t extra, char *out, size_t n)
 {
     size_t len = strlen(base), keep;
     if (len + extra <= NAME_MAX) {
@@ -38,7 +38,7 @@ void es__short_base(const char *base, size_t extra, char *out, size_t n)
 
 /* kill(pid, 0) failing with ESRCH is the only proof that the writer is
  * gone: EPERM means alive under another user, so its file is kept. */
-void es__remove_stale(const char *path, const char *prefix, const char *suffix)
+static void remove_stale(const char *path, const char *prefix, const char *suffix)
 {
     char dirbuf[4096];
     const char *base = es__path_base(path);
@@ -68,6 +68,43 @@ void es__remove_stale(const char *path, const char *prefix, const char *suffix)
     closedir(d);
 }
 
+/* The one naming scheme of temporary siblings. A part file (one writer's
+ * file, renamed over its target): "<base>.<pid><unique>.part", the base
+ * shortened for 24 bytes of suffix; a working copy (a store's, or a result
+ * file's beside it, published by the store's commit): ".<base>.tmp-<pid>-
+ * <unique>", hidden, the base shortened for 56 bytes. The pid first in
+ * both, so that the next writer removes what a dead process left. */
+static void temp_affixes(const char *path, es__temp_kind kind, char *lead, size_t n,
+                         const char **tail)
+{
+    char sb[NAME_MAX + 1];
+    short_base(es__path_base(path), kind == ES__TEMP_PART ? 24 : 56, sb, sizeof sb);
+    snprintf(lead, n, kind == ES__TEMP_PART ? "%s." : ".%s.tmp-", sb);
+    *tail = kind == ES__TEMP_PART ? ".part" : "";
+}
+
+char *es__temp_sibling(es_ctx *ctx, const char *path, es__temp_kind kind, const char *unique)
+{
+    char lead[NAME_MAX + 16];
+    const char *tail;
+    size_t dn = (size_t)(es__path_base(path) - path), n;
+    char *t;
+    temp_affixes(path, kind, lead, sizeof lead, &tail);
+    n = dn + strlen(lead) + strlen(unique) + 48;
+    if ((t = es__malloc(ctx, n)))
+        snprintf(t, n, "%.*s%s%ld%s%s%s", (int)dn, path, lead, (long)getpid(),
+                 kind == ES__TEMP_PART ? "" : "-", unique, tail);
+    return t;
+}
+
+void es__temp_clean_stale(const char *path, es__temp_kind kind)
+{
+    char lead[NAME_MAX + 16];
+    const char *tail;
+    temp_affixes(path, kind, lead, sizeof lead, &tail);
+    remove_stale(path, lead, tail);
+}
+
 /* The part file is made beside the file that path names (through a
  * symlink: beside its target, which is what gets replaced), with the mode
  * of a file already there: "<base>.<pid>[.<n>].part", the base shortened
@@ -81,8 +118,6 @@ es_status es__replace_begin(es_ctx *ctx, const char *path, es__file_replace *w)
     struct stat st;
     int have = 0;
     const char *t;
-    char sb[NAME_MAX + 1], lead[NAME_MAX + 2];
-    size_t dn;
     memset(w, 0, sizeof *w);
     w->path = path;
     if (lstat(path, &st) == 0 && S_ISLNK(st.st_mode)) w->target = realpath(path, NULL);
@@ -104,18 +139,16 @@ es_status es__replace_begin(es_ctx *ctx, const char *path, es__file_replace *w)
                 S_ISDIR(st.st_mode) ? strerror(EISDIR) : "not a regular file, pipe or "
                 "character device");
     }
-    es__short_base(es__path_base(t), 24, sb, sizeof sb);
-    snprintf(lead, sizeof lead, "%s.", sb);
-    es__remove_stale(t, lead, ".part");
-    dn = (size_t)(es__path_base(t) - t);
-    if (!(w->tmp = es__malloc(ctx, dn + strlen(sb) + 48))) {
-        free(w->target);
-        w->target = NULL;
-        return ES_ENOMEM;
-    }
+    es__temp_clean_stale(t, ES__TEMP_PART);
     for (unsigned n = 0;; n++) {
-        sprintf(w->tmp, n ? "%.*s%s.%ld.%u.part" : "%.*s%s.%ld.part", (int)dn, t, sb,
-                (long)getpid(), n);
+        char unique[16] = "";
+        if (n) snprintf(unique, sizeof unique, ".%u", n);
+        es__free(ctx, w->tmp);
+        if (!(w->tmp = es__temp_sibling(ctx, t, ES__TEMP_PART, unique))) {
+            free(w->target);
+            memset(w, 0, sizeof *w);
+            return ES_ENOMEM;
+        }
         if ((w->f = fopen(w->tmp, "wbx"))) break;
         if (errno != EEXIST || n == 99) {
             es_status rc = es__fail(ctx, ES_EIO, "cannot create '%s': %s", w->tmp,

@@ -41,13 +41,7 @@
 /* Working copies are ".<base>.tmp-<pid>-<unique>" (the base shortened when
  * long: core/file_replace.c): the next writer removes those whose process
  * is gone. */
-void es__store_clean_stale(const char *path)
-{
-    char sb[NAME_MAX + 1], prefix[NAME_MAX + 8];
-    es__short_base(es__path_base(path), 56, sb, sizeof sb);
-    snprintf(prefix, sizeof prefix, ".%s.tmp-", sb);
-    es__remove_stale(path, prefix, "");
-}
+void es__store_clean_stale(const char *path) { es__temp_clean_stale(path, ES__TEMP_WORKING_COPY); }
 
 /* The file the store's writes replace: the path given, or through a
  * symbolic link its target (a commit renames over the target and keeps the
@@ -60,17 +54,13 @@ static const char *target_of(const es_store *s) { return es__store_target(s); }
  * copy of a store, a result file being written beside it. */
 char *es__store_temp_for(es_store *s, const char *path)
 {
-    const char *tp = path, *base = es__path_base(tp);
-    size_t dn = (size_t)(base - tp), n = strlen(tp) + 64;
-    char sb[NAME_MAX + 1], *t = es__malloc(s->ctx, n);
+    char unique[64];
     struct timespec ts;
     clock_gettime(CLOCK_REALTIME, &ts);
-    es__short_base(base, 56, sb, sizeof sb);
-    /* pid first (stale copies are recognized by it), then enough to keep
-     * two handles of one process apart. */
-    if (t) snprintf(t, n, "%.*s.%s.tmp-%ld-%lx%lx%u", (int)dn, tp, sb, (long)getpid(),
-                    (unsigned long)(uintptr_t)s, (unsigned long)ts.tv_nsec, s->tmp_counter++);
-    return t;
+    /* what keeps two handles of one process apart */
+    snprintf(unique, sizeof unique, "%lx%lx%u", (unsigned long)(uintptr_t)s,
+             (unsigned long)ts.tv_nsec, s->tmp_counter++);
+    return es__temp_sibling(s->ctx, path, ES__TEMP_WORKING_COPY, unique);
 }
 
 char *es__store_temp_name(es_store *s) { return es__store_temp_for(s, target_of(s)); }

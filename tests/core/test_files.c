@@ -325,17 +325,27 @@ static void test_stale_and_long_names(es_ctx *ctx)
     ES_CHECK_OK(ctx, es__replace_end(ctx, &w, ES_OK));
     ES_CHECK(access(path, F_OK) == 0 && es_test_count_entries(dir, ".part") == 0);
     remove(path);
-    /* two long names that share their first 120 bytes get two part names */
+    /* two long names that share their first 120 bytes get two part names,
+     * each within NAME_MAX; a short name is kept; the two kinds of sibling */
     {
-        char a[300], b[300];
+        char want[300];
         memset(name, 'n', 250);
         name[250] = '\0';
-        es__short_base(name, 24, a, sizeof a);
+        char *a = es__temp_sibling(ctx, name, ES__TEMP_PART, "");
         name[249] = 'm';
-        es__short_base(name, 24, b, sizeof b);
-        ES_CHECK(strlen(a) == 137 && strcmp(a, b) != 0);
-        es__short_base("short.h5", 24, a, sizeof a);
-        ES_CHECK(!strcmp(a, "short.h5"));
+        char *b = es__temp_sibling(ctx, name, ES__TEMP_PART, "");
+        ES_CHECK(a && b && strcmp(a, b) != 0 && strlen(a) <= 255 && strstr(a, "~"));
+        ES_CHECK(a && !strncmp(a, name, 120) && a[120] == '~');
+        es__free(ctx, a);
+        es__free(ctx, b);
+        a = es__temp_sibling(ctx, "d/short.h5", ES__TEMP_PART, ".2");
+        snprintf(want, sizeof want, "d/short.h5.%ld.2.part", (long)getpid());
+        ES_CHECK(a && !strcmp(a, want));
+        es__free(ctx, a);
+        a = es__temp_sibling(ctx, "d/short.h5", ES__TEMP_WORKING_COPY, "ab1");
+        snprintf(want, sizeof want, "d/.short.h5.tmp-%ld-ab1", (long)getpid());
+        ES_CHECK(a && !strcmp(a, want));
+        es__free(ctx, a);
     }
 }
 

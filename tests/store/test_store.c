@@ -803,7 +803,7 @@ int main(void)
     /* ---- a name too long for ".<name>.tmp-<pid>-<n>" (issue 25: over ~220
      * bytes could not be written): the working copy's name is shortened ---- */
     {
-        char name[300], lp[4400], stale_long[4600], sb[300];
+        char name[300], lp[4400], stale_long[4600];
         memset(name, 'l', 240);
         memcpy(name + 237, ".h5", 4);
         snprintf(lp, sizeof lp, "%s/%.255s", dir, name);
@@ -820,8 +820,16 @@ int main(void)
         pid_t pid = fork();
         if (pid == 0) _exit(0);
         waitpid(pid, NULL, 0);
-        es__short_base(name, 56, sb, sizeof sb);
-        snprintf(stale_long, sizeof stale_long, "%s/.%.200s.tmp-%ld-0", dir, sb, (long)pid);
+        {
+            /* this process's working-copy name, with the dead writer's pid */
+            char *mine = es__temp_sibling(ctx, lp, ES__TEMP_WORKING_COPY, "0");
+            char *tmp = mine ? strstr(mine, ".tmp-") : NULL;
+            ES_CHECK(tmp != NULL);
+            if (tmp)
+                snprintf(stale_long, sizeof stale_long, "%.*s.tmp-%ld-0", (int)(tmp - mine),
+                         mine, (long)pid);
+            es__free(ctx, mine);
+        }
         es_test_write_file(stale_long, "junk");
         ES_CHECK_OK(ctx, es_store_open(ctx, lp, ES_STORE_WRITE, &s));
         ES_CHECK(s && es_store_has(s, "mean/long"));
