@@ -303,12 +303,11 @@ int es_store_pending(const es_store *store)
 
 es_status es_store_close(es_store *store)
 {
-    es_status rc = ES_OK;
     if (!store) return ES_OK;
     es__h5_quiet q;
     es__h5_quiet_begin(&q);
     const bool pending = store->work || es__beside_pending(store);
-    rc = pending && store->broken ? ES_EIO : ES_OK;
+    es_status rc = pending && store->broken ? ES_EIO : ES_OK;
     if (pending && !store->broken) {
         rc = es__store_publish(store->ctx, store);
         if (rc != ES_OK)

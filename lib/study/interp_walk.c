@@ -281,8 +281,8 @@ es_status es_study_interp(es_ctx *ctx, es_store *store, const es_study_interp_op
     if (!o->weights && o->steps > 1 && es_study_frame_path(o->output, 0, probe, sizeof probe))
         ES_FAIL(ctx, ES_EINVAL, "with several frames, the output must be a pattern with one "
                 "integer conversion, like 'out_%%02d.obj'");
-    if (o->name) snprintf(wk.name, sizeof wk.name, "%s", o->name);
-    else default_name(o->output, wk.name, sizeof wk.name);
+    /* the frames' result names (nothing is stored without one) */
+    snprintf(wk.name, sizeof wk.name, "%s", o->name ? o->name : "");
     /* every frame's result name is free (or replaced) before a frame is written */
     for (int64_t i = 0; o->name && i < (o->weights ? 1 : o->steps); i++) {
         char rn[300];

@@ -45,12 +45,6 @@ PUBLIC = {
     "es_study.h": "study", "es_plot.h": "figure", "es_render.h": "figure",
     "es_figure.h": "figure", "es_synth.h": "synth",
 }
-FOREIGN = {  # header pattern -> the only module that may include it
-    re.compile(r"^(hdf5|H5[A-Za-z]*)\.h$"): "h5",
-    re.compile(r"^cholmod[a-z_]*\.h$"): "sparse",
-    re.compile(r"^cairo[a-z-]*\.h$"): "figure",
-    re.compile(r"^mpi\.h$"): "parallel",
-}
 # The families of public function names (es_<family>_...) each module owns:
 # the name says which module's header declares it.
 FAMILIES = {
@@ -78,6 +72,10 @@ README_LIBS = {
     "OpenMP": re.compile(r"^omp\.h$"), "LAPACKE": re.compile(r"^lapacke[a-z_]*\.h$"),
     "BLAS": re.compile(r"^cblas[a-z_]*\.h$"), "cairo": re.compile(r"^cairo[a-z-]*\.h$"),
 }
+# The libraries that only one module may include: header pattern -> module
+# (rule 5, which also covers tools/ and notebooks-c/)
+FOREIGN = {README_LIBS["HDF5"]: "h5", README_LIBS["CHOLMOD"]: "sparse",
+           README_LIBS["cairo"]: "figure", README_LIBS["Open MPI"]: "parallel"}
 PUBLIC_FN = re.compile(r"ES_API\s+[^;(]*?\b(es_[a-z0-9_]+)\s*\(", re.S)
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]', re.M)
 LIB_MAX, CMD_MAX = 800, 250
